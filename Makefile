@@ -1,0 +1,38 @@
+# Two commands on a fresh Debian 12 machine:  make run  |  make test
+# Every target installs what is missing (Debian's ROS 1 packages) and builds the workspace in .ws/ first.
+SHELL := /bin/bash
+.SHELLFLAGS := -eo pipefail -c
+.DEFAULT_GOAL := help
+
+ENV := source tools/env.sh
+# `make test TESTS=run_tests_exam` runs one catkin test target instead of all of them.
+TESTS ?= run_tests
+
+.PHONY: help deps build run run-submarine test report bench soak clean
+
+help:
+	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
+	@echo "make run-submarine  the same with the underwater drone"
+	@echo "make test           install, build, and run every unit and rostest test"
+	@echo "make report         regenerate docs/ (command outputs, figures, PDF) from a live run"
+	@echo "make bench          benchmarks of the exam node against the naive baseline"
+	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
+	@echo "make clean          remove the build workspace .ws/"
+
+deps:
+	@tools/install_deps.sh
+
+build: deps
+	@tools/build_ws.sh
+
+run: build
+	@$(ENV) && exec roslaunch exam exam.launch
+
+run-submarine: build
+	@$(ENV) && exec roslaunch exam exam_submarine.launch
+
+test: build
+	@tools/run_tests.sh $(TESTS)
+
+clean:
+	rm -rf .ws

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Installs what the workspace needs, from Debian 12's own ROS 1 packages; skips what is already there.
+# Usage: tools/install_deps.sh [extra Debian packages...]   (make calls it; safe to run again)
+set -euo pipefail
+
+# ROS Noetic from packages.ros.org (Ubuntu 20.04) lives in /opt/ros: nothing to install here,
+# the README lists the ros-noetic-* names to install instead.
+if [ -f /opt/ros/noetic/setup.bash ]; then
+  exit 0
+fi
+
+packages=(
+  ros-core-dev catkin python3-catkin-pkg
+  python3-rospy python3-std-msgs python3-rostest python3-rostopic python3-rosservice
+  python3-rosnode python3-roslaunch python3-rosbag rosbash
+  python3-diagnostic-updater python3-diagnostic-msgs
+  python3-pytest python3-hypothesis python3-matplotlib
+  "$@"
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install_deps: not root and no sudo; install: ${missing[*]}" >&2; exit 1; }
+  sudo="sudo"
+fi
+echo "install_deps: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
