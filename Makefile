@@ -34,5 +34,14 @@ run-submarine: build
 test: build
 	@tools/run_tests.sh $(TESTS)
 
+report: build
+	@tools/report.sh
+
+bench: build
+	@bench/run.sh
+
+soak: build
+	@tools/soak.sh
+
 clean:
 	rm -rf .ws
