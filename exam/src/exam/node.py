@@ -1,0 +1,301 @@
+"""The exam node: altitude (or depth) from the drone's sensors at 10 Hz, and a debounced warning LED.
+
+This module is the only place that talks to ROS. The physics is in :mod:`exam.formulas`, the caching of
+inputs in :mod:`exam.inputs`, the warning rule in :mod:`exam.debounce`, the service calls in
+:mod:`exam.warning_link`, and what differs between the two drones in :mod:`exam.modes`.
+
+How one reading travels (each step runs on the thread rospy gives it):
+
+1. A sensor callback validates the reading and caches it (exam question 11: inputs arrive at different
+   rates, so the latest value of each is kept). If every input is fresh, it computes the value and feeds
+   the debouncer *right away*, so a crossing back below the threshold is acted on within the callback.
+2. The debouncer says whether the state changed; if so, the new state is handed to the warning link,
+   whose own thread calls the service (question 13). If an excess has just begun, a one-shot timer is
+   armed for the instant the delay expires (question 14b), so the WARNING is not late by a tick.
+3. A periodic timer publishes the latest value at ``~rate`` Hz, only while every input is fresh.
+4. A 1 Hz timer publishes /diagnostics.
+
+State shared by these threads (the caches, the value, the debouncer) is guarded by one lock, held only
+for short computations, never across a publish or a service call.
+
+ROS Parameters (private; units are those of the mode: m for both modes):
+    ~mode (str, default "altitude"): "altitude" (aerial drone, sheet 000) or "depth" (underwater, 001).
+    ~threshold (float, m, default 1300 in altitude mode, 150 in depth mode): the warning limit; only
+        values strictly above it are an excess.
+    ~delay (float, s, default 5.0, >= 0): how long the excess must last before WARNING.
+    ~rate (float, Hz, default 10.0, > 0): publishing rate of the output topic.
+    ~timeout (float, s, default 5.0, > 0): an input older than this is stale; nothing is published and
+        no excess is timed until it is fresh again.
+
+Subscribed Topics:
+    altitude mode: temperature (std_msgs/Float32, degC), pressure (std_msgs/Float32, Pa),
+        alt_warn_led (std_msgs/String, "GREEN"/"RED", latched by the drone).
+    depth mode: pressure_robot (std_msgs/Float32, Pa), pressure_remote (std_msgs/Float32, Pa),
+        depth_warn_led (std_msgs/String, "GREEN"/"RED", latched by the drone).
+
+Published Topics:
+    altitude mode: altitude (std_msgs/Float32, m). depth mode: depth (std_msgs/Float32, m).
+    /diagnostics (diagnostic_msgs/DiagnosticArray): "<node>: inputs" and "<node>: warning" statuses.
+
+Services called:
+    altitude mode: altitude_warning (mydrone/AltitudeWarning) with "NORMAL" or "WARNING".
+    depth mode: depth_warning (submarinedrone/DepthWarning) with "NORMAL" or "WARNING".
+"""
+import math
+import sys
+import threading
+
+import diagnostic_updater
+import rospy
+from diagnostic_msgs.msg import DiagnosticStatus
+from std_msgs.msg import Float32, String
+
+from exam.debounce import NORMAL, WARNING, Debouncer
+from exam.inputs import InputCache
+from exam.modes import MODES
+from exam.warning_link import WarningLink
+
+#: Seconds between two identical warnings on a 10 Hz path, so a fault does not flood /rosout.
+THROTTLE_S = 5.0
+#: Seconds between two attempts while the warning service is absent or failing.
+RETRY_PERIOD_S = 1.0
+#: LED colours reported by the drone, as warning states.
+LED_STATES = {'GREEN': NORMAL, 'RED': WARNING}
+LED_COLOURS = {state: colour for colour, state in LED_STATES.items()}
+
+
+class ParamError(ValueError):
+    """A parameter given to the node is unusable; the message names it and its value."""
+
+
+def read_number(name, default, is_valid, requirement):
+    """Read the private float parameter ``name``; raise ParamError if it is not a finite valid number.
+
+    A value that was given but is wrong is an error, never silently replaced by the default: a typo in
+    a launch file must stop the node, not fly with a threshold nobody chose.
+    """
+    value = rospy.get_param(name, default)
+    number = None
+    if not isinstance(value, bool):  # YAML true/false would otherwise pass as 1.0/0.0
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            pass
+    if number is None or not math.isfinite(number) or not is_valid(number):
+        raise ParamError('parameter %s = %r: expected %s' % (rospy.resolve_name(name), value, requirement))
+    return number
+
+
+class ExamNode(object):
+    """Computes, publishes and watches one value (altitude or depth); see the module docstring."""
+
+    def __init__(self):
+        # 1. Parameters, all validated before anything is created.
+        mode_name = rospy.get_param('~mode', 'altitude')
+        if mode_name not in MODES:
+            raise ParamError('parameter %s = %r: expected one of %s'
+                             % (rospy.resolve_name('~mode'), mode_name, ', '.join(sorted(MODES))))
+        self._mode = mode = MODES[mode_name]
+        threshold = read_number('~threshold', mode.default_threshold, lambda x: True, 'a finite number')
+        delay = read_number('~delay', 5.0, lambda x: x >= 0.0, 'a number of seconds >= 0')
+        rate = read_number('~rate', 10.0, lambda x: x > 0.0, 'a rate in Hz > 0')
+        self._timeout = read_number('~timeout', 5.0, lambda x: x > 0.0, 'a number of seconds > 0')
+
+        self._lock = threading.Lock()
+        self._inputs = [InputCache(spec.topic, spec.problem) for spec in mode.inputs]
+        self._debouncer = Debouncer(threshold, delay)
+        self._value = None
+        self._armed_deadline = None
+
+        # 2. Outputs and the service link, before any callback can fire.
+        self._pub = rospy.Publisher(mode.output, Float32, queue_size=10)
+        self._service = rospy.resolve_name(mode.service)
+        self._link = WarningLink(self._call_service, self._on_call_failed, self._on_call_delivered,
+                                 retry_period=RETRY_PERIOD_S)
+        self._link.start()
+        rospy.on_shutdown(lambda: self._link.stop(timeout=1.0))
+        self._diagnostics = diagnostic_updater.Updater()
+        self._diagnostics.setHardwareID(rospy.get_name())
+        self._diagnostics.add('inputs', self._diagnose_inputs)
+        self._diagnostics.add('warning', self._diagnose_warning)
+
+        rospy.loginfo('%s: mode %s, %s > %.1f %s for %.1f s -> WARNING via %s; publishing %s at %.1f Hz; '
+                      'inputs %s stale after %.1f s', rospy.get_name(), mode.name, mode.output, threshold,
+                      mode.unit, delay, self._service, rospy.resolve_name(mode.output), rate,
+                      ', '.join(rospy.resolve_name(c.topic) for c in self._inputs), self._timeout)
+
+        # 3. Inputs and timers last, so no callback sees a half-built node.
+        for spec, cache in zip(mode.inputs, self._inputs):
+            rospy.Subscriber(spec.topic, Float32, self._on_reading, callback_args=(spec, cache),
+                             queue_size=10)
+        rospy.Subscriber(mode.led_topic, String, self._on_led, queue_size=10)
+        # reset=True: a timer survives time jumping backwards (rosbag play --loop under sim time).
+        rospy.Timer(rospy.Duration(1.0 / rate), self._on_publish_tick, reset=True)
+        rospy.Timer(rospy.Duration(1.0), lambda event: self._diagnostics.update(), reset=True)
+
+    # --- inputs -------------------------------------------------------------------------------------
+
+    def _on_reading(self, msg, args):
+        """A sensor reading: validate, cache, compute, and let the debouncer judge it at once."""
+        spec, cache = args
+        now = rospy.get_time()
+        change = deadline = None
+        with self._lock:
+            problem = cache.offer(msg.data, now)
+            if problem is None:
+                value = self._compute(now)
+                if value is not None:
+                    self._value = value
+                    change = self._debouncer.update(value, now)
+                    deadline = self._debouncer.deadline
+        if problem is not None:
+            # Never cached, never published, never seen by the debouncer: just reported.
+            rospy.logwarn_throttle(THROTTLE_S, 'ignoring %s = %r %s: %s'
+                                   % (rospy.resolve_name(spec.topic), msg.data, spec.unit, problem))
+            return
+        if change is not None:
+            self._announce(change, value)
+        if deadline is not None:
+            self._arm(deadline, now)
+
+    def _compute(self, now):
+        """The value from the cached inputs, or None unless every input is fresh. Call under the lock."""
+        if not all(cache.is_fresh(now, self._timeout) for cache in self._inputs):
+            return None
+        return self._mode.compute(*(cache.value for cache in self._inputs))
+
+    def _stale_inputs(self, now):
+        """Topics whose latest value is older than ~timeout (or missing). Call under the lock."""
+        return [cache for cache in self._inputs if not cache.is_fresh(now, self._timeout)]
+
+    # --- warning ------------------------------------------------------------------------------------
+
+    def _arm(self, deadline, now):
+        """Wake up when the pending excess would turn into WARNING (once per deadline)."""
+        with self._lock:
+            if deadline == self._armed_deadline:
+                return
+            self._armed_deadline = deadline
+        rospy.Timer(rospy.Duration(max(deadline - now, 0.0)), self._on_deadline, oneshot=True)
+
+    def _on_deadline(self, event):
+        """The delay of an excess has (nearly) run out: WARNING if the excess was never interrupted."""
+        now = rospy.get_time()
+        change = None
+        with self._lock:
+            if self._stale_inputs(now):
+                # No data for longer than the timeout: the excess was not observed continuously.
+                self._debouncer.interrupt()
+            else:
+                change = self._debouncer.poll(now)
+            deadline = self._debouncer.deadline
+            value = self._value
+            if change is None and deadline is not None:
+                self._armed_deadline = None  # a timer woke a little early: arm it again for the rest
+        if change is not None:
+            self._announce(change, value)
+        elif deadline is not None:
+            self._arm(deadline, now)
+
+    def _announce(self, state, value):
+        """Log a change of the warning state and hand it to the link, which calls the service."""
+        mode, debouncer = self._mode, self._debouncer
+        if state == WARNING:
+            why = 'above the threshold %.1f %s for %.1f s' % (debouncer.threshold, mode.unit, debouncer.delay)
+        else:
+            why = 'at or below the threshold %.1f %s' % (debouncer.threshold, mode.unit)
+        rospy.loginfo('%s %.1f %s %s: %s', mode.output, value, mode.unit, why, state)
+        self._link.request(state)
+
+    def _on_led(self, msg):
+        """The drone's LED report: lets the link re-send the wanted state after a drone restart."""
+        state = LED_STATES.get(msg.data)
+        if state is None:
+            rospy.logwarn_throttle(THROTTLE_S, 'ignoring %s = %r: expected GREEN or RED'
+                                   % (rospy.resolve_name(self._mode.led_topic), msg.data))
+            return
+        self._link.led_reported(state)
+
+    def _call_service(self, state):
+        """One call of the warning service (runs on the link's thread, may block)."""
+        rospy.wait_for_service(self._service, timeout=RETRY_PERIOD_S)
+        response = rospy.ServiceProxy(self._service, self._mode.service_type)(state)
+        return response.success, response.message
+
+    def _on_call_failed(self, state, reason):
+        rospy.logwarn_throttle(THROTTLE_S, 'could not set %s to %s (retrying every %.0f s): %s'
+                               % (self._service, state, RETRY_PERIOD_S, reason))
+
+    def _on_call_delivered(self, state):
+        rospy.loginfo('%s: LED set to %s', self._service, state)
+
+    # --- output -------------------------------------------------------------------------------------
+
+    def _on_publish_tick(self, event):
+        """Publish the latest value, unless an input is missing or stale (then say which, throttled)."""
+        now = rospy.get_time()
+        with self._lock:
+            stale = self._stale_inputs(now)
+            if stale:
+                self._debouncer.interrupt()
+            value = self._value
+        if not stale:
+            self._pub.publish(Float32(value))
+            return
+        if all(cache.stamp is None for cache in stale):
+            rospy.loginfo_throttle(THROTTLE_S, 'waiting for the first reading of %s'
+                                   % ', '.join(rospy.resolve_name(c.topic) for c in stale))
+        else:
+            rospy.logwarn_throttle(THROTTLE_S, 'not publishing %s: no fresh reading of %s for more '
+                                   'than %.1f s' % (rospy.resolve_name(self._mode.output),
+                                                    ', '.join(rospy.resolve_name(c.topic) for c in stale),
+                                                    self._timeout))
+
+    # --- diagnostics --------------------------------------------------------------------------------
+
+    def _diagnose_inputs(self, stat):
+        now = rospy.get_time()
+        with self._lock:
+            rows = [(c.topic, c.rate(now), c.age(now), c.rejected) for c in self._inputs]
+        stale = []
+        for topic, rate, age, rejected in rows:
+            stat.add('%s rate [Hz]' % topic, '%.2f' % rate)
+            stat.add('%s age [s]' % topic, 'never received' if age is None else '%.2f' % age)
+            stat.add('%s rejected readings' % topic, rejected)
+            if age is None or age > self._timeout:
+                stale.append(topic)
+        if stale:
+            stat.summary(DiagnosticStatus.WARN, 'stale or missing: %s' % ', '.join(stale))
+        else:
+            stat.summary(DiagnosticStatus.OK, 'all inputs fresh')
+        return stat
+
+    def _diagnose_warning(self, stat):
+        with self._lock:
+            value, state = self._value, self._debouncer.state
+            threshold, deadline = self._debouncer.threshold, self._debouncer.deadline
+        link = self._link.snapshot()
+        unit = self._mode.unit
+        stat.add('%s [%s]' % (self._mode.output, unit), 'none yet' if value is None else '%.2f' % value)
+        stat.add('threshold [%s]' % unit, '%.2f' % threshold)
+        stat.add('state', state or 'unknown (no reading yet)')
+        stat.add('WARNING due at [s]', 'not pending' if deadline is None else '%.3f' % deadline)
+        stat.add('LED wanted', LED_COLOURS.get(link['wanted'], 'nothing yet'))
+        stat.add('LED shows', LED_COLOURS[link['shown']])
+        stat.add('failed service calls', link['failures'])
+        if link['failing']:
+            stat.summary(DiagnosticStatus.ERROR, 'cannot reach %s: %s' % (self._service, link['last_error']))
+        else:
+            stat.summary(DiagnosticStatus.OK, 'state %s, LED %s'
+                         % (state or 'unknown', LED_COLOURS[link['shown']]))
+        return stat
+
+
+def main():
+    rospy.init_node('exam')
+    try:
+        ExamNode()
+    except ParamError as err:
+        rospy.logfatal(str(err))
+        sys.exit(1)
+    rospy.spin()

@@ -1,0 +1,155 @@
+"""Delivery rules of the warning link, against a fake service driven by events (no sleeps)."""
+import threading
+
+import pytest
+
+from exam.debounce import NORMAL, WARNING
+from exam.warning_link import WarningLink
+
+WAIT_S = 5.0  # generous deadline for the worker thread to act
+
+
+class FakeService(object):
+    """Records calls; can be made absent (raises) or blocking (waits for release)."""
+
+    def __init__(self):
+        self.calls = []
+        self.available = True
+        self.hold = None  # a threading.Event to wait on inside the call, when set
+        self.entered = threading.Event()
+        self.changed = threading.Condition()
+
+    def __call__(self, state):
+        self.entered.set()
+        if self.hold is not None:
+            self.hold.wait(WAIT_S)
+        if not self.available:
+            raise IOError('service /altitude_warning unavailable')
+        with self.changed:
+            self.calls.append(state)
+            self.changed.notify_all()
+        return True, 'LED set'
+
+    def wait_calls(self, count):
+        with self.changed:
+            assert self.changed.wait_for(lambda: len(self.calls) >= count, WAIT_S), self.calls
+            return list(self.calls)
+
+
+@pytest.fixture
+def service():
+    return FakeService()
+
+
+@pytest.fixture
+def make_link(service):
+    links = []
+    failures = []
+
+    def make(retry_period=0.01):
+        link = WarningLink(service, lambda state, reason: failures.append((state, reason)),
+                           lambda state: None, retry_period=retry_period)
+        link.failures_seen = failures
+        link.start()
+        links.append(link)
+        return link
+
+    yield make
+    for link in links:
+        link.stop(timeout=WAIT_S)
+
+
+def settle(link):
+    """Wait until the worker has nothing left to send (what it shows is what is wanted)."""
+    for _ in range(int(WAIT_S / 0.01)):
+        snap = link.snapshot()
+        if snap['wanted'] in (None, snap['shown']):
+            return snap
+        threading.Event().wait(0.01)
+    raise AssertionError('link did not settle: %r' % (link.snapshot(),))
+
+
+def test_no_call_for_normal_at_start_since_the_led_starts_green(service, make_link):
+    link = make_link()
+    link.request(NORMAL)
+    settle(link)
+    link.request(WARNING)
+    assert service.wait_calls(1) == [WARNING]
+
+
+def test_one_call_per_change(service, make_link):
+    link = make_link()
+    link.request(WARNING)
+    service.wait_calls(1)
+    link.request(WARNING)
+    link.request(NORMAL)
+    assert service.wait_calls(2) == [WARNING, NORMAL]
+    settle(link)
+    assert service.calls == [WARNING, NORMAL]
+
+
+def test_absent_service_gets_the_latest_state_once_back(service, make_link):
+    service.available = False
+    link = make_link()
+    link.request(WARNING)
+    assert service.entered.wait(WAIT_S)
+    service.available = True
+    assert service.wait_calls(1) == [WARNING]
+    settle(link)
+    assert link.failures_seen and link.failures_seen[0][0] == WARNING
+    assert not link.snapshot()['failing']
+
+
+def test_flip_and_flip_back_while_absent_sends_nothing(service, make_link):
+    service.available = False
+    link = make_link()
+    link.request(WARNING)
+    service.entered.wait(WAIT_S)
+    link.request(NORMAL)  # back to what the LED shows
+    service.available = True
+    settle(link)
+    assert service.calls == []
+
+
+def test_a_blocked_call_does_not_block_requests(service, make_link):
+    service.hold = threading.Event()
+    link = make_link()
+    link.request(WARNING)
+    assert service.entered.wait(WAIT_S)
+    # The worker is stuck in the call; requesting must return at once.
+    done = threading.Event()
+    threading.Thread(target=lambda: (link.request(NORMAL), link.request(WARNING), done.set())).start()
+    assert done.wait(1.0)
+    service.hold.set()
+    assert service.wait_calls(1) == [WARNING]
+    settle(link)
+    assert service.calls == [WARNING]
+
+
+def test_a_drone_restart_reported_green_makes_it_resend_warning(service, make_link):
+    link = make_link()
+    link.request(WARNING)
+    service.wait_calls(1)
+    link.led_reported(WARNING)  # the drone confirms red: nothing to do
+    link.led_reported(NORMAL)   # the drone restarted: green again
+    assert service.wait_calls(2) == [WARNING, WARNING]
+
+
+def test_refused_call_counts_as_failure():
+    refusals = []
+    link = WarningLink(lambda state: (False, 'unknown status'),
+                       lambda state, reason: refusals.append(reason), lambda state: None,
+                       retry_period=10.0)
+    link.start()
+    try:
+        link.request(WARNING)
+        for _ in range(int(WAIT_S / 0.01)):
+            if link.snapshot()['failures']:
+                break
+            threading.Event().wait(0.01)
+        snap = link.snapshot()
+        assert snap['failing'] and snap['failures'] >= 1
+        assert 'unknown status' in snap['last_error']
+        assert snap['shown'] == NORMAL
+    finally:
+        link.stop(timeout=WAIT_S)
