@@ -2,6 +2,9 @@
 # ROS 1 needs the system interpreter: a pyenv or venv `python3` first on PATH has no rospy, and
 # rostest's hztest (#!/usr/bin/env python3) dies under it. So /usr/bin goes first.
 export PATH="/usr/bin:/bin:$PATH"
+# ROS's setup scripts read unset variables: relax `set -u` while sourcing them.
+_nounset=$([[ $- == *u* ]] && echo 1 || true)
+set +u
 if [ -f /opt/ros/noetic/setup.bash ] && [ -z "${ROS_DISTRO:-}" ]; then
   source /opt/ros/noetic/setup.bash
 fi
@@ -10,4 +13,5 @@ export EXAM_WS="${EXAM_WS:-$_repo/.ws}"
 if [ -f "$EXAM_WS/devel/setup.bash" ]; then
   source "$EXAM_WS/devel/setup.bash"
 fi
-unset _repo
+[ -n "$_nounset" ] && set -u
+unset _repo _nounset
