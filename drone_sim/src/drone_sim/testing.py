@@ -1,0 +1,118 @@
+"""Integration checks shared by the simulators' rostests (imported by test nodes only, never by a node).
+
+Both drones come from the same generic node, so one test case checks both; each package's test node
+subclasses SimulatorNodeCase and fills in its names and expected readings. The rostest file runs the
+node with zero noise and a constant profile, so every reading has an exact expected value.
+"""
+
+import subprocess
+import threading
+import time
+import unittest
+
+import rospy
+import rosservice
+from std_msgs.msg import Float32, String
+
+DEADLINE = 30.0  # s; generous, the test machine is shared
+
+
+class Recorder:
+    """Collects the messages of one topic, thread-safely, and waits for them with a deadline."""
+
+    def __init__(self, topic, msg_type):
+        self._lock = threading.Lock()
+        self._messages = []
+        self._sub = rospy.Subscriber(topic, msg_type, self._on_message)
+
+    def _on_message(self, msg):
+        with self._lock:
+            self._messages.append(msg.data)
+
+    def messages(self):
+        with self._lock:
+            return list(self._messages)
+
+    def wait_for(self, count, deadline=DEADLINE):
+        """The first ``count`` messages, or the fewer received by the deadline."""
+        end = time.monotonic() + deadline
+        while time.monotonic() < end and len(self.messages()) < count and not rospy.is_shutdown():
+            time.sleep(0.05)
+        return self.messages()[:count]
+
+    def close(self):
+        self._sub.unregister()
+
+
+class SimulatorNodeCase(unittest.TestCase):
+    """Subclasses set the class attributes below and implement check_readings."""
+
+    PACKAGE = None  # e.g. 'mydrone'
+    SCRIPT = None  # e.g. 'mydrone_node.py'
+    SENSOR_TOPICS = ()  # absolute names of the Float32 sensor topics
+    TRUTH_TOPIC = None  # absolute name of the private truth topic
+    TRUE_VALUE = None  # the constant profile value of the .test file
+    SERVICE = None  # absolute service name
+    SERVICE_TYPE = None  # the service class
+    LED_TOPIC = None  # absolute name of the latched LED topic
+    # (private param, value as given on a command line, resolved name expected in the fatal log)
+    BAD_PARAMS = ()
+
+    def check_readings(self, readings):
+        """Assert the first reading of each sensor topic; ``readings`` maps topic -> value."""
+        raise NotImplementedError
+
+    def test_advertised_types(self):
+        expected = {topic: 'std_msgs/Float32' for topic in self.SENSOR_TOPICS + (self.TRUTH_TOPIC,)}
+        expected[self.LED_TOPIC] = 'std_msgs/String'
+        end = time.monotonic() + DEADLINE
+        while True:
+            published = dict(rospy.get_published_topics())
+            if all(published.get(t) == kind for t, kind in expected.items()) or time.monotonic() > end:
+                break
+            time.sleep(0.1)
+        self.assertEqual({t: published.get(t) for t in expected}, expected)
+        rospy.wait_for_service(self.SERVICE, timeout=DEADLINE)
+        self.assertEqual(rosservice.get_service_type(self.SERVICE), self.SERVICE_TYPE._type)
+
+    def test_readings_and_truth(self):
+        recorders = {t: Recorder(t, Float32) for t in self.SENSOR_TOPICS + (self.TRUTH_TOPIC,)}
+        readings = {t: r.wait_for(1) for t, r in recorders.items()}
+        for recorder in recorders.values():
+            recorder.close()
+        for topic, values in readings.items():
+            self.assertEqual(len(values), 1, 'no message on %s within %.0f s' % (topic, DEADLINE))
+        self.assertAlmostEqual(readings[self.TRUTH_TOPIC][0], self.TRUE_VALUE, places=3)
+        self.check_readings({t: v[0] for t, v in readings.items()})
+
+    def test_service_drives_latched_led(self):
+        led = Recorder(self.LED_TOPIC, String)
+        self.assertEqual(led.wait_for(1), ['GREEN'], 'the latched LED must start GREEN')
+        rospy.wait_for_service(self.SERVICE, timeout=DEADLINE)
+        call = rospy.ServiceProxy(self.SERVICE, self.SERVICE_TYPE)
+        responses = [call(status) for status in ('warning', 'WARNING', 'WARNING', 'BOOM', 'NORMAL')]
+        self.assertEqual([r.success for r in responses], [False, True, True, False, True])
+        for refused in (responses[0], responses[3]):
+            self.assertIn("'NORMAL'", refused.message)
+            self.assertIn("'WARNING'", refused.message)
+        self.assertIn('RED', responses[1].message)
+        self.assertIn('GREEN', responses[4].message)
+        # One message per change: a refused or repeated request publishes nothing. The node publishes
+        # before it answers, so all three are on their way by now.
+        self.assertEqual(led.wait_for(3), ['GREEN', 'RED', 'GREEN'])
+        led.close()
+        # A late subscriber gets the current colour from the latch.
+        late = Recorder(self.LED_TOPIC, String)
+        self.assertEqual(late.wait_for(1), ['GREEN'])
+        late.close()
+
+    def test_bad_params_exit_nonzero(self):
+        for param, value, resolved in self.BAD_PARAMS:
+            with self.subTest(param=param, value=value):
+                # A namespace of its own: a node that wrongly started would not disturb the others.
+                done = subprocess.run(['rosrun', self.PACKAGE, self.SCRIPT, '__ns:=/bad',
+                                       '_%s:=%s' % (param, value)],
+                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                      universal_newlines=True, timeout=DEADLINE)
+                self.assertNotEqual(done.returncode, 0, done.stdout)
+                self.assertIn(resolved, done.stdout)
