@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""Restart re-sync (issue 6): a drone or exam node that crashes and respawns is brought back in line.
+
+Runs in restart.test against fake_drone.py (hovering above the threshold, respawn="true") and the exam
+node (respawn="true", ~delay from the test's ~delay param). Each phase kills processes with SIGKILL, as
+a crash or power loss would, and reads the calls from the drone's own record.
+"""
+import sys
+import time
+import unittest
+
+import rospy
+import rostest
+from std_msgs.msg import Float32
+
+from ops_helpers import DroneRecord, Latest, kill_node, node_pid, process_start_time, stays, wait_for
+
+PKG = 'exam'
+EXAM = '/exam'
+DRONE = '/fake_drone'
+# The issue's bound from the drone's LED coming back GREEN to the WARNING being re-sent.
+RESYNC_BOUND = 2.0
+# Long enough to see a repeated call: the exam node retries every second and publishes at 10 Hz.
+STEADY_WINDOW = 3.0
+# Room for a respawn on a loaded 2-core machine (python start-up and rospy registration).
+RESPAWN_TIMEOUT = 30.0
+
+
+class RestartTest(unittest.TestCase):
+
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node('check_restart')
+        cls.delay = float(rospy.get_param('~delay'))
+        cls.drone = DroneRecord()
+        cls.altitude = Latest('altitude', Float32)
+
+    def calls(self):
+        record = self.drone.record()
+        return None if record is None else [status for _stamp, status in record['calls']]
+
+    def new_drone_record(self, old_pid):
+        record = self.drone.record()
+        return record if record is not None and record['pid'] != old_pid else None
+
+    def assert_steady(self, expected):
+        """The drone has received exactly `expected` and nothing more for STEADY_WINDOW."""
+        self.assertTrue(stays(lambda: self.calls() == expected, STEADY_WINDOW),
+                        'calls %s, expected exactly %s in steady state' % (self.calls(), expected))
+
+    def test_1_one_warning_then_silence(self):
+        self.assertIsNotNone(wait_for(self.calls, RESPAWN_TIMEOUT), 'no record from %s' % DRONE)
+        self.assertIsNotNone(wait_for(lambda: self.calls() or None, self.delay + 20.0),
+                             'no WARNING call while hovering above the threshold')
+        self.assert_steady(['WARNING'])
+
+    def test_2_drone_restart_gets_warning_again(self):
+        old_pid = kill_node(DRONE)
+        record = wait_for(lambda: self.new_drone_record(old_pid), RESPAWN_TIMEOUT)
+        self.assertIsNotNone(record, 'the drone did not respawn within %.0f s' % RESPAWN_TIMEOUT)
+        self.assertEqual(record['led'], 'GREEN', 'a restarted drone must come back GREEN')
+        record = wait_for(lambda: (self.drone.record() if self.drone.record()['calls'] else None),
+                          RESYNC_BOUND + 10.0)
+        self.assertIsNotNone(record, 'WARNING was never re-sent to the restarted drone')
+        first_stamp, first_status = record['calls'][0]
+        self.assertEqual(first_status, 'WARNING')
+        resync = first_stamp - record['started']
+        rospy.loginfo('re-sync: WARNING %.3f s after the restarted drone published GREEN', resync)
+        self.assertLessEqual(resync, RESYNC_BOUND, 'WARNING re-sent after %.3f s' % resync)
+        self.assert_steady(['WARNING'])
+        self.assertEqual(self.drone.record()['led'], 'RED')
+
+    def test_3_exam_restart_alone_keeps_the_led_red(self):
+        old_pid = kill_node(EXAM)
+        new_pid = wait_for(lambda: (node_pid(EXAM) if node_pid(EXAM) not in (None, old_pid) else None),
+                           RESPAWN_TIMEOUT)
+        self.assertIsNotNone(new_pid, 'the exam node did not respawn within %.0f s' % RESPAWN_TIMEOUT)
+        restarted = time.time()
+        self.assertIsNotNone(wait_for(lambda: (self.altitude.get()[1] or 0.0) > restarted, 20.0),
+                             'the respawned exam node publishes no altitude')
+        # The respawned node reads RED from the latched LED and wants WARNING after the delay: nothing
+        # to send, and above all no NORMAL that would flash the LED green for `delay` seconds.
+        self.assertTrue(stays(lambda: self.calls() == ['WARNING'], self.delay + STEADY_WINDOW),
+                        'calls after the exam node restarted: %s' % self.calls())
+        self.assertEqual(self.drone.record()['led'], 'RED')
+
+    def test_4_both_restart_warning_after_the_delay(self):
+        old_drone = kill_node(DRONE)
+        old_exam = kill_node(EXAM)
+        exam_pid = wait_for(lambda: (node_pid(EXAM) if node_pid(EXAM) not in (None, old_exam) else None),
+                            RESPAWN_TIMEOUT)
+        self.assertIsNotNone(exam_pid, 'the exam node did not respawn')
+        exam_started = process_start_time(exam_pid)
+        self.assertIsNotNone(wait_for(lambda: self.new_drone_record(old_drone), RESPAWN_TIMEOUT),
+                             'the drone did not respawn')
+        record = wait_for(lambda: (self.drone.record() if self.drone.record()['calls'] else None),
+                          self.delay + 20.0)
+        self.assertIsNotNone(record, 'the respawned pair never reached WARNING')
+        stamp, status = record['calls'][0]
+        self.assertEqual(status, 'WARNING')
+        after = stamp - exam_started
+        rospy.loginfo('both restarted: WARNING %.3f s after the exam process started (delay %.1f s)',
+                      after, self.delay)
+        # Never before the delay (the debounce starts from the first reading, after start-up), and
+        # within the delay plus a generous start-up allowance.
+        self.assertGreaterEqual(after, self.delay)
+        self.assertLessEqual(after, self.delay + 15.0)
+        self.assert_steady(['WARNING'])
+
+
+if __name__ == '__main__':
+    rostest.rosrun(PKG, 'restart_resync', RestartTest, sys.argv)
