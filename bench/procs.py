@@ -1,0 +1,188 @@
+"""Processes of the benchmark: a master on a free port, the nodes under test, and their CPU and RSS.
+
+Every child runs in its own session (process group), so stopping it also stops anything it forked
+(roscore's rosmaster and rosout). Each group id is appended to ``pid_file`` the moment it exists:
+bench/run.sh's trap kills exactly those groups if this Python process itself dies without cleaning up.
+"""
+
+import os
+import signal
+import socket
+import subprocess
+import time
+
+from stats import cpu_percent
+
+CLOCK_TICKS = os.sysconf('SC_CLK_TCK')
+
+
+def free_port():
+    """A TCP port nobody listens on right now: bind to port 0 and let the kernel choose."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.bind(('127.0.0.1', 0))
+        return sock.getsockname()[1]
+
+
+def cpu_ticks(pid):
+    """utime + stime of ``pid`` in clock ticks, or None once it has exited."""
+    try:
+        with open('/proc/%d/stat' % pid) as f:
+            stat = f.read()
+    except OSError:
+        return None
+    # The command name (field 2) may hold spaces and parentheses: split after its last ')'.
+    fields = stat[stat.rindex(')') + 2:].split()
+    return int(fields[11]) + int(fields[12])
+
+
+def rss_kb(pid):
+    """Resident set size (VmRSS, kB) of ``pid``, or None once it has exited."""
+    try:
+        with open('/proc/%d/status' % pid) as f:
+            for line in f:
+                if line.startswith('VmRSS:'):
+                    return int(line.split()[1])
+    except OSError:
+        return None
+    return None
+
+
+def loadavg():
+    """The 1, 5 and 15 minute load averages: how busy the shared machine was around a measurement."""
+    with open('/proc/loadavg') as f:
+        return [float(x) for x in f.read().split()[:3]]
+
+
+class CpuWindow:
+    """CPU share of a set of processes between ``start()`` and ``stop()``, from /proc."""
+
+    def __init__(self, pids):
+        self.pids = list(pids)
+        self._t0 = None
+        self._ticks0 = None
+
+    def start(self):
+        self._t0 = time.monotonic()
+        self._ticks0 = {pid: cpu_ticks(pid) for pid in self.pids}
+
+    def stop(self):
+        """Percent of one core for each pid (None for a process that died meanwhile)."""
+        seconds = time.monotonic() - self._t0
+        result = {}
+        for pid in self.pids:
+            now, before = cpu_ticks(pid), self._ticks0[pid]
+            if now is None or before is None:
+                result[pid] = None
+            else:
+                result[pid] = cpu_percent(now - before, seconds, CLOCK_TICKS)
+        return result
+
+
+class Children:
+    """The processes this benchmark started, stopped by their own process group id only."""
+
+    def __init__(self, pid_file, log_dir):
+        self.pid_file = pid_file
+        self.log_dir = log_dir
+        self.procs = []
+        self.adopted = []
+
+    def start(self, name, argv, env):
+        """Start ``argv`` in a new session with output to ``<log_dir>/<name>.log``."""
+        log = open(os.path.join(self.log_dir, name + '.log'), 'ab')
+        proc = subprocess.Popen(argv, env=env, stdout=log, stderr=subprocess.STDOUT,
+                                stdin=subprocess.DEVNULL, start_new_session=True)
+        log.close()
+        self.procs.append(proc)
+        self._record(proc.pid)
+        return proc
+
+    def adopt(self, pid):
+        """Take responsibility for a process another child started in its own session.
+
+        roslaunch starts each node with setsid: if the launcher died hard, its nodes would outlive it.
+        """
+        self.adopted.append(pid)
+        self._record(pid)
+
+    def _record(self, pid):
+        with open(self.pid_file, 'a') as f:
+            f.write('%d\n' % pid)
+
+    def stop(self, procs=None, grace=5.0):
+        """SIGINT (rospy's clean shutdown), then SIGKILL after ``grace`` seconds, per process group."""
+        procs = list(self.procs if procs is None else procs)
+        for proc in procs:
+            _signal_group(proc, signal.SIGINT)
+        deadline = time.monotonic() + grace
+        for proc in procs:
+            try:
+                proc.wait(timeout=max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                pass
+            # The leader may be gone while a forked child (rosout under roscore) still runs.
+            _signal_group(proc, signal.SIGKILL)
+            proc.wait()
+            if proc in self.procs:
+                self.procs.remove(proc)
+
+    def release(self, pids, grace=5.0):
+        """Wait for adopted processes that their launcher is stopping; SIGKILL the ones that linger."""
+        deadline = time.monotonic() + grace
+        for pid in pids:
+            while _alive(pid) and time.monotonic() < deadline:
+                time.sleep(0.1)
+            if _alive(pid):
+                _kill_group(pid, signal.SIGKILL)
+            if pid in self.adopted:
+                self.adopted.remove(pid)
+
+    def stop_all(self):
+        """Everything still running: the started processes, then what roslaunch left behind."""
+        self.stop()
+        for pid in self.adopted:
+            _kill_group(pid, signal.SIGKILL)
+        self.adopted = []
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    # A zombie still answers kill(0); it holds no resources and is not ours to reap.
+    try:
+        with open('/proc/%d/stat' % pid) as f:
+            return f.read().rsplit(')', 1)[1].split()[0] != 'Z'
+    except OSError:
+        return False
+
+
+def _signal_group(proc, sig):
+    _kill_group(proc.pid, sig)
+
+
+def _kill_group(pgid, sig):
+    try:
+        os.killpg(pgid, sig)
+    except ProcessLookupError:
+        pass
+
+
+def start_master(children, env):
+    """Start ``roscore`` on a free port; return its process and URI once the master answers."""
+    import rosgraph  # the ROS environment is only needed from here on
+
+    port = free_port()
+    uri = 'http://127.0.0.1:%d/' % port
+    env = dict(env, ROS_MASTER_URI=uri)
+    proc = children.start('roscore', ['roscore', '-p', str(port)], env)
+    deadline = time.monotonic() + 30.0
+    master = rosgraph.Master('/bench', master_uri=uri)
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            raise RuntimeError('roscore on port %d exited with %d' % (port, proc.returncode))
+        if master.is_online():
+            return proc, uri
+        time.sleep(0.2)
+    raise RuntimeError('roscore on port %d did not answer within 30 s' % port)

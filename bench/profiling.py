@@ -1,0 +1,45 @@
+"""BENCH_PROFILE=1: sample the exam node with py-spy where it misses a goal, and rank its functions.
+
+py-spy reads the node's memory from outside (``--nonblocking``: it never pauses the process), so the
+profile shows the node as it runs, every thread included: rospy's receive threads, the timer, the
+service worker. bench/run.sh installs py-spy into a throwaway directory only when asked.
+"""
+
+import os
+import subprocess
+
+import stages
+import stats
+
+
+class Profiler:
+    def __init__(self, py_spy, out_dir):
+        self.py_spy = py_spy
+        self.out_dir = out_dir
+
+    def profile_missed(self, lab, results):
+        """Profiles of ours at 10 Hz (CPU goal) and at the first rate it could not sustain."""
+        profiles = {}
+        ours = results['ours']
+        targets = [10]
+        runs = (ours.get('max_rate') or {}).get('runs') or []
+        failed = [x['target_hz'] for x in runs if not x['sustained']]
+        if failed:
+            targets.append(min(failed))
+        for target in targets:
+            label = 'ours at ~rate %g Hz' % target
+            stages.progress('profile: py-spy on %s for 30 s' % label)
+            out = os.path.join(self.out_dir, 'py-spy-%g.txt' % target)
+            try:
+                stages.rate_and_cost(lab, 'ours', 30, rate=target,
+                                     during=lambda pid, window: self._record(pid, window, out))
+                profiles[label] = stats.summarize_collapsed(out)
+            except (RuntimeError, OSError, subprocess.SubprocessError) as e:
+                profiles[label] = 'profile failed: %s' % e
+        return profiles
+
+    def _record(self, pid, seconds, out):
+        subprocess.run([self.py_spy, 'record', '--pid', str(pid), '--duration', str(seconds),
+                        '--rate', '250', '--nonblocking', '--format', 'raw', '--output', out],
+                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                       timeout=seconds + 30)

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# `make bench`: measures the exam node against bench/baseline_exam_node.py and writes
+# docs/benchmarks.md and docs/figures/bench_fleet.png (about 13 minutes).
+#   BENCH_QUICK=1    a few seconds per stage; results go to a scratch directory, docs/ is untouched
+#   BENCH_PROFILE=1  also profile ours with py-spy (installed from PyPI into a throwaway directory)
+#   BENCH_RENDER_ONLY=1  measure nothing: render the docs again from the last results
+# Every process it starts runs in its own process group listed in a pid file; the trap kills exactly
+# those groups on exit, error or Ctrl-C, so nothing outlives the run.
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+source "$repo/tools/env.sh"
+
+scratch="$(mktemp -d /tmp/exam-bench.XXXXXX)"
+pid_file="$scratch/pids"
+touch "$pid_file"
+bench_pid=""
+
+cleanup() {
+  local status=$?
+  trap - EXIT INT TERM
+  if [ -n "$bench_pid" ] && kill -0 "$bench_pid" 2>/dev/null; then
+    kill -TERM "$bench_pid" 2>/dev/null || true
+    wait "$bench_pid" 2>/dev/null || true
+  fi
+  # Whatever bench.py could not stop itself (it was killed hard): its children's process groups.
+  while read -r pgid; do
+    kill -KILL -- "-$pgid" 2>/dev/null || true
+  done < "$pid_file"
+  if [ "$status" -eq 0 ]; then
+    rm -rf "$scratch"
+  else
+    echo "bench: failed (status $status); node logs kept in $scratch/logs" >&2
+  fi
+  exit "$status"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+mkdir -p "$scratch/logs"
+args=(--log-dir "$scratch/logs" --pid-file "$pid_file")
+if [ "${BENCH_QUICK:-0}" = 1 ]; then
+  out="$repo/.ws/bench-quick"
+  mkdir -p "$out"
+  args+=(--quick --out "$out" --figure "$out/bench_fleet.png" --json "$out/bench_results.json"
+         --command "BENCH_QUICK=1 make bench")
+else
+  args+=(--out "$repo/docs" --figure "$repo/docs/figures/bench_fleet.png"
+         --json "$repo/bench/results.json" --command "make bench")
+fi
+
+if [ "${BENCH_RENDER_ONLY:-0}" = 1 ]; then
+  # After editing bench/analysis.md or report.py: the same numbers, rendered again.
+  exec /usr/bin/python3 "$repo/bench/bench.py" "${args[@]}" --render-only
+fi
+if [ "${BENCH_PROFILE:-0}" = 1 ]; then
+  echo "bench: installing py-spy into $scratch/py-spy (BENCH_PROFILE=1)"
+  /usr/bin/python3 -m pip install --quiet --disable-pip-version-check --target "$scratch/py-spy" py-spy
+  args+=(--py-spy "$scratch/py-spy/bin/py-spy")
+fi
+
+# In the background so the trap runs at once on Ctrl-C instead of after the stage in progress.
+/usr/bin/python3 "$repo/bench/bench.py" "${args[@]}" &
+bench_pid=$!
+wait "$bench_pid"

@@ -1,0 +1,260 @@
+"""The measurements of `make bench`, one function per stage, each for one kind of node.
+
+A kind is ``ours`` (exam/scripts/exam_node.py), ``baseline`` (bench/baseline_exam_node.py) or ``floor``
+(bench/floor_node.py, the cheapest rospy node with the same topics). Every stage starts its node(s) in
+a namespace of its own, measures, stops them, and returns a plain dict that report.py renders.
+"""
+
+import os
+import time
+import xmlrpc.client
+
+import rosgraph
+
+import driver
+import procs
+import stats
+
+PYTHON = '/usr/bin/python3'
+BENCH = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(BENCH)
+SCRIPTS = {
+    'ours': os.path.join(REPO, 'exam', 'scripts', 'exam_node.py'),
+    'baseline': os.path.join(BENCH, 'baseline_exam_node.py'),
+    'floor': os.path.join(BENCH, 'floor_node.py'),
+}
+SIMULATOR = os.path.join(REPO, 'mydrone', 'scripts', 'mydrone_node.py')
+FLEET_LAUNCHER = os.path.join(REPO, 'exam', 'scripts', 'fleet_launch.py')
+BELOW, ABOVE = 1000.0, 1600.0
+THRESHOLD = 1300.0
+STARTUP_TIMEOUT = 30.0
+
+
+def progress(message):
+    print('[bench %s] %s' % (time.strftime('%H:%M:%S'), message), flush=True)
+
+
+def available(path):
+    """A script counts only once it has content: another engineer may have created it empty."""
+    return os.path.isfile(path) and os.path.getsize(path) > 0
+
+
+class Lab:
+    """What every stage needs: the master, the child processes and the environment of the nodes."""
+
+    def __init__(self, children, uri, env):
+        self.children = children
+        self.uri = uri
+        self.env = dict(env, ROS_MASTER_URI=uri)
+        self._serial = 0
+
+    def namespace(self, stage, kind):
+        self._serial += 1
+        return '/%s_%s_%d' % (stage, kind, self._serial)
+
+    def start_node(self, kind, ns, **params):
+        argv = [PYTHON, SCRIPTS[kind], '__ns:=' + ns, '__name:=exam']
+        argv += ['_%s:=%s' % (k, v) for k, v in sorted(params.items())]
+        return self.children.start(ns.strip('/') + '_exam', argv, self.env)
+
+    def start_simulator(self, ns):
+        argv = [PYTHON, SIMULATOR, '__ns:=' + ns, '__name:=mydrone']
+        return self.children.start(ns.strip('/') + '_mydrone', argv, self.env)
+
+
+class Rig:
+    """One node under test with the bench as its drone: player, fake service, altitude monitor."""
+
+    def __init__(self, lab, kind, ns, steps, slow=0.0, **params):
+        self.lab = lab
+        self.service = driver.FakeWarningService(ns + '/altitude_warning', slow)
+        self.monitor = driver.StreamMonitor(ns + '/altitude')
+        self.player = driver.Player(ns, steps)
+        self.proc = lab.start_node(kind, ns, **params)
+
+    def start(self):
+        """Play the script once the node is subscribed; raise if it never publishes."""
+        deadline = time.monotonic() + STARTUP_TIMEOUT
+        while not self.player.connected():
+            if self.proc.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError('node %s did not subscribe (exit code %s)'
+                                   % (self.proc.args, self.proc.poll()))
+            time.sleep(0.05)
+        self.player.start()
+        if not self.monitor.wait_first(STARTUP_TIMEOUT):
+            raise RuntimeError('node %s published no altitude' % (self.proc.args,))
+
+    def close(self):
+        self.lab.children.stop([self.proc])
+        self.player.stop()
+        self.monitor.close()
+        self.service.close()
+
+
+def rate_and_cost(lab, kind, window, rate=None, during=None):
+    """Altitude stream timing, CPU and RSS of one node fed steady readings below the threshold.
+
+    ``during(pid, window)``, when given, runs instead of the plain wait (a profiler attaching).
+    """
+    params = {'threshold': THRESHOLD}
+    if rate is not None:
+        params['rate'] = rate
+    rig = Rig(lab, kind, lab.namespace('rate', kind), [(0.0, BELOW)], **params)
+    try:
+        rig.start()
+        time.sleep(1.0)  # past the first messages' connection setup
+        rig.monitor.reset()
+        cpu = procs.CpuWindow([rig.proc.pid])
+        cpu.start()
+        if during is None:
+            time.sleep(window)
+        else:
+            during(rig.proc.pid, window)
+        usage = cpu.stop()[rig.proc.pid]
+        result = stats.interval_stats(rig.monitor.stamps())
+        result.update(cpu_percent=usage, rss_mb=_mb(procs.rss_kb(rig.proc.pid)),
+                      window_s=window, loadavg=procs.loadavg())
+        return result
+    finally:
+        rig.close()
+
+
+def latency(lab, kind, count, delay, hold, seed, slow=0.0):
+    """Scripted excursions above the threshold; latency of each WARNING and NORMAL call.
+
+    With ``slow`` > 0 the service takes that long per call and the stage is about the longest gap in
+    /altitude while calls are in flight.
+    """
+    steps = stats.crossing_script(count, delay, hold, stats.new_rng(seed), BELOW, ABOVE)
+    rig = Rig(lab, kind, lab.namespace('slow' if slow else 'latency', kind), steps, slow=slow,
+              threshold=THRESHOLD, delay=delay)
+    try:
+        rig.start()
+        rig.monitor.reset()
+        # The last NORMAL call may wait behind a slow call already in flight.
+        time.sleep(steps[-1][0] + hold + 2 * slow + 1.0)
+        stamps = rig.player.step_stamps
+        # Step 0 is the initial reading below; then pairs (above, back below).
+        cycles = list(zip(stamps[1::2], stamps[2::2]))
+        warning, normal, anomalies = stats.match_warning_calls(cycles, rig.service.calls(), delay)
+        return {
+            'excursions': len(cycles),
+            'delay_s': delay,
+            'slow_s': slow,
+            'warning': stats.summarize_ms(warning),
+            'normal': stats.summarize_ms(normal),
+            'anomalies': anomalies,
+            'anomaly_count': len(anomalies),
+            'stream': stats.interval_stats(rig.monitor.stamps()),
+            'loadavg': procs.loadavg(),
+        }
+    finally:
+        rig.close()
+
+
+def fleet(lab, kind, count, window):
+    """``count`` drone + exam pairs: each pair's /altitude rate, total CPU and RSS by role."""
+    launcher = None
+    started = []
+    if kind == 'ours' and available(FLEET_LAUNCHER):
+        namespaces = ['/drone%d' % i for i in range(1, count + 1)]
+        launcher = lab.children.start('fleet_%d' % count,
+                                      [PYTHON, FLEET_LAUNCHER, str(count)], lab.env)
+        pids = {}
+    else:
+        namespaces = [lab.namespace('fleet%d' % count, kind) for _ in range(count)]
+        pids = {}
+        for ns in namespaces:
+            started.append(lab.start_simulator(ns))
+            started.append(lab.start_node(kind, ns, threshold=THRESHOLD))
+            pids[ns + '/mydrone'] = started[-2].pid
+            pids[ns + '/exam'] = started[-1].pid
+    monitors = {ns: driver.StreamMonitor(ns + '/altitude') for ns in namespaces}
+    try:
+        deadline = time.monotonic() + STARTUP_TIMEOUT + 3.0 * count
+        for ns, monitor in monitors.items():
+            if not monitor.wait_first(max(0.1, deadline - time.monotonic())):
+                raise RuntimeError('fleet of %d: %s/altitude never published' % (count, ns))
+        if launcher is not None:
+            for ns in namespaces:
+                for name in ('mydrone', 'exam'):
+                    pids[ns + '/' + name] = node_pid(lab.uri, ns + '/' + name)
+                    lab.children.adopt(pids[ns + '/' + name])
+            pids['roslaunch'] = launcher.pid
+        time.sleep(2.0)
+        for monitor in monitors.values():
+            monitor.reset()
+        cpu = procs.CpuWindow(pids.values())
+        cpu.start()
+        time.sleep(window)
+        usage = cpu.stop()
+        rss = {name: procs.rss_kb(pid) for name, pid in pids.items()}
+        streams = {ns: stats.interval_stats(m.stamps()) for ns, m in monitors.items()}
+        # A pair that fell silent has no rate: it counts as 0 Hz, not as missing.
+        rates = [s['rate_hz'] or 0.0 for s in streams.values()]
+        return {
+            'pairs': count,
+            'window_s': window,
+            'launcher': 'exam/scripts/fleet_launch.py' if launcher else 'bench (one process per node)',
+            'rates_hz': rates,
+            'min_rate_hz': min(rates),
+            'max_rate_hz': max(rates),
+            'max_gap_ms': max((s['max_gap_ms'] or 0.0) for s in streams.values()),
+            'cpu_percent': _by_role(usage, pids),
+            'rss_mb': _by_role({pids[n]: v and v / 1024.0 for n, v in rss.items()}, pids),
+            'loadavg': procs.loadavg(),
+        }
+    finally:
+        for monitor in monitors.values():
+            monitor.close()
+        lab.children.stop([launcher] if launcher else started)
+        lab.children.release(list(lab.children.adopted))
+
+
+def _by_role(values_by_pid, pids):
+    """Sum per role (exam, mydrone, roslaunch) of a per-pid value."""
+    roles = {}
+    for name, pid in pids.items():
+        role = name.rsplit('/', 1)[-1]
+        value = values_by_pid.get(pid)
+        if value is not None:
+            roles[role] = roles.get(role, 0.0) + value
+    return roles
+
+
+def node_pid(uri, name):
+    """Pid of a registered node, asked from the node itself (rosnode info does the same)."""
+    master = rosgraph.Master('/bench', master_uri=uri)
+    deadline = time.monotonic() + STARTUP_TIMEOUT
+    while True:
+        try:
+            api = master.lookupNode(name)
+            code, _, pid = xmlrpc.client.ServerProxy(api).getPid('/bench')
+            if code == 1:
+                return pid
+        except (rosgraph.MasterError, OSError):
+            pass
+        if time.monotonic() > deadline:
+            raise RuntimeError('node %s never registered' % name)
+        time.sleep(0.2)
+
+
+def _mb(kb):
+    return kb / 1024.0 if kb is not None else None
+
+
+def max_rate(lab, kind, rates, window):
+    """The highest ``~rate`` sustained within 1 % with interval sd < 1 ms, and each attempt."""
+    runs = []
+    for target in rates:
+        progress('  %s at ~rate %g Hz' % (kind, target))
+        try:
+            run = rate_and_cost(lab, kind, window, rate=target)
+        except RuntimeError as e:
+            run = {'error': str(e)}
+        run['target_hz'] = target
+        run['sustained'] = (stats.within(run.get('rate_hz'), target, 0.01)
+                            and run.get('sd_ms') is not None and run['sd_ms'] < 1.0)
+        runs.append(run)
+    sustained = [x['target_hz'] for x in runs if x['sustained']]
+    return {'runs': runs, 'highest_hz': max(sustained) if sustained else 0}
