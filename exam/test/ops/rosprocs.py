@@ -58,14 +58,24 @@ class Processes(object):
 
     @staticmethod
     def stop(proc, grace=15.0):
-        """Ctrl-C the process group, as a user would; SIGKILL what is left after `grace` seconds."""
+        """Ctrl-C the process group, as a user would; SIGKILL what is left after `grace` seconds.
+
+        roslaunch (hence roscore) starts each node in a session of its own, so the group alone does not
+        hold the nodes: their launcher stops them on SIGINT, and the SIGKILL fallback takes every
+        descendant found in /proc beforehand.
+        """
         if proc.poll() is not None:
             return proc.returncode
+        family = descendants(proc.pid)
         try:
             os.killpg(proc.pid, signal.SIGINT)
             return proc.wait(timeout=grace)
         except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
+            for pid in [proc.pid] + family:
+                try:
+                    os.kill(pid, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
             return proc.wait()
         except ProcessLookupError:
             return proc.wait()
@@ -73,10 +83,25 @@ class Processes(object):
     def stop_all(self):
         for _name, proc in reversed(self.procs):
             self.stop(proc)
-            try:  # children that left the group die with it
-                os.killpg(proc.pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
+
+
+def descendants(pid):
+    """Pids of every living descendant of pid, from the parent links in /proc."""
+    children = {}
+    for entry in os.listdir('/proc'):
+        if entry.isdigit():
+            try:
+                with open('/proc/%s/stat' % entry) as stat:
+                    ppid = int(stat.read().rsplit(')', 1)[1].split()[1])
+            except (OSError, ValueError, IndexError):
+                continue
+            children.setdefault(ppid, []).append(int(entry))
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.append(child)
+            todo.append(child)
+    return found
 
 
 def probe(args, env, prefix=(), timeout=90.0):
