@@ -38,6 +38,8 @@ PROGRAMS = {'rosnode', 'rostopic', 'rosmsg', 'rossrv', 'rosservice', 'rosparam',
             'rosbag', 'catkin_create_pkg'}
 #: Node names the launch files give (name="...") and ROS's own logging node.
 ROS_TOPICS = {'/rosout', '/rosout_agg'}
+#: Private services rospy gives every node (``~get_loggers``), named in the docs like parameters.
+ROS_PRIVATE_NAMES = {'get_loggers', 'set_logger_level'}
 #: Special arguments every ROS node understands (remapping of its name, namespace, log file...).
 SPECIAL_ARGS = {'__name', '__ns', '__log', '__ip', '__hostname', '__master'}
 #: How a parameter or launch argument is named in prose: `~threshold`, `threshold:=1500`.
@@ -61,8 +63,9 @@ def read(path):
 
 
 def private_names_in_code():
-    """Every private parameter some node reads, and the drones' private topics (``~true_altitude``)."""
-    names = set()
+    """Every private parameter some node reads, the drones' private topics (``~true_altitude``), and the
+    private services of every rospy node."""
+    names = set(ROS_PRIVATE_NAMES)
     sensor_suffixes = set()
     for path in code_files():
         text = read(path)
