@@ -69,10 +69,11 @@ def guarded(label, fn, *args, **kwargs):
     started = time.monotonic()
     try:
         result = fn(*args, **kwargs)
-    except (RuntimeError, OSError) as e:
+    except (RuntimeError, OSError, subprocess.SubprocessError) as e:
         progress('  FAILED: %s' % e)
         return {'error': str(e)}
-    progress('  done in %.0f s: %s' % (time.monotonic() - started, _headline(result)))
+    progress('  done in %.0f s%s' % (time.monotonic() - started,
+                                       ': ' + _headline(result) if isinstance(result, dict) else ''))
     return result
 
 
@@ -97,6 +98,8 @@ def run_stages(lab, cfg, kinds, profiler):
             stages.rate_and_cost, lab, kind, cfg['rate_window'])
     results['floor'] = guarded('floor: bare rospy node at 10 Hz over %d s' % cfg['floor_window'],
                                stages.rate_and_cost, lab, 'floor', cfg['floor_window'])
+    results['memory_floor'] = guarded('floor: RSS of python3, import rospy, init_node',
+                                      stages.memory_floor, lab)
     for kind in kinds:
         results[kind]['latency'] = guarded(
             '%s: warning latency over %d excursions' % (kind, cfg['crossings']),
@@ -121,8 +124,6 @@ def run_stages(lab, cfg, kinds, profiler):
                 results[kind]['fleet'][str(n)] = guarded(
                     '%s: fleet of %d drone + node pairs over %d s' % (kind, n, cfg['fleet_window']),
                     stages.fleet, lab, kind, n, cfg['fleet_window'])
-            if '20' in results[kind]['fleet']:
-                results[kind]['fleet_20'] = results[kind]['fleet']['20']
     if profiler and 'ours' in kinds:
         results['profile'] = profiler.profile_missed(lab, results)
     return results
@@ -144,7 +145,7 @@ def main(argv):
     if args.render_only:
         with open(args.json) as f:
             write_report(json.load(f), args)
-        return
+        return 0
     cfg = QUICK if args.quick else FULL
     signal.signal(signal.SIGTERM, _on_sigterm)
 
@@ -174,6 +175,77 @@ def main(argv):
     with open(args.json, 'w') as f:
         json.dump(results, f, indent=1, sort_keys=True)
     write_report(results, args)
+    failed = report.failed_stages(results)
+    if failed:
+        progress('%d stage(s) failed: %s' % (len(failed), '; '.join(failed)))
+    return 1 if failed else 0
+
+
+def main(argv):
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument('--quick', action='store_true', help='a few seconds per stage (smoke run)')
+    parser.add_argument('--out', required=True, help='directory that receives benchmarks.md')
+    parser.add_argument('--figure', required=True, help='path of the fleet plot (PNG)')
+    parser.add_argument('--json', required=True, help='path of the raw results (JSON)')
+    parser.add_argument('--log-dir', help='where the nodes write their output')
+    parser.add_argument('--pid-file', help='process groups, for run.sh to clean up')
+    parser.add_argument('--py-spy', default=None, help='py-spy executable: profile missed goals')
+    parser.add_argument('--render-only', action='store_true',
+                        help='measure nothing: render the report again from --json')
+    parser.add_argument('--command', default='make bench', help='command shown in the report')
+    args = parser.parse_args(argv)
+    if args.render_only:
+        with open(args.json) as f:
+            write_report(json.load(f), args)
+        return 0
+    cfg = QUICK if args.quick else FULL
+    signal.signal(signal.SIGTERM, _on_sigterm)
+
+    t0 = time.monotonic()
+    date = time.strftime('%Y-%m-%d %H:%M', time.gmtime())
+    info = machine()
+    kinds = ['ours', 'baseline']
+    if not stages.available(stages.SCRIPTS['ours']):
+        progress('ours: %s is missing, measuring the baseline only' % stages.SCRIPTS['ours'])
+        kinds = ['baseline']
+    env = dict(os.environ, ROS_LOG_DIR=args.log_dir, PYTHONUNBUFFERED='1')
+    children = procs.Children(args.pid_file, args.log_dir)
+    try:
+        _, uri = procs.start_master(children, env)
+        progress('master at %s, node output in %s' % (uri, args.log_dir))
+        driver.init(uri)
+        lab = stages.Lab(children, uri, env)
+        profiler = profiling.Profiler(args.py_spy, args.log_dir) if args.py_spy else None
+        results = run_stages(lab, cfg, kinds, profiler)
+    finally:
+        import rospy
+        rospy.signal_shutdown('bench over')
+        children.stop_all()
+    info['loadavg_end'] = procs.loadavg()
+    results.update(machine=info, config=cfg, quick=args.quick, date=date, command=args.command,
+                   duration_s=time.monotonic() - t0)
+    with open(args.json, 'w') as f:
+        json.dump(results, f, indent=1, sort_keys=True)
+    write_report(results, args)
+    failed = report.failed_stages(results)
+    if failed:
+        progress('%d stage(s) failed: %s' % (len(failed), '; '.join(failed)))
+    return 1 if failed else 0
+
+
+def failed_stages(results):
+    failed = []
+    for kind in ('ours', 'baseline', 'floor'):
+        entry = results.get(kind) or {}
+        if 'error' in entry:
+            failed.append('%s: %s' % (kind, entry['error']))
+        for stage, value in entry.items():
+            if isinstance(value, dict) and 'error' in value:
+                failed.append('%s %s: %s' % (kind, stage, value['error']))
+        for n, value in (entry.get('fleet') or {}).items():
+            if 'error' in value:
+                failed.append('%s fleet %s: %s' % (kind, n, value['error']))
+    return failed
 
 
 def write_report(results, args):
@@ -202,7 +274,7 @@ def _read_analysis():
 
 if __name__ == '__main__':
     try:
-        main(sys.argv[1:])
+        sys.exit(main(sys.argv[1:]))
     except (KeyboardInterrupt, Stop):
         progress('interrupted: every process started was stopped')
         sys.exit(130)

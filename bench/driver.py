@@ -20,9 +20,10 @@ from std_msgs.msg import Float32
 from stats import pressure_at
 
 TEMPERATURE_C = 15.0
-# The simulators publish their two sensors at different rates; so does the player.
-TEMPERATURE_PERIOD = 1.0
-PRESSURE_PERIOD = 0.2
+# mydrone's default sensor rates (0.778 Hz and 2 Hz): the node under test sees the same input load as
+# with the simulator; scripted steps are published at once on top of them.
+TEMPERATURE_PERIOD = 1.0 / 0.778
+PRESSURE_PERIOD = 0.5
 
 
 def init(uri):

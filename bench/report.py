@@ -19,7 +19,8 @@ def _fmt(value, digits=2):
 
 
 def _ratio(ours, baseline):
-    if ours is None or baseline is None or baseline == 0:
+    # A ratio of signed latencies (the baseline warns early: negative) would read as nonsense.
+    if ours is None or baseline is None or ours < 0 or baseline <= 0:
         return 'n/a'
     return '%.2f' % (ours / baseline)
 
@@ -68,9 +69,9 @@ def goal_rows(r):
     row('RSS at 10 Hz (MB)', ('rate', 'rss_mb'), '<= 35 MB', lambda v: v <= 35.0, 1)
     row('highest sustained ~rate (Hz)', ('max_rate', 'highest_hz'), '>= 500 Hz',
         lambda v: v >= 500, 0)
-    row('fleet of 20: slowest pair (Hz)', ('fleet_20', 'min_rate_hz'), 'all within 1 % of 10 Hz',
+    row('fleet of 20: slowest pair (Hz)', ('fleet', '20', 'min_rate_hz'), 'all within 1 % of 10 Hz',
         lambda v: stats.within(v, 10.0, FLEET_TOLERANCE), 3)
-    row('fleet of 20: fastest pair (Hz)', ('fleet_20', 'max_rate_hz'), 'all within 1 % of 10 Hz',
+    row('fleet of 20: fastest pair (Hz)', ('fleet', '20', 'max_rate_hz'), 'all within 1 % of 10 Hz',
         lambda v: stats.within(v, 10.0, FLEET_TOLERANCE), 3)
     return rows
 
@@ -101,6 +102,13 @@ def render(r, figure_rel):
             'publishes and calls the service synchronously, the delay as a count of iterations). '
             'Ratio is ours/baseline.', '',
             _table(['metric', 'ours', 'baseline', 'ratio', 'goal', 'ours vs goal'], goal_rows(r)), '']
+    out += ['## How to run', '',
+            '`make bench` (about 13 minutes; prints one line per stage). `BENCH_QUICK=1 make bench` '
+            'is a smoke run of about 2 minutes that writes to `.ws/bench-quick/` and leaves this file '
+            'alone. `BENCH_PROFILE=1 make bench` also profiles the exam node with py-spy. '
+            '`BENCH_RENDER_ONLY=1 make bench` renders this file again from `bench/results.json`. '
+            'The benchmark is not part of `make test`; its statistics have unit tests: '
+            '`/usr/bin/python3 -m pytest bench/test`.', '']
     out += _method(r)
     out += _floor(r)
     out += _max_rate(r)
@@ -116,8 +124,9 @@ def render(r, figure_rel):
 def _method(r):
     c = r['config']
     return ['## Method', '',
-            '- One rospy process (`/bench`) plays the drone: it publishes `temperature` (1 Hz) and '
-            '`pressure` (5 Hz, plus each scripted step the moment it is due) in the node\'s namespace, '
+            '- One rospy process (`/bench`) plays the drone: it publishes `temperature` (0.778 Hz) and '
+            '`pressure` (2 Hz, the simulator\'s rates, plus each scripted step the moment it is due) '
+            'in the node\'s namespace, '
             'serves a fake `altitude_warning` that stamps each call on arrival, and subscribes '
             '`altitude` with `tcp_nodelay`. All stamps are ROS time (`rospy.get_time()`), readings '
             'stamped right before publishing. Each measurement has its own namespace and node process.',
@@ -144,10 +153,16 @@ def _floor(r):
     f = r.get('floor')
     if not f or 'error' in f:
         return []
-    return ['## Floor: the cheapest rospy node', '',
-            '`bench/floor_node.py` subscribes both inputs and publishes a constant at 10 Hz, nothing '
-            'else: CPU %s %% of a core, RSS %s MB (%d s window). No rospy node doing this job can cost '
-            'less on this machine.' % (_fmt(f['cpu_percent']), _fmt(f['rss_mb'], 1), f['window_s']), '']
+    out = ['## Floor: the cheapest rospy node', '',
+           '`bench/floor_node.py` subscribes both inputs and publishes a constant at 10 Hz with a '
+           '`rospy.Timer`, nothing else: CPU %s %% of a core, RSS %s MB, interval sd %s ms (%d s '
+           'window). No rospy node doing this job can cost less on this machine.'
+           % (_fmt(f['cpu_percent']), _fmt(f['rss_mb'], 1), _fmt(f['sd_ms'], 3), f['window_s']), '']
+    steps = r.get('memory_floor')
+    if isinstance(steps, list):
+        out += ['RSS of a fresh process after each step every rospy node takes:', '',
+                _table(['step', 'RSS (MB)'], [(label, _fmt(mb, 1)) for label, mb in steps]), '']
+    return out
 
 
 def _max_rate(r):
@@ -167,12 +182,13 @@ def _fleet(r, figure_rel):
     for kind in ('ours', 'baseline'):
         for n, f in sorted((_get(r, kind, 'fleet') or {}).items(), key=lambda kv: int(kv[0])):
             if 'error' in f:
-                rows.append((kind, n, f['error'], '', '', '', '', '', ''))
+                rows.append((kind, n, f['error'], '', '', '', '', '', '', ''))
                 continue
             cpu, rss = f['cpu_percent'], f['rss_mb']
             rows.append((kind, n, _fmt(f['min_rate_hz'], 3), _fmt(f['max_rate_hz'], 3),
                          _fmt(f['max_gap_ms'], 0), _fmt(cpu.get('exam'), 1),
-                         _fmt(sum(cpu.values()), 1), _fmt(sum(rss.values()), 0),
+                         _fmt(sum(cpu.values()), 1), _fmt(rss.get('exam'), 0),
+                         _fmt(sum(rss.values()), 0),
                          ' '.join('%.2f' % x for x in f['loadavg'])))
     if not rows:
         return []
@@ -181,16 +197,29 @@ def _fleet(r, figure_rel):
             'ours, the roslaunch process of `fleet_launch.py`. RSS is the sum over all processes.'
             % r['machine']['nproc'], '',
             _table(['node', 'pairs', 'slowest (Hz)', 'fastest (Hz)', 'max gap (ms)',
-                    'CPU exam nodes', 'CPU all', 'RSS all (MB)', 'loadavg after'], rows), '',
+                    'CPU exam nodes', 'CPU all', 'RSS exam nodes (MB)', 'RSS all (MB)',
+                    'loadavg after'], rows), '',
             '![fleet cost against N](%s)' % figure_rel, '']
 
 
-def _errors(r):
-    lines = []
+def failed_stages(r):
+    """One line per stage that raised instead of measuring."""
+    failed = []
     for kind in ('ours', 'baseline', 'floor'):
-        for stage, value in sorted((r.get(kind) or {}).items()):
-            if isinstance(value, dict) and 'error' in value:
-                lines.append('- %s, %s: %s' % (kind, stage, value['error']))
+        entry = r.get(kind) or {}
+        if 'error' in entry:
+            failed.append('%s: %s' % (kind, entry['error']))
+        entries = [(name, v) for name, v in entry.items() if isinstance(v, dict) and name != 'fleet']
+        if kind == 'floor' and isinstance(r.get('memory_floor'), dict):
+            entries.append(('memory', r['memory_floor']))
+        entries += [('fleet %s' % n, v) for n, v in (entry.get('fleet') or {}).items()]
+        failed += ['%s %s: %s' % (kind, name, v['error']) for name, v in entries if 'error' in v]
+    return failed
+
+
+def _errors(r):
+    lines = ['- ' + line for line in failed_stages(r)]
+    for kind in ('ours', 'baseline'):
         anomalies = _get(r, kind, 'latency', 'anomalies') or []
         lines += ['- %s, latency: %s' % (kind, a) for a in anomalies[:10]]
     return (['## Stages that failed or misbehaved', ''] + lines + ['']) if lines else []

@@ -6,6 +6,7 @@ a namespace of its own, measures, stops them, and returns a plain dict that repo
 """
 
 import os
+import subprocess
 import time
 import xmlrpc.client
 
@@ -172,9 +173,11 @@ def fleet(lab, kind, count, window):
     monitors = {ns: driver.StreamMonitor(ns + '/altitude') for ns in namespaces}
     try:
         deadline = time.monotonic() + STARTUP_TIMEOUT + 3.0 * count
-        for ns, monitor in monitors.items():
-            if not monitor.wait_first(max(0.1, deadline - time.monotonic())):
-                raise RuntimeError('fleet of %d: %s/altitude never published' % (count, ns))
+        silent = [ns for ns, monitor in monitors.items()
+                  if not monitor.wait_first(max(0.1, deadline - time.monotonic()))]
+        if silent:
+            raise RuntimeError('fleet of %d: no altitude from %s (registered nodes there: %s)'
+                               % (count, ', '.join(silent), registered(lab.uri, silent)))
         if launcher is not None:
             for ns in namespaces:
                 for name in ('mydrone', 'exam'):
@@ -222,6 +225,13 @@ def _by_role(values_by_pid, pids):
     return roles
 
 
+def registered(uri, namespaces):
+    """Names of the nodes of ``namespaces`` that the master knows: tells a crash from a slow start."""
+    state = rosgraph.Master('/bench', master_uri=uri).getSystemState()
+    nodes = {node for _, names in state[0] + state[1] + state[2] for node in names}
+    return sorted(n for n in nodes if any(n.startswith(ns + '/') for ns in namespaces)) or 'none'
+
+
 def node_pid(uri, name):
     """Pid of a registered node, asked from the node itself (rosnode info does the same)."""
     master = rosgraph.Master('/bench', master_uri=uri)
@@ -258,3 +268,25 @@ def max_rate(lab, kind, rates, window):
         runs.append(run)
     sustained = [x['target_hz'] for x in runs if x['sustained']]
     return {'runs': runs, 'highest_hz': max(sustained) if sustained else 0}
+
+
+# Each snippet prints its own VmRSS (kB) once it has done one more step of what every rospy node does.
+MEMORY_STEPS = [
+    ('python3 interpreter', ''),
+    # genpy.message imports numpy, so every rospy node pays for it; measured apart to show its share.
+    ('+ import numpy', 'import numpy'),
+    ('+ import rospy, std_msgs', 'import numpy, rospy, std_msgs.msg'),
+    ('+ rospy.init_node', 'import numpy, rospy, std_msgs.msg; rospy.init_node("rss_probe", anonymous=True)'),
+]
+
+
+def memory_floor(lab):
+    """RSS after each step a rospy node cannot skip: what bounds the memory of any such node."""
+    steps = []
+    for label, code in MEMORY_STEPS:
+        probe = code + ('; ' if code else '') + (
+            'print([l.split()[1] for l in open("/proc/self/status") if l.startswith("VmRSS")][0])')
+        out = subprocess.run([PYTHON, '-c', probe], env=lab.env, capture_output=True, text=True,
+                             timeout=60, check=True).stdout
+        steps.append((label, int(out.strip().splitlines()[-1]) / 1024.0))
+    return steps
