@@ -145,8 +145,9 @@ class Player:
             due = min(next_temperature, next_pressure)
             if index < len(self.steps):
                 due = min(due, t0 + self.steps[index][0])
-            # Sleep to just before the next event, then spin the last 2 ms: a plain sleep can
-            # oversleep on a busy machine, and a late step would blur the crossing phases.
+            # No busy-wait to be punctual: a spinning thread holds the GIL for up to the 5 ms switch
+            # interval and would delay the monitor's receive stamps, faking jitter. A late wake-up
+            # costs nothing, since every reading is stamped when it is actually published.
             wait = due - rospy.get_time()
-            if wait > 0.002:
-                self._stop.wait(wait - 0.002)
+            if wait > 0:
+                self._stop.wait(wait)

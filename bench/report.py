@@ -246,19 +246,23 @@ def plot_fleet(r, path):
     import matplotlib.pyplot as plt
 
     fig, (ax_cpu, ax_mem, ax_rate) = plt.subplots(1, 3, figsize=(13, 4))
-    for kind, style in (('ours', 'o-'), ('baseline', 's--')):
+    for kind, style, color in (('ours', 'o-', 'tab:blue'), ('baseline', 's--', 'tab:orange')):
         fleet = {int(n): f for n, f in (_get(r, kind, 'fleet') or {}).items() if 'error' not in f}
         if not fleet:
             continue
         ns = sorted(fleet)
-        ax_cpu.plot(ns, [fleet[n]['cpu_percent'].get('exam', 0) for n in ns], style,
+        ax_cpu.plot(ns, [fleet[n]['cpu_percent'].get('exam', 0) for n in ns], style, color=color,
                     label='%s: exam nodes' % kind)
-        ax_cpu.plot(ns, [sum(fleet[n]['cpu_percent'].values()) for n in ns], style, alpha=0.5,
-                    label='%s: all processes' % kind)
-        ax_mem.plot(ns, [sum(fleet[n]['rss_mb'].values()) for n in ns], style, label=kind)
-        ax_rate.plot(ns, [fleet[n]['min_rate_hz'] for n in ns], style, label='%s: slowest pair' % kind)
+        ax_cpu.plot(ns, [sum(fleet[n]['cpu_percent'].values()) for n in ns], style, color=color,
+                    alpha=0.4, label='%s: all processes' % kind)
+        ax_mem.plot(ns, [fleet[n]['rss_mb'].get('exam', 0) for n in ns], style, color=color,
+                    label='%s: exam nodes' % kind)
+        ax_mem.plot(ns, [sum(fleet[n]['rss_mb'].values()) for n in ns], style, color=color,
+                    alpha=0.4, label='%s: all processes' % kind)
+        ax_rate.plot(ns, [fleet[n]['min_rate_hz'] for n in ns], style, color=color,
+                     label='%s: slowest pair' % kind)
     ax_cpu.set(xlabel='pairs N', ylabel='CPU (% of one core)', title='CPU')
-    ax_mem.set(xlabel='pairs N', ylabel='RSS (MB)', title='Memory (all processes)')
+    ax_mem.set(xlabel='pairs N', ylabel='RSS (MB)', title='Memory')
     ax_rate.axhspan(9.9, 10.1, color='green', alpha=0.15, label='10 Hz +/- 1 %')
     ax_rate.set(xlabel='pairs N', ylabel='/altitude rate (Hz)', title='Slowest pair')
     for ax in (ax_cpu, ax_mem, ax_rate):
