@@ -1,0 +1,25 @@
+"""The submarine_drone node's configuration: names, default rates and the physics each sensor reads."""
+
+import pytest
+
+from submarinedrone import hydrostatics
+from submarinedrone.simulator import SPEC
+
+
+def test_names_and_default_rates():
+    sensors = {s.topic: s for s in SPEC.sensors}
+    assert sorted(sensors) == ['pressure_remote', 'pressure_robot']
+    assert sensors['pressure_robot'].default_rate != sensors['pressure_remote'].default_rate
+    assert all(0.0 < s.default_rate < 10.0 for s in SPEC.sensors)
+    assert [s.topic for s in SPEC.sensors if s.publishes_truth] == ['pressure_robot']
+    assert (SPEC.node_name, SPEC.service_name, SPEC.led_topic, SPEC.truth_topic) == \
+        ('submarine_drone', 'depth_warning', 'depth_warn_led', 'true_depth')
+    assert SPEC.service_type._type == 'submarinedrone/DepthWarning'
+
+
+def test_robot_reads_the_same_instants_surface_plus_the_water_column():
+    sensors = {s.topic: s for s in SPEC.sensors}
+    for t in (0.0, 37.5, 250.0):
+        surface = sensors['pressure_remote'].read(150.0, t)
+        assert surface == hydrostatics.surface_pressure_pa(t)
+        assert sensors['pressure_robot'].read(150.0, t) == pytest.approx(surface + 1030 * 9.80665 * 150.0)
