@@ -38,14 +38,19 @@ trap 'exit 130' INT TERM
 
 mkdir -p "$scratch/logs"
 args=(--log-dir "$scratch/logs" --pid-file "$pid_file")
+# The exact command, as the report prints it: the BENCH_ variables change what is measured.
+command="$(env | grep -E '^BENCH_(QUICK|PROFILE)=' | sort | tr '\n' ' ')make bench"
+if [ "$EXAM_WS" != "$repo/.ws" ]; then
+  command="EXAM_WS=$EXAM_WS $command"
+fi
 if [ "${BENCH_QUICK:-0}" = 1 ]; then
   out="$repo/.ws/bench-quick"
   mkdir -p "$out"
   args+=(--quick --out "$out" --figure "$out/bench_fleet.png" --json "$out/bench_results.json"
-         --command "BENCH_QUICK=1 make bench")
+         --command "$command")
 else
   args+=(--out "$repo/docs" --figure "$repo/docs/figures/bench_fleet.png"
-         --json "$repo/bench/results.json" --command "make bench")
+         --json "$repo/bench/results.json" --command "$command")
 fi
 
 if [ "${BENCH_RENDER_ONLY:-0}" = 1 ]; then
