@@ -5,6 +5,14 @@ failing warning service, and back.
 Runs in diagnostics.test. This checker is the drone itself (a FakeDrone from fake_drone.py, scripted
 in-process) and watches the two statuses the exam node publishes: "<node>: inputs" (each input's rate
 and age) and "<node>: warning" (value, threshold, state, service failures).
+
+ROS Parameters:
+    ~node (str, default "exam"): the exam node's name, prefix of its status names.
+    ~timeout (float, s) and ~delay (float, s): the exam node's, to bound how long each level may take.
+
+Subscribed Topics:
+    /diagnostics (diagnostic_msgs/DiagnosticArray)
+The drone's topics and service are those of fake_drone.FakeDrone.
 """
 import sys
 import threading

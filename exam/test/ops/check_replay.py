@@ -5,6 +5,12 @@ Runs in replay.test (use_sim_time=true) next to the exam node. This checker serv
 records every call and every /altitude message with the ROS (bag) time it arrived, then plays the bag
 itself, so the bag is generated fresh and the same module computes the expected values offline.
 Under sim time a correct node warns 5 s of BAG time after the crossing: 1 s of wall time at -r 5.
+
+Subscribed Topics:
+    altitude (std_msgs/Float32, m): what the exam node computes from the replayed readings.
+
+Services:
+    altitude_warning (mydrone/AltitudeWarning): records each status with the ROS (bag) time.
 """
 import os
 import shutil

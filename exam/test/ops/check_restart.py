@@ -4,6 +4,13 @@
 Runs in restart.test against fake_drone.py (hovering above the threshold, respawn="true") and the exam
 node (respawn="true", ~delay from the test's ~delay param). Each phase kills processes with SIGKILL, as
 a crash or power loss would, and reads the calls from the drone's own record.
+
+ROS Parameters:
+    ~delay (float, s): the exam node's ~delay, which the restarted pair must wait again.
+
+Subscribed Topics:
+    fake_drone/record (std_msgs/String, JSON): the drone's calls, see fake_drone.py.
+    altitude (std_msgs/Float32, m): proof that a respawned exam node publishes again.
 """
 import sys
 import time
