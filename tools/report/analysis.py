@@ -159,6 +159,37 @@ def lapse_rate_error(altitude_m):
     return lapse_rate_altitude(atmosphere.temperature_c(altitude_m), atmosphere.pressure_pa(altitude_m)) - altitude_m
 
 
+def mean_temperature_altitude(temperature_c, pressure_pa, iterations=50):
+    """Equation (1) with the column's mean temperature T + L*h/2 instead of the local T [m].
+
+    h appears on both sides; a fixed-point iteration from the isothermal value converges in a few steps
+    (the correction is a few per cent of h).
+    """
+    t_k = temperature_c + formulas.ZERO_CELSIUS
+    log_ratio = math.log(formulas.P0 / pressure_pa)
+    h = formulas.altitude(temperature_c, pressure_pa)
+    for _ in range(iterations):
+        h = formulas.R * (t_k + atmosphere.LAPSE_RATE * h / 2.0) / (formulas.MU_AIR * formulas.G) * log_ratio
+    return h
+
+
+def mean_temperature_error(altitude_m):
+    """Error [m] of :func:`mean_temperature_altitude` against the ISA truth."""
+    return (mean_temperature_altitude(atmosphere.temperature_c(altitude_m), atmosphere.pressure_pa(altitude_m))
+            - altitude_m)
+
+
+def true_altitude_read_as(estimate_m, low=-500.0, high=11000.0):
+    """The ISA altitude [m] at which equation (1) reads ``estimate_m`` (bisection; the error is monotonic)."""
+    for _ in range(100):
+        middle = (low + high) / 2.0
+        if isothermal_error(middle) + middle < estimate_m:
+            low = middle
+        else:
+            high = middle
+    return (low + high) / 2.0
+
+
 def mean(numbers):
     numbers = list(numbers)
     return sum(numbers) / len(numbers) if numbers else math.nan
