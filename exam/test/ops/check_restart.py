@@ -50,6 +50,16 @@ class RestartTest(unittest.TestCase):
         record = self.drone.record()
         return record if record is not None and record['pid'] != old_pid else None
 
+    def record_with_calls(self):
+        record = self.drone.record()
+        return record if record is not None and record['calls'] else None
+
+    @staticmethod
+    def respawned(name, old_pid):
+        """Pid of the process that replaced old_pid as node `name`, once it is registered."""
+        return wait_for(lambda: (node_pid(name) if node_pid(name) not in (None, old_pid) else None),
+                        RESPAWN_TIMEOUT)
+
     def assert_steady(self, expected):
         """The drone has received exactly `expected` and nothing more for STEADY_WINDOW."""
         self.assertTrue(stays(lambda: self.calls() == expected, STEADY_WINDOW),
@@ -66,8 +76,7 @@ class RestartTest(unittest.TestCase):
         record = wait_for(lambda: self.new_drone_record(old_pid), RESPAWN_TIMEOUT)
         self.assertIsNotNone(record, 'the drone did not respawn within %.0f s' % RESPAWN_TIMEOUT)
         # The new drone published GREEN at `started`; the re-sync may already be in its first record.
-        record = wait_for(lambda: (self.drone.record() if self.drone.record()['calls'] else None),
-                          RESYNC_BOUND + 10.0)
+        record = wait_for(self.record_with_calls, RESYNC_BOUND + 10.0)
         self.assertIsNotNone(record, 'WARNING was never re-sent to the restarted drone')
         first_stamp, first_status = record['calls'][0]
         self.assertEqual(first_status, 'WARNING')
@@ -79,9 +88,8 @@ class RestartTest(unittest.TestCase):
 
     def test_3_exam_restart_alone_keeps_the_led_red(self):
         old_pid = kill_node(EXAM)
-        new_pid = wait_for(lambda: (node_pid(EXAM) if node_pid(EXAM) not in (None, old_pid) else None),
-                           RESPAWN_TIMEOUT)
-        self.assertIsNotNone(new_pid, 'the exam node did not respawn within %.0f s' % RESPAWN_TIMEOUT)
+        self.assertIsNotNone(self.respawned(EXAM, old_pid),
+                             'the exam node did not respawn within %.0f s' % RESPAWN_TIMEOUT)
         restarted = time.time()
         self.assertIsNotNone(wait_for(lambda: (self.altitude.get()[1] or 0.0) > restarted, 20.0),
                              'the respawned exam node publishes no altitude')
@@ -94,14 +102,12 @@ class RestartTest(unittest.TestCase):
     def test_4_both_restart_warning_after_the_delay(self):
         old_drone = kill_node(DRONE)
         old_exam = kill_node(EXAM)
-        exam_pid = wait_for(lambda: (node_pid(EXAM) if node_pid(EXAM) not in (None, old_exam) else None),
-                            RESPAWN_TIMEOUT)
+        exam_pid = self.respawned(EXAM, old_exam)
         self.assertIsNotNone(exam_pid, 'the exam node did not respawn')
         exam_started = process_start_time(exam_pid)
         self.assertIsNotNone(wait_for(lambda: self.new_drone_record(old_drone), RESPAWN_TIMEOUT),
                              'the drone did not respawn')
-        record = wait_for(lambda: (self.drone.record() if self.drone.record()['calls'] else None),
-                          self.delay + 20.0)
+        record = wait_for(self.record_with_calls, self.delay + 20.0)
         self.assertIsNotNone(record, 'the respawned pair never reached WARNING')
         stamp, status = record['calls'][0]
         self.assertEqual(status, 'WARNING')
