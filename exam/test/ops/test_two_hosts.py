@@ -2,9 +2,10 @@
 network namespaces joined by a veth pair, as docs/operations.md describes for two machines.
 
 Each namespace has only its loopback and its end of the veth pair, with private addresses that exist
-nowhere else, so every byte between the nodes crosses that link and none leaves the namespaces. Each
-process advertises its own address with ROS_IP (ROS_HOSTNAME would need name resolution); the drone
-reaches the master at the ground station's address.
+nowhere else, so every byte between the nodes crosses that link and none leaves the namespaces. The
+test runs twice: each host advertising its address with ROS_IP, then its name with ROS_HOSTNAME, which
+the other host resolves through a hosts file of its own (`ip netns exec` mounts /etc/netns/NS/hosts
+over /etc/hosts), as two real machines would through DNS or /etc/hosts.
 
 Skipped, with the reason printed and recorded as skipped in the JUnit file, where network namespaces
 cannot be created (not root, no CAP_SYS_ADMIN, no iproute2).
@@ -22,7 +23,10 @@ from rosprocs import Processes, probe, ros_env
 SUBNET = '10.213.77.%d/30'
 GROUND_IP = '10.213.77.1'
 DRONE_IP = '10.213.77.2'
-MASTER_URI = 'http://%s:11311' % GROUND_IP  # the namespaces are private: the default port is free
+GROUND_NAME = 'ground-station.exam-ops'
+DRONE_NAME = 'drone.exam-ops'
+HOSTS = '127.0.0.1 localhost\n%s %s\n%s %s\n' % (GROUND_IP, GROUND_NAME, DRONE_IP, DRONE_NAME)
+PORT = 11311  # the namespaces are private: the default port is free there
 PREFIX = 'exam_ops_'
 
 
@@ -31,11 +35,20 @@ def ip(*args):
                           universal_newlines=True, timeout=30)
 
 
+def delete_namespace(name):
+    ip('netns', 'del', name)
+    shutil.rmtree(os.path.join('/etc/netns', name), ignore_errors=True)
+    try:
+        os.rmdir('/etc/netns')  # only when empty: other namespaces' files stay
+    except OSError:
+        pass
+
+
 def remove_orphans():
     """Delete namespaces left by a run of this test that was killed before its cleanup (its pid is gone)."""
-    for name in re.findall(r'^(%s\w+_(\d+))' % PREFIX, ip('netns', 'list').stdout, re.M):
-        if not os.path.exists('/proc/%s' % name[1]):
-            ip('netns', 'del', name[0])
+    for name, pid in re.findall(r'^(%s\w+_(\d+))' % PREFIX, ip('netns', 'list').stdout, re.M):
+        if not os.path.exists('/proc/%s' % pid):
+            delete_namespace(name)
 
 
 @pytest.fixture
@@ -62,6 +75,10 @@ def network():
             ('-n', ground, 'link', 'set', 'veth_ground', 'up'),
             ('-n', drone, 'link', 'set', 'veth_drone', 'up'),
         ]
+        for name in (ground, drone):
+            os.makedirs(os.path.join('/etc/netns', name), exist_ok=True)
+            with open(os.path.join('/etc/netns', name, 'hosts'), 'w') as hosts:
+                hosts.write(HOSTS)
         for index, step in enumerate(steps):
             done = ip(*step)
             if done.returncode != 0 and index == 0:
@@ -71,16 +88,28 @@ def network():
         yield ground, drone
     finally:
         # Processes are stopped by then (the test's `with` block); deleting a namespace deletes its veth.
-        ip('netns', 'del', drone)
-        ip('netns', 'del', ground)
+        delete_namespace(drone)
+        delete_namespace(ground)
 
 
-def test_drone_and_ground_station_on_two_hosts(network, tmp_path):
+def host_env(advertise, own_ip, own_name, log_dir):
+    """A host's ROS environment: the master at the ground station, and what this host advertises."""
+    if advertise == 'ROS_IP':
+        env = ros_env('http://%s:%d' % (GROUND_IP, PORT), log_dir)
+        env['ROS_IP'] = own_ip
+    else:
+        env = ros_env('http://%s:%d' % (GROUND_NAME, PORT), log_dir)
+        env['ROS_HOSTNAME'] = own_name
+    return env
+
+
+@pytest.mark.parametrize('advertise', ['ROS_IP', 'ROS_HOSTNAME'])
+def test_drone_and_ground_station_on_two_hosts(network, tmp_path, advertise):
     ground, drone = network
     in_ground = ('ip', 'netns', 'exec', ground)
     in_drone = ('ip', 'netns', 'exec', drone)
-    ground_env = ros_env(MASTER_URI, tmp_path, ip=GROUND_IP)
-    drone_env = ros_env(MASTER_URI, tmp_path, ip=DRONE_IP)
+    ground_env = host_env(advertise, GROUND_IP, GROUND_NAME, tmp_path)
+    drone_env = host_env(advertise, DRONE_IP, DRONE_NAME, tmp_path)
 
     # The link leads nowhere else: the drone host's only route is the ground station's subnet.
     routes = subprocess.run(in_drone + ('ip', 'route'), stdout=subprocess.PIPE,
@@ -88,7 +117,7 @@ def test_drone_and_ground_station_on_two_hosts(network, tmp_path):
     assert 'default' not in routes, routes
 
     with Processes(tmp_path) as procs:
-        procs.start('roscore', in_ground + ('roscore', '-p', '11311'), ground_env)
+        procs.start('roscore', in_ground + ('roscore', '-p', str(PORT)), ground_env)
         # rospy gives up on private parameters when the master is not up yet: wait for it first.
         ok, out = probe(['--node', '/rosout', '--timeout', '30'], ground_env, prefix=in_ground)
         assert ok, out + procs.output('roscore')
@@ -108,7 +137,8 @@ def test_drone_and_ground_station_on_two_hosts(network, tmp_path):
         print('ground station sees:', seen_ground)
         print('drone host sees:', seen_drone)
 
-    # Each node advertised its own host's address, so the traffic did cross the veth link.
-    assert GROUND_IP in seen_ground['nodes']['/exam']
-    assert DRONE_IP in seen_ground['nodes']['/mydrone']
+    # Each node advertised its own host, so the traffic did cross the veth link.
+    own = {'ROS_IP': (GROUND_IP, DRONE_IP), 'ROS_HOSTNAME': (GROUND_NAME, DRONE_NAME)}[advertise]
+    assert '//%s:' % own[0] in seen_ground['nodes']['/exam']
+    assert '//%s:' % own[1] in seen_ground['nodes']['/mydrone']
     assert seen_drone['/alt_warn_led']['last'] == 'RED'
