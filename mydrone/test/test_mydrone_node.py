@@ -13,6 +13,7 @@ ALTITUDE = 1500.0  # m, the waypoints of mydrone.test
 
 class TestMydroneNode(SimulatorNodeCase):
     PACKAGE = 'mydrone'
+    NODE = 'mydrone'
     SCRIPT = 'mydrone_node.py'
     SENSOR_TOPICS = ('/temperature', '/pressure')
     TRUTH_TOPIC = '/mydrone/true_altitude'
@@ -20,12 +21,12 @@ class TestMydroneNode(SimulatorNodeCase):
     SERVICE = '/altitude_warning'
     SERVICE_TYPE = AltitudeWarning
     LED_TOPIC = '/alt_warn_led'
-    BAD_PARAMS = (('temperature_rate', '0', '/bad/mydrone/temperature_rate'),
-                  ('pressure_rate', '-2', '/bad/mydrone/pressure_rate'),
-                  ('pressure_noise', 'loud', '/bad/mydrone/pressure_noise'),
-                  ('seed', '1.5', '/bad/mydrone/seed'),
-                  ('profile', 'nosuch', '/bad/mydrone/profile'),
-                  ('profile', '[[0,1000],[10,20000],[20,1000]]', '/bad/mydrone/profile'))
+    BAD_PARAMS = (('temperature_rate', '0'),
+                  ('pressure_rate', '-2'),
+                  ('pressure_noise', 'loud'),
+                  ('seed', '1.5'),
+                  ('profile', 'nosuch'),
+                  ('profile', '[[0,1000],[10,20000],[20,1000]]'))
 
     def check_readings(self, readings):
         # Float32 keeps about 7 significant digits: 0.01 Pa of 85 kPa, 1e-6 degC of 5 degC.

@@ -13,6 +13,7 @@ DEPTH = 200.0  # m, the waypoints of submarinedrone.test
 
 class TestSubmarineDroneNode(SimulatorNodeCase):
     PACKAGE = 'submarinedrone'
+    NODE = 'submarine_drone'
     SCRIPT = 'submarine_drone_node.py'
     SENSOR_TOPICS = ('/pressure_robot', '/pressure_remote')
     TRUTH_TOPIC = '/submarine_drone/true_depth'
@@ -20,11 +21,11 @@ class TestSubmarineDroneNode(SimulatorNodeCase):
     SERVICE = '/depth_warning'
     SERVICE_TYPE = DepthWarning
     LED_TOPIC = '/depth_warn_led'
-    BAD_PARAMS = (('pressure_robot_rate', '0.0', '/bad/submarine_drone/pressure_robot_rate'),
-                  ('pressure_remote_rate', 'fast', '/bad/submarine_drone/pressure_remote_rate'),
-                  ('pressure_remote_noise', '-1', '/bad/submarine_drone/pressure_remote_noise'),
-                  ('seed', 'true', '/bad/submarine_drone/seed'),
-                  ('profile', '[[0,10],[5,-3],[10,10]]', '/bad/submarine_drone/profile'))
+    BAD_PARAMS = (('pressure_robot_rate', '0.0'),
+                  ('pressure_remote_rate', 'fast'),
+                  ('pressure_remote_noise', '-1'),
+                  ('seed', 'true'),
+                  ('profile', '[[0,10],[5,-3],[10,10]]'))
 
     def check_readings(self, readings):
         # The weather drift stays within 55 Pa of the mean; it moves about 1 Pa/s, so two readings

@@ -49,13 +49,15 @@ class SimulatorNodeCase(unittest.TestCase):
 
     PACKAGE = None  # e.g. 'mydrone'
     SCRIPT = None  # e.g. 'mydrone_node.py'
+    NODE = None  # the node's default name, e.g. 'mydrone'
     SENSOR_TOPICS = ()  # absolute names of the Float32 sensor topics
     TRUTH_TOPIC = None  # absolute name of the private truth topic
     TRUE_VALUE = None  # the constant profile value of the .test file
     SERVICE = None  # absolute service name
     SERVICE_TYPE = None  # the service class
     LED_TOPIC = None  # absolute name of the latched LED topic
-    # (private param, value as given on a command line, resolved name expected in the fatal log)
+    # (private param, value as given on a command line): each must stop the node with a fatal log
+    # naming the resolved parameter
     BAD_PARAMS = ()
 
     def check_readings(self, readings):
@@ -107,12 +109,21 @@ class SimulatorNodeCase(unittest.TestCase):
         late.close()
 
     def test_bad_params_exit_nonzero(self):
-        for param, value, resolved in self.BAD_PARAMS:
-            with self.subTest(param=param, value=value):
-                # A namespace of its own: a node that wrongly started would not disturb the others.
-                done = subprocess.run(['rosrun', self.PACKAGE, self.SCRIPT, '__ns:=/bad',
+        # One namespace per case: `_name:=value` stays on the parameter server after the node exits,
+        # and would otherwise be the first bad value the next case's node meets.
+        # No subTest: rosunit's XML runner drops subtest failures and reports the test as passed.
+        outcomes = []
+        for i, (param, value) in enumerate(self.BAD_PARAMS):
+            namespace = '/bad%d' % i
+            resolved = '%s/%s/%s' % (namespace, self.NODE, param)
+            try:
+                done = subprocess.run(['rosrun', self.PACKAGE, self.SCRIPT, '__ns:=' + namespace,
                                        '_%s:=%s' % (param, value)],
                                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                       universal_newlines=True, timeout=DEADLINE)
-                self.assertNotEqual(done.returncode, 0, done.stdout)
-                self.assertIn(resolved, done.stdout)
+            finally:
+                rospy.delete_param(namespace)
+            outcomes.append((param, value, done.returncode != 0, resolved in done.stdout, done.stdout))
+        # Compared as a whole, so a failure shows every case with the node's output.
+        self.assertEqual([o[:4] for o in outcomes], [o[:2] + (True, True) for o in outcomes],
+                         '\n'.join(o[4] for o in outcomes))
