@@ -47,9 +47,12 @@ def clean(text):
 
 
 def last_rate(hz_output):
-    """The last 'average rate' that ``rostopic hz`` printed, as a float (None if it printed none)."""
+    """The last 'average rate' that ``rostopic hz`` printed, as a float."""
     rates = re.findall(r'average rate: ([0-9.]+)', hz_output)
-    return float(rates[-1]) if rates else None
+    if not rates:
+        raise RuntimeError('rostopic hz printed no rate (a loaded machine?); run make report again:\n'
+                           + hz_output)
+    return float(rates[-1])
 
 
 def console_lines(text, pattern):
