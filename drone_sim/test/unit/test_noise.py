@@ -23,9 +23,10 @@ def test_sequences_differ_across_seeds_and_channels():
 
 
 def test_known_values_do_not_change_between_runs():
-    # String seeding hashes with SHA-512, not hash(): the value is fixed across interpreters.
-    assert channel_rng(0, 'pressure').random() == channel_rng(0, 'pressure').random()
-    assert round(channel_rng(7, 'x').random(), 12) == round(channel_rng(7, 'x').random(), 12)
+    # String seeds are hashed with SHA-512, not hash() (salted per process): a recorded run can be
+    # reproduced later by another interpreter. These values were drawn once and written down.
+    assert channel_rng(0, 'pressure').random() == 0.4978564184439018
+    assert channel_rng(7, 'x').gauss(0.0, 1.0) == -1.0449274870852954
 
 
 def test_spread_matches_sigma_and_mean_is_the_value():
