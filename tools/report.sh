@@ -7,6 +7,10 @@ set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 # pandoc and weasyprint turn the Markdown into the PDF; pdftoppm is how its pages are checked.
 "$repo/tools/install_deps.sh" pandoc weasyprint poppler-utils python3-rosmsg python3-rosparam
+# install_deps.sh installs nothing where ROS comes from /opt/ros (Ubuntu + Noetic): say what is missing.
+for tool in pandoc weasyprint pdfinfo; do
+  command -v "$tool" >/dev/null || { echo "report: $tool is missing: apt-get install pandoc weasyprint poppler-utils" >&2; exit 1; }
+done
 source "$repo/tools/env.sh"
 work="$EXAM_WS/report"
 mkdir -p "$work"
