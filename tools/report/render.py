@@ -193,9 +193,9 @@ def facts(work, repo, outputs):
     created = depends(outputs['exam.create_pkg']['package_xml'])
     with open(os.path.join(repo, 'exam', 'package.xml')) as f:
         ours = depends(f.read())
-    rows = ['%-18s %-44s %s' % ('tag', 'catkin_create_pkg wrote', 'exam/package.xml has')]
+    rows = ['%-20s %-44s %s' % ('tag', 'catkin_create_pkg wrote', 'exam/package.xml has')]
     for tag in sorted(set(created) | set(ours)):
-        rows.append('%-18s %-44s %s' % (tag, ' '.join(created.get(tag, [])) or '-',
+        rows.append('%-20s %-44s %s' % (tag, ' '.join(created.get(tag, [])) or '-',
                                         ' '.join(ours.get(tag, [])) or '-'))
     b['exam.depends'] = '\n'.join(rows)
     return v, b
