@@ -25,13 +25,13 @@ from stages import progress
 
 FULL = {
     'rate_window': 60, 'floor_window': 20,
-    'crossings': 22, 'delay': 1.0, 'hold': 0.6, 'slow_crossings': 3,
+    'crossings': 22, 'delay': 1.0, 'hold': 0.6, 'slow_crossings': 3, 'slow_hold': 2.5,
     'rates': [10, 100, 500, 1000], 'max_rate_window': 10,
     'fleet_sizes': [1, 5, 10, 20], 'baseline_fleet_sizes': [1, 5, 10, 20], 'fleet_window': 20,
 }
 QUICK = {
     'rate_window': 4, 'floor_window': 3,
-    'crossings': 3, 'delay': 0.5, 'hold': 0.4, 'slow_crossings': 1,
+    'crossings': 3, 'delay': 0.5, 'hold': 0.4, 'slow_crossings': 1, 'slow_hold': 2.5,
     'rates': [10, 100, 500, 1000], 'max_rate_window': 3,
     'fleet_sizes': [1, 3], 'baseline_fleet_sizes': [1], 'fleet_window': 3,
 }
@@ -107,7 +107,7 @@ def run_stages(lab, cfg, kinds, profiler):
     for kind in kinds:
         results[kind]['slow'] = guarded(
             '%s: /altitude gaps while the service takes 2 s per call' % kind,
-            stages.latency, lab, kind, cfg['slow_crossings'], cfg['delay'], cfg['hold'], SEED,
+            stages.latency, lab, kind, cfg['slow_crossings'], cfg['delay'], cfg['slow_hold'], SEED,
             slow=2.0)
     if 'ours' in kinds:
         results['ours']['max_rate'] = guarded(

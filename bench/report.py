@@ -54,6 +54,8 @@ def goal_rows(r):
     row('/altitude mean rate (Hz)', ('rate', 'rate_hz'), '10 Hz within 0.1 %',
         lambda v: stats.within(v, 10.0, RATE_TOLERANCE), 4)
     row('/altitude interval sd (ms)', ('rate', 'sd_ms'), '<= 0.5 ms', lambda v: v <= 0.5, 3)
+    row('/altitude interval off the mean, median (ms)', ('rate', 'dev_p50_ms'), '', None, 3)
+    row('/altitude interval off the mean, p99 (ms)', ('rate', 'dev_p99_ms'), '', None, 3)
     row('/altitude max gap (ms)', ('rate', 'max_gap_ms'), '', None, 1)
     for which, label in (('warning', 'WARNING'), ('normal', 'NORMAL')):
         row('%s latency median (ms)' % label, ('latency', which, 'median_ms'), '', None, 1)
@@ -139,8 +141,10 @@ def _method(r):
             'arrival - (first reading above + delay); NORMAL latency = call arrival - first reading '
             'back. Transport and service connection time are included, as a user sees them.'
             % (c['crossings'], 1000, 1600, 1300, c['delay'], c['hold'], c['hold']),
-            '- Slow service: the fake service sleeps 2 s per call during %d excursions; the max gap '
-            'between /altitude messages over the whole stage is reported.' % c['slow_crossings'],
+            '- Slow service: the fake service sleeps 2 s per call during %d excursions held %.1f s '
+            'above and below (so each 2 s call ends within its excursion); the max gap between '
+            '/altitude messages over the whole stage is reported.'
+            % (c['slow_crossings'], c.get('slow_hold', c['hold'])),
             '- Highest rate: `~rate` %s Hz, %d s each; sustained = mean rate within 1 %% and interval '
             'sd < 1 ms. The baseline has no `~rate` (10 Hz is hard-coded).'
             % (', '.join(str(x) for x in c['rates']), c['max_rate_window']),

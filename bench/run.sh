@@ -59,7 +59,7 @@ if [ "${BENCH_RENDER_ONLY:-0}" = 1 ]; then
 fi
 if [ "${BENCH_PROFILE:-0}" = 1 ]; then
   echo "bench: installing py-spy into $scratch/py-spy (BENCH_PROFILE=1)"
-  /usr/bin/python3 -m pip install --quiet --disable-pip-version-check --target "$scratch/py-spy" py-spy
+  /usr/bin/python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --target "$scratch/py-spy" py-spy
   args+=(--py-spy "$scratch/py-spy/bin/py-spy")
 fi
 

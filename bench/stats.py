@@ -14,10 +14,13 @@ def interval_stats(stamps):
 
     :param stamps: receive times (s), in arrival order.
     :returns: dict with ``count``, ``rate_hz`` (messages per second over the span from first to last),
-        ``sd_ms`` (sample standard deviation of the intervals) and ``max_gap_ms``; the timing values are
-        None when fewer than three messages make no meaningful interval statistics.
+        ``sd_ms`` (sample standard deviation of the intervals), ``max_gap_ms``, and ``dev_p50_ms`` /
+        ``dev_p99_ms``, percentiles of each interval's distance from the mean interval: they tell a
+        steady wobble (both high) from a few scheduler hiccups (median low, p99 and sd high). The
+        timing values are None when fewer than three messages make no meaningful statistics.
     """
-    stats = {'count': len(stamps), 'rate_hz': None, 'sd_ms': None, 'max_gap_ms': None}
+    stats = {'count': len(stamps), 'rate_hz': None, 'sd_ms': None, 'max_gap_ms': None,
+             'dev_p50_ms': None, 'dev_p99_ms': None}
     if len(stamps) < 3:
         return stats
     intervals = [b - a for a, b in zip(stamps, stamps[1:])]
@@ -27,6 +30,9 @@ def interval_stats(stamps):
     stats['rate_hz'] = len(intervals) / span if span > 0 else None
     stats['sd_ms'] = math.sqrt(variance) * 1e3
     stats['max_gap_ms'] = max(intervals) * 1e3
+    deviations = [abs(x - mean) * 1e3 for x in intervals]
+    stats['dev_p50_ms'] = percentile(deviations, 50)
+    stats['dev_p99_ms'] = percentile(deviations, 99)
     return stats
 
 

@@ -39,10 +39,23 @@ def test_interval_stats_sd_matches_a_known_jitter():
     assert stats.interval_stats(stamps)['sd_ms'] == pytest.approx(0.5 * 2 ** 0.5, rel=0.05)
 
 
+def test_interval_stats_tells_rare_hiccups_from_steady_wobble():
+    hiccups = [0.1 * i for i in range(1001)]
+    hiccups[500] += 0.008  # one message 8 ms late: two intervals off by 8 ms
+    s = stats.interval_stats(hiccups)
+    assert s['dev_p50_ms'] == pytest.approx(0.0, abs=1e-6)
+    assert s['dev_p99_ms'] < 1.0
+    assert s['sd_ms'] > 0.3
+    wobble = [0.1 * i + (0.001 if i % 2 else 0.0) for i in range(1001)]
+    w = stats.interval_stats(wobble)
+    assert w['dev_p50_ms'] == pytest.approx(1.0, abs=1e-6)
+    assert w['dev_p99_ms'] == pytest.approx(1.0, abs=1e-6)
+
+
 def test_interval_stats_needs_three_messages():
     s = stats.interval_stats([1.0, 1.1])
     assert s['count'] == 2
-    assert s['rate_hz'] is None and s['sd_ms'] is None and s['max_gap_ms'] is None
+    assert all(s[k] is None for k in ('rate_hz', 'sd_ms', 'max_gap_ms', 'dev_p50_ms', 'dev_p99_ms'))
 
 
 def test_percentile_interpolates_like_numpy():
