@@ -28,12 +28,14 @@ FULL = {
     'crossings': 22, 'delay': 1.0, 'hold': 0.6, 'slow_crossings': 3, 'slow_hold': 2.5,
     'rates': [10, 100, 500, 1000], 'max_rate_window': 10,
     'fleet_sizes': [1, 5, 10, 20], 'baseline_fleet_sizes': [1, 5, 10, 20], 'fleet_window': 20,
+    'jitter_rounds': 3, 'jitter_window': 20, 'profile_window': 30,
 }
 QUICK = {
     'rate_window': 4, 'floor_window': 3,
     'crossings': 3, 'delay': 0.5, 'hold': 0.4, 'slow_crossings': 1, 'slow_hold': 2.5,
     'rates': [10, 100, 500, 1000], 'max_rate_window': 3,
     'fleet_sizes': [1, 3], 'baseline_fleet_sizes': [1], 'fleet_window': 3,
+    'jitter_rounds': 1, 'jitter_window': 3, 'profile_window': 5,
 }
 SEED = 5
 
@@ -90,32 +92,39 @@ def _headline(result):
     return ', '.join(parts)
 
 
-def run_stages(lab, cfg, kinds, profiler):
+STAGES = ('rate', 'latency', 'slow', 'max_rate', 'fleet')
+
+
+def run_stages(lab, cfg, kinds, profiler, wanted=STAGES):
+    """Every stage in ``wanted`` for every kind; the profile last, since it reads their results."""
     results = {kind: {} for kind in ('ours', 'baseline', 'floor')}
-    for kind in kinds:
-        results[kind]['rate'] = guarded(
-            '%s: /altitude rate, CPU and RSS at 10 Hz over %d s' % (kind, cfg['rate_window']),
-            stages.rate_and_cost, lab, kind, cfg['rate_window'])
-    results['floor'] = guarded('floor: bare rospy node at 10 Hz over %d s' % cfg['floor_window'],
-                               stages.rate_and_cost, lab, 'floor', cfg['floor_window'])
-    results['memory_floor'] = guarded('floor: RSS of python3, import rospy, init_node',
-                                      stages.memory_floor, lab)
-    for kind in kinds:
-        results[kind]['latency'] = guarded(
-            '%s: warning latency over %d excursions' % (kind, cfg['crossings']),
-            stages.latency, lab, kind, cfg['crossings'], cfg['delay'], cfg['hold'], SEED)
-    for kind in kinds:
-        results[kind]['slow'] = guarded(
-            '%s: /altitude gaps while the service takes 2 s per call' % kind,
-            stages.latency, lab, kind, cfg['slow_crossings'], cfg['delay'], cfg['slow_hold'], SEED,
-            slow=2.0)
-    if 'ours' in kinds:
+    if 'rate' in wanted:
+        for kind in kinds:
+            results[kind]['rate'] = guarded(
+                '%s: /altitude rate, CPU and RSS at 10 Hz over %d s' % (kind, cfg['rate_window']),
+                stages.rate_and_cost, lab, kind, cfg['rate_window'])
+        results['floor'] = guarded('floor: bare rospy node at 10 Hz over %d s' % cfg['floor_window'],
+                                   stages.rate_and_cost, lab, 'floor', cfg['floor_window'])
+        results['memory_floor'] = guarded('floor: RSS of python3, import rospy, init_node',
+                                          stages.memory_floor, lab)
+    if 'latency' in wanted:
+        for kind in kinds:
+            results[kind]['latency'] = guarded(
+                '%s: warning latency over %d excursions' % (kind, cfg['crossings']),
+                stages.latency, lab, kind, cfg['crossings'], cfg['delay'], cfg['hold'], SEED)
+    if 'slow' in wanted:
+        for kind in kinds:
+            results[kind]['slow'] = guarded(
+                '%s: /altitude gaps while the service takes 2 s per call' % kind,
+                stages.latency, lab, kind, cfg['slow_crossings'], cfg['delay'], cfg['slow_hold'],
+                SEED, slow=2.0)
+    if 'max_rate' in wanted and 'ours' in kinds:
         results['ours']['max_rate'] = guarded(
             'ours: highest sustained ~rate among %s Hz' % cfg['rates'],
             stages.max_rate, lab, 'ours', cfg['rates'], cfg['max_rate_window'])
-    if not stages.available(stages.SIMULATOR):
+    if 'fleet' in wanted and not stages.available(stages.SIMULATOR):
         progress('fleet: skipped, %s is missing' % stages.SIMULATOR)
-    else:
+    elif 'fleet' in wanted:
         for kind, sizes in (('ours', cfg['fleet_sizes']), ('baseline', cfg['baseline_fleet_sizes'])):
             if kind not in kinds:
                 continue
@@ -138,10 +147,16 @@ def main(argv):
     parser.add_argument('--log-dir', help='where the nodes write their output')
     parser.add_argument('--pid-file', help='process groups, for run.sh to clean up')
     parser.add_argument('--py-spy', default=None, help='py-spy executable: profile missed goals')
+    parser.add_argument('--stages', default=','.join(STAGES),
+                        help='comma-separated subset of %s (a targeted experiment)' % ', '.join(STAGES))
     parser.add_argument('--render-only', action='store_true',
                         help='measure nothing: render the report again from --json')
     parser.add_argument('--command', default='make bench', help='command shown in the report')
     args = parser.parse_args(argv)
+    unknown = set(args.stages.split(',')) - set(STAGES)
+    if unknown:
+        parser.error('unknown stage(s) %s; choose among %s' % (', '.join(sorted(unknown)),
+                                                               ', '.join(STAGES)))
     if args.render_only:
         with open(args.json) as f:
             write_report(json.load(f), args)
@@ -163,8 +178,11 @@ def main(argv):
         progress('master at %s, node output in %s' % (uri, args.log_dir))
         driver.init(uri)
         lab = stages.Lab(children, uri, env)
-        profiler = profiling.Profiler(args.py_spy, args.log_dir) if args.py_spy else None
-        results = run_stages(lab, cfg, kinds, profiler)
+        profiler = None
+        if args.py_spy:
+            profiler = profiling.Profiler(args.py_spy, args.log_dir, cfg['profile_window'],
+                                          cfg['jitter_rounds'], cfg['jitter_window'])
+        results = run_stages(lab, cfg, kinds, profiler, args.stages.split(','))
     finally:
         import rospy
         rospy.signal_shutdown('bench over')

@@ -53,6 +53,16 @@ def loadavg():
         return [float(x) for x in f.read().split()[:3]]
 
 
+def machine_ticks():
+    """(busy, total) clock ticks of all cores since boot, from the first line of /proc/stat."""
+    with open('/proc/stat') as f:
+        fields = [int(x) for x in f.readline().split()[1:]]
+    # user nice system idle iowait irq softirq steal [guest guest_nice, already counted in user/nice]
+    idle = fields[3] + fields[4]
+    total = sum(fields[:8])
+    return total - idle, total
+
+
 class CpuWindow:
     """CPU share of a set of processes between ``start()`` and ``stop()``, from /proc."""
 
@@ -64,6 +74,14 @@ class CpuWindow:
     def start(self):
         self._t0 = time.monotonic()
         self._ticks0 = {pid: cpu_ticks(pid) for pid in self.pids}
+        self._machine0 = machine_ticks()
+
+    def machine_busy(self):
+        """Percent of all cores busy (anyone's work, steal included) since ``start()``: how loaded the
+        shared machine was while this window measured timing."""
+        busy, total = machine_ticks()
+        busy0, total0 = self._machine0
+        return 100.0 * (busy - busy0) / (total - total0) if total > total0 else None
 
     def stop(self):
         """Percent of one core for each pid (None for a process that died meanwhile)."""

@@ -57,6 +57,8 @@ def goal_rows(r):
     row('/altitude interval off the mean, median (ms)', ('rate', 'dev_p50_ms'), '', None, 3)
     row('/altitude interval off the mean, p99 (ms)', ('rate', 'dev_p99_ms'), '', None, 3)
     row('/altitude max gap (ms)', ('rate', 'max_gap_ms'), '', None, 1)
+    row('machine busy during that window (% of all cores)', ('rate', 'machine_busy_percent'), '',
+        None, 0)
     for which, label in (('warning', 'WARNING'), ('normal', 'NORMAL')):
         row('%s latency median (ms)' % label, ('latency', which, 'median_ms'), '', None, 1)
         row('%s latency p99 (ms)' % label, ('latency', which, 'p99_ms'), '<= 20 ms',
@@ -175,10 +177,11 @@ def _max_rate(r):
         return []
     rows = [(x['target_hz'], _fmt(x.get('rate_hz'), 3), _fmt(x.get('sd_ms'), 3),
              _fmt(x.get('max_gap_ms'), 1), _fmt(x.get('cpu_percent'), 1),
+             _fmt(x.get('machine_busy_percent'), 0),
              x.get('error') or ('yes' if x['sustained'] else 'no')) for x in runs]
     return ['## Highest sustained rate (ours)', '',
             _table(['~rate (Hz)', 'measured (Hz)', 'interval sd (ms)', 'max gap (ms)',
-                    'CPU (% core)', 'sustained'], rows), '']
+                    'CPU (% core)', 'machine busy (%)', 'sustained'], rows), '']
 
 
 def _fleet(r, figure_rel):
@@ -192,17 +195,18 @@ def _fleet(r, figure_rel):
             rows.append((kind, n, _fmt(f['min_rate_hz'], 3), _fmt(f['max_rate_hz'], 3),
                          _fmt(f['max_gap_ms'], 0), _fmt(cpu.get('exam'), 1),
                          _fmt(sum(cpu.values()), 1), _fmt(rss.get('exam'), 0),
-                         _fmt(sum(rss.values()), 0),
-                         ' '.join('%.2f' % x for x in f['loadavg'])))
+                         _fmt(sum(rss.values()), 0), _fmt(f.get('machine_busy_percent'), 0)))
     if not rows:
         return []
     return ['## Fleet scale', '',
             'CPU in %% of one core (the machine has %d cores); "all" adds the simulators and, for '
-            'ours, the roslaunch process of `fleet_launch.py`. RSS is the sum over all processes.'
+            'ours, the roslaunch process of `fleet_launch.py`. RSS is the sum over all processes. '
+            '"Machine busy" is the share of all cores in use by anyone (these nodes, the bench, other '
+            'work on the shared machine) during the window, from /proc/stat.'
             % r['machine']['nproc'], '',
             _table(['node', 'pairs', 'slowest (Hz)', 'fastest (Hz)', 'max gap (ms)',
                     'CPU exam nodes', 'CPU all', 'RSS exam nodes (MB)', 'RSS all (MB)',
-                    'loadavg after'], rows), '',
+                    'machine busy (%)'], rows), '',
             '![fleet cost against N](%s)' % figure_rel, '']
 
 
@@ -232,6 +236,9 @@ def _errors(r):
 def _profile(p):
     out = ['## Profile (py-spy, ours)', '']
     for label, top in p.items():
+        if label == 'jitter' and isinstance(top, list):
+            out += _jitter(top)
+            continue
         if isinstance(top, str):
             out += ['- %s: %s' % (label, top)]
             continue
@@ -241,6 +248,19 @@ def _profile(p):
                       [(name, _fmt(s, 1), _fmt(i, 1)) for name, s, i in top['functions']]).split('\n')
         out += ['']
     return out
+
+
+def _jitter(runs):
+    rows = [(x.get('variant'), _fmt(x.get('sd_ms'), 3), _fmt(x.get('dev_p50_ms'), 3),
+             _fmt(x.get('dev_p99_ms'), 3), _fmt(x.get('max_gap_ms'), 1), _fmt(x.get('cpu_percent'), 2),
+             _fmt(x.get('machine_busy_percent'), 0)) for x in runs]
+    return ['Jitter experiment: each variant at 10 Hz, %d s each, variants interleaved round by round '
+            '(floor, synchronous publish = `bench/floor_node.py _synchronous:=true`):'
+            % runs[0].get('window_s', 0), '',
+            _table(['variant', 'interval sd (ms)', 'off the mean, median (ms)',
+                    'off the mean, p99 (ms)', 'max gap (ms)', 'CPU (% core)',
+                    'machine busy (% of all cores)'], rows),
+            '']
 
 
 def plot_fleet(r, path):

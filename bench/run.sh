@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `make bench`: measures the exam node against bench/baseline_exam_node.py and writes
 # docs/benchmarks.md and docs/figures/bench_fleet.png (about 13 minutes).
-#   BENCH_QUICK=1    a few seconds per stage; results go to a scratch directory, docs/ is untouched
+#   BENCH_QUICK=1    a few seconds per stage; results go to .ws/bench-quick/, docs/ is untouched
+#   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet), also to .ws/bench-quick/
 #   BENCH_PROFILE=1  also profile ours with py-spy (installed from PyPI into a throwaway directory)
 #   BENCH_RENDER_ONLY=1  measure nothing: render the docs again from the last results
 # Every process it starts runs in its own process group listed in a pid file; the trap kills exactly
@@ -39,14 +40,20 @@ trap 'exit 130' INT TERM
 mkdir -p "$scratch/logs"
 args=(--log-dir "$scratch/logs" --pid-file "$pid_file")
 # The exact command, as the report prints it: the BENCH_ variables change what is measured.
-command="$(env | grep -E '^BENCH_(QUICK|PROFILE)=' | sort | tr '\n' ' ')make bench"
+command="$({ env | grep -E '^BENCH_(QUICK|PROFILE|STAGES)=' || true; } | sort | tr '\n' ' ')make bench"
 if [ "$EXAM_WS" != "$repo/.ws" ]; then
   command="EXAM_WS=$EXAM_WS $command"
 fi
-if [ "${BENCH_QUICK:-0}" = 1 ]; then
+if [ -n "${BENCH_STAGES:-}" ]; then
+  args+=(--stages "$BENCH_STAGES")
+fi
+if [ "${BENCH_QUICK:-0}" = 1 ] || [ -n "${BENCH_STAGES:-}" ]; then
   out="$repo/.ws/bench-quick"
   mkdir -p "$out"
-  args+=(--quick --out "$out" --figure "$out/bench_fleet.png" --json "$out/bench_results.json"
+  if [ "${BENCH_QUICK:-0}" = 1 ]; then
+    args+=(--quick)
+  fi
+  args+=(--out "$out" --figure "$out/bench_fleet.png" --json "$out/bench_results.json"
          --command "$command")
 else
   args+=(--out "$repo/docs" --figure "$repo/docs/figures/bench_fleet.png"

@@ -92,12 +92,13 @@ class Rig:
         self.service.close()
 
 
-def rate_and_cost(lab, kind, window, rate=None, during=None):
+def rate_and_cost(lab, kind, window, rate=None, during=None, **extra):
     """Altitude stream timing, CPU and RSS of one node fed steady readings below the threshold.
 
-    ``during(pid, window)``, when given, runs instead of the plain wait (a profiler attaching).
+    ``during(pid, window)``, when given, runs instead of the plain wait (a profiler attaching);
+    ``extra`` are more private params of the node.
     """
-    params = {'threshold': THRESHOLD}
+    params = dict(extra, threshold=THRESHOLD)
     if rate is not None:
         params['rate'] = rate
     rig = Rig(lab, kind, lab.namespace('rate', kind), [(0.0, BELOW)], **params)
@@ -114,7 +115,8 @@ def rate_and_cost(lab, kind, window, rate=None, during=None):
         usage = cpu.stop()[rig.proc.pid]
         result = stats.interval_stats(rig.monitor.stamps())
         result.update(cpu_percent=usage, rss_mb=_mb(procs.rss_kb(rig.proc.pid)),
-                      window_s=window, loadavg=procs.loadavg())
+                      machine_busy_percent=cpu.machine_busy(), window_s=window,
+                      loadavg=procs.loadavg())
         return result
     finally:
         rig.close()
@@ -191,6 +193,7 @@ def fleet(lab, kind, count, window):
         cpu.start()
         time.sleep(window)
         usage = cpu.stop()
+        busy = cpu.machine_busy()
         rss = {name: procs.rss_kb(pid) for name, pid in pids.items()}
         streams = {ns: stats.interval_stats(m.stamps()) for ns, m in monitors.items()}
         # A pair that fell silent has no rate: it counts as 0 Hz, not as missing.
@@ -205,6 +208,7 @@ def fleet(lab, kind, count, window):
             'max_gap_ms': max((s['max_gap_ms'] or 0.0) for s in streams.values()),
             'cpu_percent': _by_role(usage, pids),
             'rss_mb': _by_role({pids[n]: v and v / 1024.0 for n, v in rss.items()}, pids),
+            'machine_busy_percent': busy,
             'loadavg': procs.loadavg(),
         }
     finally:
@@ -290,3 +294,26 @@ def memory_floor(lab):
                              timeout=60, check=True).stdout
         steps.append((label, int(out.strip().splitlines()[-1]) / 1024.0))
     return steps
+
+
+# What can make a 10 Hz stream wobble, one suspect per variant: the node's own code (ours vs floor),
+# rospy's writer thread (floor vs floor, synchronous), and the load of the shared machine (the rounds).
+JITTER_VARIANTS = [
+    ('ours', 'ours', {}),
+    ('baseline', 'baseline', {}),
+    ('floor', 'floor', {}),
+    ('floor, synchronous publish', 'floor', {'synchronous': 'true'}),
+]
+
+
+def jitter(lab, rounds, window):
+    """Interval statistics of each variant at 10 Hz, interleaved over ``rounds`` so a burst of load
+    from other work on the machine hits every variant alike rather than one of them."""
+    runs = []
+    for i in range(rounds):
+        for label, kind, params in JITTER_VARIANTS:
+            progress('  jitter round %d/%d: %s' % (i + 1, rounds, label))
+            run = rate_and_cost(lab, kind, window, **params)
+            run['variant'] = label
+            runs.append(run)
+    return runs
