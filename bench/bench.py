@@ -28,7 +28,7 @@ FULL = {
     'crossings': 22, 'delay': 1.0, 'hold': 0.6, 'slow_crossings': 3, 'slow_hold': 2.5,
     'rates': [10, 100, 500, 1000], 'max_rate_window': 10,
     'fleet_sizes': [1, 5, 10, 20], 'baseline_fleet_sizes': [1, 5, 10, 20], 'fleet_window': 20,
-    'jitter_rounds': 3, 'jitter_window': 20, 'profile_window': 30,
+    'jitter_rounds': 2, 'jitter_window': 20, 'profile_window': 30,
 }
 QUICK = {
     'rate_window': 4, 'floor_window': 3,
@@ -181,7 +181,7 @@ def main(argv):
         profiler = None
         if args.py_spy:
             profiler = profiling.Profiler(args.py_spy, args.log_dir, cfg['profile_window'],
-                                          cfg['jitter_rounds'], cfg['jitter_window'])
+                                          cfg['jitter_rounds'], cfg['jitter_window'], args.quick)
         results = run_stages(lab, cfg, kinds, profiler, args.stages.split(','))
     finally:
         import rospy

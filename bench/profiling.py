@@ -16,7 +16,8 @@ JITTER_GOAL_MS = 0.5
 
 
 class Profiler:
-    def __init__(self, py_spy, out_dir, window, jitter_rounds, jitter_window):
+    def __init__(self, py_spy, out_dir, window, jitter_rounds, jitter_window, always_jitter=False):
+        self.always_jitter = always_jitter  # a smoke run exercises the experiment whatever the sd
         self.py_spy = py_spy
         self.out_dir = out_dir
         self.window = window
@@ -45,7 +46,7 @@ class Profiler:
             except (RuntimeError, OSError, subprocess.SubprocessError) as e:
                 profiles[label] = 'profile failed: %s' % e
         sd = (ours.get('rate') or {}).get('sd_ms')
-        if sd is not None and sd > JITTER_GOAL_MS:
+        if self.always_jitter or (sd is not None and sd > JITTER_GOAL_MS):
             stages.progress('profile: jitter experiment, %d rounds of %d s per variant'
                             % (self.jitter_rounds, self.jitter_window))
             try:

@@ -107,9 +107,11 @@ def render(r, figure_rel):
             'Ratio is ours/baseline.', '',
             _table(['metric', 'ours', 'baseline', 'ratio', 'goal', 'ours vs goal'], goal_rows(r)), '']
     out += ['## How to run', '',
-            '`make bench` (about 13 minutes; prints one line per stage). `BENCH_QUICK=1 make bench` '
+            '`make bench` (about 10 minutes; prints one line per stage). `BENCH_QUICK=1 make bench` '
             'is a smoke run of about 2 minutes that writes to `.ws/bench-quick/` and leaves this file '
-            'alone. `BENCH_PROFILE=1 make bench` also profiles the exam node with py-spy. '
+            'alone, as does `BENCH_STAGES=rate,latency make bench` (a subset of rate, latency, slow, '
+            'max_rate, fleet). `BENCH_PROFILE=1 make bench` (about 15 minutes) also profiles the exam '
+            'node with py-spy and, when the interval sd misses its goal, runs the jitter experiment. '
             '`BENCH_RENDER_ONLY=1 make bench` renders this file again from `bench/results.json`. '
             'The benchmark is not part of `make test`; its statistics have unit tests: '
             '`/usr/bin/python3 -m pytest bench/test`.', '']

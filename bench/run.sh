@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # `make bench`: measures the exam node against bench/baseline_exam_node.py and writes
-# docs/benchmarks.md and docs/figures/bench_fleet.png (about 13 minutes).
+# docs/benchmarks.md and docs/figures/bench_fleet.png (about 10 minutes, 15 with BENCH_PROFILE=1).
 #   BENCH_QUICK=1    a few seconds per stage; results go to .ws/bench-quick/, docs/ is untouched
 #   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet), also to .ws/bench-quick/
 #   BENCH_PROFILE=1  also profile ours with py-spy (installed from PyPI into a throwaway directory)
