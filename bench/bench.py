@@ -107,11 +107,22 @@ def run_stages(lab, cfg, kinds, profiler, wanted=STAGES):
                                    stages.rate_and_cost, lab, 'floor', cfg['floor_window'])
         results['memory_floor'] = guarded('floor: RSS of python3, import rospy, init_node',
                                           stages.memory_floor, lab)
+        if 'ours' in kinds:
+            results['ours_without_numpy'] = guarded(
+                'ours without numpy (bench/without_numpy.py): rate, CPU and RSS over %d s'
+                % cfg['floor_window'],
+                stages.rate_and_cost, lab, 'ours_without_numpy', cfg['floor_window'])
     if 'latency' in wanted:
         for kind in kinds:
             results[kind]['latency'] = guarded(
                 '%s: warning latency over %d excursions' % (kind, cfg['crossings']),
                 stages.latency, lab, kind, cfg['crossings'], cfg['delay'], cfg['hold'], SEED)
+        if 'ours' in kinds:
+            # The memory experiment must still warn correctly, or its RSS proves nothing.
+            results['ours_without_numpy_latency'] = guarded(
+                'ours without numpy: warning latency over %d excursions' % cfg['crossings'],
+                stages.latency, lab, 'ours_without_numpy', cfg['crossings'], cfg['delay'],
+                cfg['hold'], SEED)
     if 'slow' in wanted:
         for kind in kinds:
             results[kind]['slow'] = guarded(

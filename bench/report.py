@@ -164,12 +164,25 @@ def _floor(r):
     out = ['## Floor: the cheapest rospy node', '',
            '`bench/floor_node.py` subscribes both inputs and publishes a constant at 10 Hz with a '
            '`rospy.Timer`, nothing else: CPU %s %% of a core, RSS %s MB, interval sd %s ms (%d s '
-           'window). No rospy node doing this job can cost less on this machine.'
+           'window). No rospy node doing this job with rospy\'s usual imports can cost less here.'
            % (_fmt(f['cpu_percent']), _fmt(f['rss_mb'], 1), _fmt(f['sd_ms'], 3), f['window_s']), '']
     steps = r.get('memory_floor')
     if isinstance(steps, list):
         out += ['RSS of a fresh process after each step every rospy node takes:', '',
                 _table(['step', 'RSS (MB)'], [(label, _fmt(mb, 1)) for label, mb in steps]), '']
+    lean = r.get('ours_without_numpy')
+    if isinstance(lean, dict) and 'error' not in lean:
+        out += ['The exam node itself run through `bench/without_numpy.py` (numpy unimportable, so '
+                'genpy takes its fallback): RSS %s MB, CPU %s %% of a core, rate %s Hz, interval sd '
+                '%s ms (%d s window).' % (_fmt(lean['rss_mb'], 1), _fmt(lean['cpu_percent']),
+                                          _fmt(lean['rate_hz'], 4), _fmt(lean['sd_ms'], 3),
+                                          lean['window_s']), '']
+    calls = r.get('ours_without_numpy_latency')
+    if isinstance(calls, dict) and 'error' not in calls:
+        out += ['Its warnings over the same %d excursions as the latency stage: %d wrong or missing '
+                'calls, WARNING p99 %s ms, NORMAL p99 %s ms.'
+                % (calls['excursions'], calls['anomaly_count'], _fmt(calls['warning']['p99_ms'], 1),
+                   _fmt(calls['normal']['p99_ms'], 1)), '']
     return out
 
 
@@ -220,8 +233,10 @@ def failed_stages(r):
         if 'error' in entry:
             failed.append('%s: %s' % (kind, entry['error']))
         entries = [(name, v) for name, v in entry.items() if isinstance(v, dict) and name != 'fleet']
-        if kind == 'floor' and isinstance(r.get('memory_floor'), dict):
-            entries.append(('memory', r['memory_floor']))
+        if kind == 'floor':
+            entries += [(name, r[name]) for name in ('memory_floor', 'ours_without_numpy',
+                                                     'ours_without_numpy_latency')
+                        if isinstance(r.get(name), dict)]
         entries += [('fleet %s' % n, v) for n, v in (entry.get('fleet') or {}).items()]
         failed += ['%s %s: %s' % (kind, name, v['error']) for name, v in entries if 'error' in v]
     return failed

@@ -24,6 +24,10 @@ SCRIPTS = {
     'baseline': os.path.join(BENCH, 'baseline_exam_node.py'),
     'floor': os.path.join(BENCH, 'floor_node.py'),
 }
+# Variants run through a wrapper instead of their script alone.
+COMMANDS = {
+    'ours_without_numpy': [os.path.join(BENCH, 'without_numpy.py'), SCRIPTS['ours']],
+}
 SIMULATOR = os.path.join(REPO, 'mydrone', 'scripts', 'mydrone_node.py')
 FLEET_LAUNCHER = os.path.join(REPO, 'exam', 'scripts', 'fleet_launch.py')
 BELOW, ABOVE = 1000.0, 1600.0
@@ -54,7 +58,8 @@ class Lab:
         return '/%s_%s_%d' % (stage, kind, self._serial)
 
     def start_node(self, kind, ns, **params):
-        argv = [PYTHON, SCRIPTS[kind], '__ns:=' + ns, '__name:=exam']
+        command = COMMANDS[kind] if kind in COMMANDS else [SCRIPTS[kind]]
+        argv = [PYTHON] + command + ['__ns:=' + ns, '__name:=exam']
         argv += ['_%s:=%s' % (k, v) for k, v in sorted(params.items())]
         return self.children.start(ns.strip('/') + '_exam', argv, self.env)
 
@@ -281,6 +286,9 @@ MEMORY_STEPS = [
     ('+ import numpy', 'import numpy'),
     ('+ import rospy, std_msgs', 'import numpy, rospy, std_msgs.msg'),
     ('+ rospy.init_node', 'import numpy, rospy, std_msgs.msg; rospy.init_node("rss_probe", anonymous=True)'),
+    ('rospy.init_node with numpy blocked (bench/without_numpy.py)',
+     'import sys; sys.modules["numpy"] = None; import rospy, std_msgs.msg; '
+     'rospy.init_node("rss_probe", anonymous=True)'),
 ]
 
 
