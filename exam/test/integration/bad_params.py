@@ -2,12 +2,12 @@
 """rostest: each bad parameter makes the exam node log it and exit non-zero within seconds.
 
 Launched alone by ``bad_params.test``: this test starts each exam node itself, as a child process
-under a name of its own (``exam_bad_<n>``), with exactly one bad private parameter set on the master
-beforehand. A fresh name per run matters: private parameters outlive the node on the master, so a
-leftover from one case would otherwise leak into the next. A good run under the same harness must
+under a name of its own (``exam_<test method>``), with exactly one bad private parameter set on the
+master beforehand. A fresh name per test matters: private parameters outlive the node on the master,
+so a leftover from one case would otherwise leak into the next. A good run under the same harness must
 keep running, or a node that dies on every start would pass.
 
-Parameters set on the master: ``/exam_bad_<n>/<param>`` (deleted after each case).
+Parameters set on the master: ``/exam_<test method>/<param>`` (deleted after each test).
 """
 import signal
 import subprocess
@@ -24,17 +24,6 @@ from fake_drone import wait_until
 # Seconds within which a bad parameter must have ended the node: rospy start-up on a loaded machine
 # takes one or two of them.
 EXIT_WITHIN = 10.0
-
-BAD = [
-    ('mode', 'foo'),
-    ('threshold', float('nan')),
-    ('threshold', float('inf')),
-    ('threshold', 'abc'),
-    ('delay', -1.0),
-    ('rate', 0.0),
-    ('timeout', 0.0),
-]
-
 
 def renderings(value):
     """The ways a log line may print ``value`` (str, repr, %g), any of which names it."""
@@ -66,23 +55,43 @@ class BadParams(unittest.TestCase):
         if rospy.has_param('/' + name):
             rospy.delete_param('/' + name)
 
-    def test_each_bad_param_exits_non_zero(self):
-        for index, (key, value) in enumerate(BAD):
-            name = 'exam_bad_%d' % index
-            with self.subTest(param=key, value=value):
-                process = self.run_node(name, {key: value})
-                try:
-                    output, _ = process.communicate(timeout=EXIT_WITHIN)
-                except subprocess.TimeoutExpired:
-                    process.kill()
-                    process.communicate()
-                    self.fail('~%s=%r: the node still ran after %.0f s' % (key, value, EXIT_WITHIN))
-                self.assertNotEqual(process.returncode, 0, '~%s=%r: exit status 0' % (key, value))
-                resolved = '/%s/%s' % (name, key)
-                self.assertIn(resolved, output, '~%s=%r: the log does not name %s:\n%s'
-                              % (key, value, resolved, output))
-                self.assertTrue(any(text in output for text in renderings(value)),
-                                '~%s=%r: the log does not show the value:\n%s' % (key, value, output))
+    def check_exits(self, key, value):
+        """The node with ``~key`` = ``value`` exits non-zero in time, naming the parameter and value."""
+        name = 'exam_' + self._testMethodName
+        process = self.run_node(name, {key: value})
+        try:
+            output, _ = process.communicate(timeout=EXIT_WITHIN)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.communicate()
+            self.fail('~%s=%r: the node still ran after %.0f s' % (key, value, EXIT_WITHIN))
+        self.assertNotEqual(process.returncode, 0, '~%s=%r: exit status 0' % (key, value))
+        resolved = '/%s/%s' % (name, key)
+        self.assertIn(resolved, output,
+                      '~%s=%r: the log does not name %s:\n%s' % (key, value, resolved, output))
+        self.assertTrue(any(text in output for text in renderings(value)),
+                        '~%s=%r: the log does not show the value:\n%s' % (key, value, output))
+
+    def test_unknown_mode(self):
+        self.check_exits('mode', 'foo')
+
+    def test_threshold_nan(self):
+        self.check_exits('threshold', float('nan'))
+
+    def test_threshold_inf(self):
+        self.check_exits('threshold', float('inf'))
+
+    def test_threshold_not_a_number(self):
+        self.check_exits('threshold', 'abc')
+
+    def test_negative_delay(self):
+        self.check_exits('delay', -1.0)
+
+    def test_zero_rate(self):
+        self.check_exits('rate', 0.0)
+
+    def test_zero_timeout(self):
+        self.check_exits('timeout', 0.0)
 
     def test_good_params_keep_running(self):
         name = 'exam_good'

@@ -6,7 +6,7 @@ rate 10 Hz, timeout 5 s). The tests run in the order of their names and share th
 ``test_01`` must see it before it ever had an input; every later test starts from
 :meth:`fake_drone.Drone.settle` (inputs fresh, below the threshold, LED state NORMAL).
 
-Subscribed Topics: ``altitude`` (std_msgs/Float32, m), ``alt_warn_led`` is published, not read.
+Subscribed Topics: ``altitude`` (std_msgs/Float32, m).
 Published Topics: ``temperature`` (std_msgs/Float32, degC), ``pressure`` (std_msgs/Float32, Pa),
 ``alt_warn_led`` (std_msgs/String, latched).
 Services: ``altitude_warning`` (mydrone/AltitudeWarning), the fake drone's.
@@ -43,7 +43,7 @@ class AltitudeScenarios(fake_drone.DroneScenario):
 
     def assert_no_call_until(self, deadline):
         calls = self.drone.service.wait_for_calls(1, deadline - rospy.get_time())
-        self.assertEqual(calls, [], 'unexpected warning calls')
+        self.assertEqual(calls, [], 'warning calls though never %.0f s above %.0f m' % (DELAY, THRESHOLD))
 
     def test_01_nothing_before_both_inputs(self):
         self.assert_nothing_before_both_inputs('temperature')
