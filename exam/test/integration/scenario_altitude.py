@@ -67,6 +67,8 @@ class AltitudeScenarios(fake_drone.DroneScenario):
         calls = self.drone.service.wait_for_calls(2, 3.0)
         self.assertEqual([s for _, s in calls], ['WARNING', 'NORMAL'])
         self.assert_warning_time(calls[0][0] - t0)
+        rospy.loginfo('WARNING %.3f s after the first reading above, NORMAL %.3f s after the return',
+                      calls[0][0] - t0, calls[1][0] - t1)
         self.assertLess(calls[1][0] - t1, NORMAL_LATENCY, 'NORMAL late after the return below')
         # Once per change of state: nothing more while the state holds.
         self.assertEqual(len(self.drone.service.wait_for_calls(3, 1.5)), 2)
