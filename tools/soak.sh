@@ -15,11 +15,15 @@ threshold=1300
 delay=5
 dir="${SOAK_DIR:-$EXAM_WS/soak/$(date -u +%Y%m%dT%H%M%SZ)}"
 mkdir -p "$dir/log"
-port="$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')"
+port="$(/usr/bin/python3 -c \
+  'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')"
 export ROS_MASTER_URI="http://127.0.0.1:$port" ROS_LOG_DIR="$dir/log"
 
 groups=()
-descendants() { local child; for child in $(ps -o pid= --ppid "$1"); do echo "$child"; descendants "$child"; done; }
+descendants() {
+  local child
+  for child in $(ps -o pid= --ppid "$1"); do echo "$child"; descendants "$child"; done
+}
 # Ctrl-C a process group as a terminal would; SIGKILL it after 20 s. roslaunch puts each node in a
 # session of its own, so the fallback also kills every descendant found before the Ctrl-C.
 stop_group() {
