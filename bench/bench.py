@@ -197,7 +197,7 @@ def main(argv):
     finally:
         import rospy
         rospy.signal_shutdown('bench over')
-        children.stop_all()
+        children.stop()
     info['loadavg_end'] = procs.loadavg()
     results.update(machine=info, config=cfg, quick=args.quick, date=date, command=args.command,
                    duration_s=time.monotonic() - t0)

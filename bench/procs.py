@@ -103,7 +103,6 @@ class Children:
         self.pid_file = pid_file
         self.log_dir = log_dir
         self.procs = []
-        self.adopted = []
 
     def start(self, name, argv, env):
         """Start ``argv`` in a new session with output to ``<log_dir>/<name>.log``."""
@@ -112,20 +111,9 @@ class Children:
                                 stdin=subprocess.DEVNULL, start_new_session=True)
         log.close()
         self.procs.append(proc)
-        self._record(proc.pid)
-        return proc
-
-    def adopt(self, pid):
-        """Take responsibility for a process another child started in its own session.
-
-        roslaunch starts each node with setsid: if the launcher died hard, its nodes would outlive it.
-        """
-        self.adopted.append(pid)
-        self._record(pid)
-
-    def _record(self, pid):
         with open(self.pid_file, 'a') as f:
-            f.write('%d\n' % pid)
+            f.write('%d\n' % proc.pid)
+        return proc
 
     def stop(self, procs=None, grace=5.0):
         """SIGINT (rospy's clean shutdown), then SIGKILL after ``grace`` seconds, per process group."""
@@ -144,45 +132,10 @@ class Children:
             if proc in self.procs:
                 self.procs.remove(proc)
 
-    def release(self, pids, grace=5.0):
-        """Wait for adopted processes that their launcher is stopping; SIGKILL the ones that linger."""
-        deadline = time.monotonic() + grace
-        for pid in pids:
-            while _alive(pid) and time.monotonic() < deadline:
-                time.sleep(0.1)
-            if _alive(pid):
-                _kill_group(pid, signal.SIGKILL)
-            if pid in self.adopted:
-                self.adopted.remove(pid)
-
-    def stop_all(self):
-        """Everything still running: the started processes, then what roslaunch left behind."""
-        self.stop()
-        for pid in self.adopted:
-            _kill_group(pid, signal.SIGKILL)
-        self.adopted = []
-
-
-def _alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    # A zombie still answers kill(0); it holds no resources and is not ours to reap.
-    try:
-        with open('/proc/%d/stat' % pid) as f:
-            return f.read().rsplit(')', 1)[1].split()[0] != 'Z'
-    except OSError:
-        return False
-
 
 def _signal_group(proc, sig):
-    _kill_group(proc.pid, sig)
-
-
-def _kill_group(pgid, sig):
     try:
-        os.killpg(pgid, sig)
+        os.killpg(proc.pid, sig)
     except ProcessLookupError:
         pass
 

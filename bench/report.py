@@ -153,8 +153,11 @@ def _method(r):
             'sd < 1 ms. The baseline has no `~rate` (10 Hz is hard-coded).'
             % (', '.join(str(x) for x in c['rates']), c['max_rate_window']),
             '- Fleet: N pairs of the real simulator (`mydrone/scripts/mydrone_node.py`) and a node, '
-            'each pair in its own namespace on one master, %d s window after all pairs publish.'
-            % c['fleet_window'], '']
+            'each pair in its own namespace on one master, %d s window after all pairs publish. The '
+            'bench starts the nodes itself, in namespaces never reused, instead of through '
+            '`exam/scripts/fleet_launch.py`, whose names repeat from one fleet to the next: see '
+            '`fleet()` in bench/stages.py for the rospy hazard that made a reused name kill a node '
+            'of the next fleet.' % c['fleet_window'], '']
 
 
 def _floor(r):
@@ -214,8 +217,8 @@ def _fleet(r, figure_rel):
     if not rows:
         return []
     return ['## Fleet scale', '',
-            'CPU in %% of one core (the machine has %d cores); "all" adds the simulators and, for '
-            'ours, the roslaunch process of `fleet_launch.py`. RSS is the sum over all processes. '
+            'CPU in %% of one core (the machine has %d cores); "all" adds the simulators. RSS is '
+            'the sum over the processes. '
             '"Machine busy" is the share of all cores in use by anyone (these nodes, the bench, other '
             'work on the shared machine) during the window, from /proc/stat.'
             % r['machine']['nproc'], '',

@@ -8,7 +8,6 @@ a namespace of its own, measures, stops them, and returns a plain dict that repo
 import os
 import subprocess
 import time
-import xmlrpc.client
 
 import rosgraph
 
@@ -29,7 +28,6 @@ COMMANDS = {
     'ours_without_numpy': [os.path.join(BENCH, 'without_numpy.py'), SCRIPTS['ours']],
 }
 SIMULATOR = os.path.join(REPO, 'mydrone', 'scripts', 'mydrone_node.py')
-FLEET_LAUNCHER = os.path.join(REPO, 'exam', 'scripts', 'fleet_launch.py')
 BELOW, ABOVE = 1000.0, 1600.0
 THRESHOLD = 1300.0
 STARTUP_TIMEOUT = 30.0
@@ -161,22 +159,25 @@ def latency(lab, kind, count, delay, hold, seed, slow=0.0):
 
 
 def fleet(lab, kind, count, window):
-    """``count`` drone + exam pairs: each pair's /altitude rate, total CPU and RSS by role."""
-    launcher = None
+    """``count`` drone + exam pairs: each pair's /altitude rate, total CPU and RSS by role.
+
+    Every pair gets a namespace never used before on this master, and the bench starts each node
+    itself rather than through exam/scripts/fleet_launch.py, whose names drone1..droneN repeat from
+    one fleet to the next. A rospy node never withdraws its param subscriptions (rosout's
+    /rosout_disable_topics_generation, diagnostic_updater's ~diagnostic_period), so the master keeps
+    every stopped node's XML-RPC address; when a node of the same name registers again, the master
+    tells the old address to shut down, and if the OS has meanwhile given that port to a node of the
+    new fleet, that node dies ("new node registered with same name"). The first full run lost a
+    simulator of the 20-pair fleet exactly so.
+    """
+    namespaces = [lab.namespace('fleet%d' % count, kind) for _ in range(count)]
+    pids = {}
     started = []
-    if kind == 'ours' and available(FLEET_LAUNCHER):
-        namespaces = ['/drone%d' % i for i in range(1, count + 1)]
-        launcher = lab.children.start('fleet_%d' % count,
-                                      [PYTHON, FLEET_LAUNCHER, str(count)], lab.env)
-        pids = {}
-    else:
-        namespaces = [lab.namespace('fleet%d' % count, kind) for _ in range(count)]
-        pids = {}
-        for ns in namespaces:
-            started.append(lab.start_simulator(ns))
-            started.append(lab.start_node(kind, ns, threshold=THRESHOLD))
-            pids[ns + '/mydrone'] = started[-2].pid
-            pids[ns + '/exam'] = started[-1].pid
+    for ns in namespaces:
+        started.append(lab.start_simulator(ns))
+        pids[ns + '/mydrone'] = started[-1].pid
+        started.append(lab.start_node(kind, ns, threshold=THRESHOLD))
+        pids[ns + '/exam'] = started[-1].pid
     monitors = {ns: driver.StreamMonitor(ns + '/altitude') for ns in namespaces}
     try:
         deadline = time.monotonic() + STARTUP_TIMEOUT + 3.0 * count
@@ -185,12 +186,6 @@ def fleet(lab, kind, count, window):
         if silent:
             raise RuntimeError('fleet of %d: no altitude from %s (registered nodes there: %s)'
                                % (count, ', '.join(silent), registered(lab.uri, silent)))
-        if launcher is not None:
-            for ns in namespaces:
-                for name in ('mydrone', 'exam'):
-                    pids[ns + '/' + name] = node_pid(lab.uri, ns + '/' + name)
-                    lab.children.adopt(pids[ns + '/' + name])
-            pids['roslaunch'] = launcher.pid
         time.sleep(2.0)
         for monitor in monitors.values():
             monitor.reset()
@@ -206,7 +201,6 @@ def fleet(lab, kind, count, window):
         return {
             'pairs': count,
             'window_s': window,
-            'launcher': 'exam/scripts/fleet_launch.py' if launcher else 'bench (one process per node)',
             'rates_hz': rates,
             'min_rate_hz': min(rates),
             'max_rate_hz': max(rates),
@@ -219,12 +213,11 @@ def fleet(lab, kind, count, window):
     finally:
         for monitor in monitors.values():
             monitor.close()
-        lab.children.stop([launcher] if launcher else started)
-        lab.children.release(list(lab.children.adopted))
+        lab.children.stop(started)
 
 
 def _by_role(values_by_pid, pids):
-    """Sum per role (exam, mydrone, roslaunch) of a per-pid value."""
+    """Sum per role (exam, mydrone) of a per-pid value."""
     roles = {}
     for name, pid in pids.items():
         role = name.rsplit('/', 1)[-1]
@@ -239,23 +232,6 @@ def registered(uri, namespaces):
     state = rosgraph.Master('/bench', master_uri=uri).getSystemState()
     nodes = {node for _, names in state[0] + state[1] + state[2] for node in names}
     return sorted(n for n in nodes if any(n.startswith(ns + '/') for ns in namespaces)) or 'none'
-
-
-def node_pid(uri, name):
-    """Pid of a registered node, asked from the node itself (rosnode info does the same)."""
-    master = rosgraph.Master('/bench', master_uri=uri)
-    deadline = time.monotonic() + STARTUP_TIMEOUT
-    while True:
-        try:
-            api = master.lookupNode(name)
-            code, _, pid = xmlrpc.client.ServerProxy(api).getPid('/bench')
-            if code == 1:
-                return pid
-        except (rosgraph.MasterError, OSError):
-            pass
-        if time.monotonic() > deadline:
-            raise RuntimeError('node %s never registered' % name)
-        time.sleep(0.2)
 
 
 def _mb(kb):
