@@ -86,7 +86,6 @@ class SensorFeeder(object):
     def __init__(self, rates):
         """:param rates: dict topic name -> publishing rate in Hz."""
         self._lock = threading.Lock()
-        self._stop = threading.Event()
         self._pubs = {}
         self._values = {}
         self._quiet_until = {}
@@ -132,15 +131,17 @@ class SensorFeeder(object):
             self._quiet_until[topic] = time.monotonic() + quiet
             return self._publish(topic, value)
 
-    def shutdown(self):
-        self._stop.set()
-
     def _run(self, topic, period):
-        while not self._stop.wait(period) and not rospy.is_shutdown():
+        while not rospy.is_shutdown():
+            time.sleep(period)
             with self._lock:
                 value = self._values[topic]
-                if value is not None and time.monotonic() >= self._quiet_until[topic]:
+                if value is None or time.monotonic() < self._quiet_until[topic]:
+                    continue
+                try:
                     self._publish(topic, value)
+                except rospy.ROSException:
+                    return  # the publisher closed: the test node is shutting down
 
     def _publish(self, topic, value):
         """Publish one message (the caller holds the lock); return its ROS time."""
@@ -179,7 +180,8 @@ class FakeWarningService(object):
         self._service.shutdown('withdrawn by the test')
         # The master must have forgotten the service, or the caller would still find it.
         resolved = rospy.resolve_name(self._name)
-        wait_until(lambda: not _service_registered(resolved), 5.0)
+        if not wait_until(lambda: not _service_registered(resolved), 5.0):
+            raise AssertionError('the master still lists %s 5 s after its shutdown' % resolved)
 
     def configure(self, delay=0.0, failing=False):
         with self._lock:
@@ -187,7 +189,11 @@ class FakeWarningService(object):
             self._failing = failing
 
     def calls(self):
-        """Accepted calls so far: a list of (ROS time of arrival in s, status string)."""
+        """Answered calls so far, as (ROS time of arrival in s, status string).
+
+        A status other than NORMAL/WARNING is answered (success false) and listed too, so that a test
+        comparing call sequences sees it.
+        """
         with self._lock:
             return list(self._calls)
 
@@ -205,7 +211,7 @@ class FakeWarningService(object):
             del self._attempts[:]
 
     def wait_for_calls(self, count, timeout):
-        """The accepted calls once there are at least ``count`` of them, or all there are at timeout."""
+        """The answered calls once there are at least ``count`` of them, or all there are at timeout."""
         wait_until(lambda: len(self.calls()) >= count, timeout)
         return self.calls()
 

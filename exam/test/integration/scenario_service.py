@@ -17,7 +17,7 @@ import rospy
 import rostest
 
 import fake_drone
-from fake_drone import hold
+from fake_drone import hold, wait_until
 
 DELAY = 5.0         # s, the node's default
 LOW = 1200.0        # m, below the default threshold 1300 m
@@ -47,7 +47,6 @@ class ServiceScenarios(fake_drone.DroneScenario):
         # WARNING is wanted since ~t1 + 5 s, and nobody could take it.
         self.assertLess(self.drone.output.max_gap(t1, rospy.get_time()), 0.5,
                         'publishing stalled while the service was absent')
-        self.assertEqual(self.drone.service.attempts(), [])
         appeared = rospy.get_time()
         self.drone.service.advertise()
         calls = self.drone.service.wait_for_calls(1, DELIVERY)
@@ -91,13 +90,17 @@ class ServiceScenarios(fake_drone.DroneScenario):
 
     def test_04_slow_service_never_stalls_publishing(self):
         self.drone.service.configure(delay=2.0)
+        service = self.drone.service
         t0 = self.drone.fly_to(HIGH)
-        calls = self.drone.service.wait_for_calls(1, DELAY + 2.0)
-        self.assertEqual([s for _, s in calls], ['WARNING'])
+        # A slow call is listed once answered: its arrival shows in the attempts at once.
+        wait_until(service.attempts, DELAY + 2.0)
+        self.assertEqual([s for _, s in service.attempts()], ['WARNING'])
         # Back below while the WARNING call is still in the fake's hands.
         hold(0.5)
         back = self.drone.fly_to(LOW)
-        calls = self.drone.service.wait_for_calls(2, 5.0)
+        self.assertEqual(service.calls(), [], 'the WARNING call did not last its 2 s')
+        # NORMAL may only start once WARNING is answered, and takes 2 s more.
+        calls = service.wait_for_calls(2, 6.0)
         end = rospy.get_time()
         self.assertEqual([s for _, s in calls], ['WARNING', 'NORMAL'])
         self.assertGreater(calls[1][0], back)
