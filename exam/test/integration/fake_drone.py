@@ -154,7 +154,8 @@ class FakeWarningService(object):
     """The drone's warning service: sets a fake LED and records every call with its arrival time.
 
     Like the real drone it publishes the LED colour on a latched topic, GREEN at start, following the
-    calls it accepts. It can be absent (:meth:`withdraw`, or ``advertise=False``), slow (``delay`` s
+    calls it accepts; with ``led_topic`` None it publishes none (a drone without LED reports). It can
+    be absent (:meth:`withdraw`, or ``advertise=False``), slow (``delay`` s
     per call) or failing (the handler raises, so the caller gets a ServiceException).
     """
 
@@ -167,8 +168,10 @@ class FakeWarningService(object):
         self._delay = 0.0
         self._failing = False
         self._service = None
-        self._led = rospy.Publisher(led_topic, String, queue_size=1, latch=True)
-        self._led.publish(String('GREEN'))
+        self._led = None
+        if led_topic is not None:
+            self._led = rospy.Publisher(led_topic, String, queue_size=1, latch=True)
+            self._led.publish(String('GREEN'))
         if advertise:
             self.advertise()
 
@@ -227,7 +230,7 @@ class FakeWarningService(object):
         valid = request.status in ('NORMAL', 'WARNING')
         with self._lock:
             self._calls.append((now, request.status))
-        if valid:
+        if valid and self._led is not None:
             self._led.publish(String('RED' if request.status == 'WARNING' else 'GREEN'))
         return self._srv_class._response_class(valid, 'LED set' if valid else 'unknown status')
 
@@ -273,18 +276,19 @@ class Drone(object):
     input that carries it; the other input stays at its constant value.
     """
 
-    def __init__(self, mode='altitude', advertise=True):
+    def __init__(self, mode='altitude', advertise=True, led=True):
         self.mode = mode
         if mode == 'altitude':
             self.feeder = SensorFeeder({'temperature': 2.0, 'pressure': 5.0})
-            self.service = FakeWarningService('altitude_warning', AltitudeWarning, 'alt_warn_led',
-                                              advertise)
+            self.service = FakeWarningService('altitude_warning', AltitudeWarning,
+                                              'alt_warn_led' if led else None, advertise)
             self.output = TopicRecorder('altitude')
             self.fixed_topic, self.fixed_value = 'temperature', AIR_TEMPERATURE
             self.moving_topic = 'pressure'
         else:
             self.feeder = SensorFeeder({'pressure_remote': 2.0, 'pressure_robot': 5.0})
-            self.service = FakeWarningService('depth_warning', DepthWarning, 'depth_warn_led', advertise)
+            self.service = FakeWarningService('depth_warning', DepthWarning,
+                                              'depth_warn_led' if led else None, advertise)
             self.output = TopicRecorder('depth')
             self.fixed_topic, self.fixed_value = 'pressure_remote', REMOTE_PRESSURE
             self.moving_topic = 'pressure_robot'
@@ -341,16 +345,18 @@ class DroneScenario(unittest.TestCase):
 
     Subclasses set ``MODE`` and ``REST`` (a value in m on the safe side of the threshold), and may name
     in ``FIRST`` the test that must meet the exam node before it ever had an input; unittest runs the
-    tests in the order of their names, so that one is named ``test_01_...``.
+    tests in the order of their names, so that one is named ``test_01_...``. ``ADVERTISE`` False starts
+    the drone without its warning service, ``LED`` False without its LED topic.
     """
     MODE = 'altitude'
     ADVERTISE = True
+    LED = True
     REST = None
     FIRST = None
 
     @classmethod
     def setUpClass(cls):
-        cls.drone = Drone(cls.MODE, cls.ADVERTISE)
+        cls.drone = Drone(cls.MODE, cls.ADVERTISE, cls.LED)
 
     def setUp(self):
         if self._testMethodName != self.FIRST:

@@ -3,11 +3,11 @@
 
 Launched by ``depth.test`` beside an exam node given only ``mode: depth``, so threshold 150 m and
 delay 5 s come from the node's defaults for that mode. The tests run in the order of their names and
-share the node: ``test_01`` must see it before it ever had an input.
+share the node: ``test_01`` must see it before it ever had an input. This fake drone publishes no
+LED topic: the exam node must drive the LED from its own record of the calls it made.
 
 Subscribed Topics: ``depth`` (std_msgs/Float32, m).
-Published Topics: ``pressure_robot`` (std_msgs/Float32, Pa), ``pressure_remote`` (std_msgs/Float32, Pa),
-``depth_warn_led`` (std_msgs/String, latched).
+Published Topics: ``pressure_robot`` (std_msgs/Float32, Pa), ``pressure_remote`` (std_msgs/Float32, Pa).
 Services: ``depth_warning`` (submarinedrone/DepthWarning), the fake drone's.
 """
 import sys
@@ -27,6 +27,7 @@ DEEP = 160.0       # m, beyond the threshold
 
 class DepthScenarios(fake_drone.DroneScenario):
     MODE = 'depth'
+    LED = False
     REST = SHALLOW
     FIRST = 'test_01_nothing_before_both_inputs'
 
