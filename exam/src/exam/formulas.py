@@ -31,6 +31,10 @@ R = 8.31432
 ZERO_CELSIUS = 273.15
 #: Density of salt water [kg/m^3].
 RHO_SEA_WATER = 1030.0
+#: Kelvin temperatures up to this are taken as absolute zero [K]. std_msgs/Float32 cannot hold
+#: -273.15 exactly: it arrives as -273.1499939 degC, 6e-6 K above absolute zero, and would pass a bare
+#: comparison. 1 mK is far above that rounding and far below any real air temperature.
+ABSOLUTE_ZERO_MARGIN_K = 1e-3
 
 
 def altitude(temperature_c, pressure_pa):
@@ -52,7 +56,7 @@ def temperature_problem(temperature_c):
     """
     if not math.isfinite(temperature_c):
         return 'not a finite number'
-    if temperature_c <= -ZERO_CELSIUS:
+    if temperature_c + ZERO_CELSIUS <= ABSOLUTE_ZERO_MARGIN_K:
         return 'at or below absolute zero (-273.15 degC)'
     return None
 

@@ -1,5 +1,6 @@
 """Both formulas against values computed by hand, and the input checks."""
 import math
+import struct
 
 import pytest
 
@@ -39,6 +40,12 @@ def test_depth_at_150_m_by_hand():
 @pytest.mark.parametrize('value', [float('nan'), float('inf'), -float('inf'), -273.15, -300.0])
 def test_unusable_temperatures(value):
     assert formulas.temperature_problem(value) is not None
+
+
+def test_absolute_zero_as_carried_by_a_float32_message_is_unusable():
+    as_float32 = struct.unpack('f', struct.pack('f', -273.15))[0]
+    assert as_float32 > -273.15  # the rounding that would let it through a bare comparison
+    assert formulas.temperature_problem(as_float32) is not None
 
 
 @pytest.mark.parametrize('value', [-273.14, -40.0, 0.0, 15.0, 60.0])
