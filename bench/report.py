@@ -121,7 +121,8 @@ def render(r, figure_rel):
     out += _fleet(r, figure_rel)
     out += _errors(r)
     if r.get('analysis'):
-        out += ['## What bounds the missed goals', '', r['analysis'].strip(), '']
+        out += ['## What bounds each result (hand-written: bench/analysis.md)', '',
+                r['analysis'].strip(), '']
     if r.get('profile'):
         out += _profile(r['profile'])
     return '\n'.join(out) + '\n'
