@@ -62,7 +62,8 @@ fi
 
 if [ "${BENCH_RENDER_ONLY:-0}" = 1 ]; then
   # After editing bench/analysis.md or report.py: the same numbers, rendered again.
-  exec /usr/bin/python3 "$repo/bench/bench.py" "${args[@]}" --render-only
+  /usr/bin/python3 "$repo/bench/bench.py" "${args[@]}" --render-only
+  exit 0
 fi
 if [ "${BENCH_PROFILE:-0}" = 1 ]; then
   echo "bench: installing py-spy into $scratch/py-spy (BENCH_PROFILE=1)"
