@@ -1,8 +1,9 @@
 """The measurements of `make bench`, one function per stage, each for one kind of node.
 
-A kind is ``ours`` (exam/scripts/exam_node.py), ``baseline`` (bench/baseline_exam_node.py) or ``floor``
-(bench/floor_node.py, the cheapest rospy node with the same topics). Every stage starts its node(s) in
-a namespace of its own, measures, stops them, and returns a plain dict that report.py renders.
+A kind is ``ours`` (exam/scripts/exam_node.py), ``baseline`` (bench/baseline_exam_node.py), ``floor``
+(bench/floor_node.py, the cheapest rospy node with the same topics) or ``ours_without_numpy`` (ours
+through bench/without_numpy.py, the memory experiment). Every stage starts its node(s) in a namespace
+of its own, measures, stops them, and returns a plain dict that report.py renders.
 """
 
 import os
