@@ -1,0 +1,421 @@
+"""The lab's one fake drone: scripted sensors, a recording warning service, the LED topic.
+
+It plays the drone for an exam node under test (ours in the rostests and the bench, a student's in the
+grader): it publishes the two sensor inputs of either sheet with the values a script sets, serves the
+warning service and records every call with the time it arrived, and publishes the LED colour on a
+latched topic as the real drones do. It also records what the exam node publishes. Times are ROS time
+(``rospy.get_time()``), the clock the exam node counts its delay in.
+
+The values come from :mod:`exam_lab.harness.oracle`, never from the ``exam`` package.
+
+Used in-process, after ``rospy.init_node`` (a rostest test node, the bench driver, the grader's probe)::
+
+    drone = Drone('altitude')            # temperature + pressure, altitude_warning, alt_warn_led
+    drone.start(1200.0)                  # waits for the node under test to subscribe, then feeds
+    t = drone.fly_to(1500.0)             # ROS time of the first reading at 1500 m
+    drone.service.wait_for_calls(1, 10.0)
+
+or as a node of its own: ``rosrun exam_lab fake_drone_node.py`` (a drone process a test can kill).
+"""
+import threading
+import time
+import unittest
+
+import rospy
+from std_msgs.msg import Float32, String
+
+from mydrone.srv import AltitudeWarning
+from submarinedrone.srv import DepthWarning
+
+from exam_lab.harness import oracle
+from exam_lab.harness.wait import wait_until
+
+#: Temperature the fake aerial drone flies in, degC (any valid value would do).
+AIR_TEMPERATURE = 15.0
+#: Pressure the fake remote measures at sea level, Pa.
+REMOTE_PRESSURE = oracle.P0
+#: The statuses of the sheets and the LED colour each sets.
+COLOURS = {'NORMAL': 'GREEN', 'WARNING': 'RED'}
+
+
+def _alive():
+    return not rospy.is_shutdown()
+
+
+class SensorFeeder(object):
+    """Publishes each input topic from its own thread at its own rate, with the value the test sets.
+
+    The rates differ and are below the exam node's 10 Hz on purpose: the node must cache the latest
+    value of each input rather than wait for a pair. A new value is published at once by :meth:`set`
+    and the time returned, so a test knows when the node saw its first reading of it. Publishing
+    happens under one lock, so a periodic message can never overtake a newer value.
+
+    :param rates: dict topic name -> publishing rate in Hz.
+    :param tcp_nodelay: ask subscribers for TCP_NODELAY (the bench: no Nagle batching in the stamps).
+    """
+
+    def __init__(self, rates, tcp_nodelay=False):
+        self._lock = threading.Lock()
+        self._pubs = {}
+        self._values = {}
+        self._quiet_until = {}
+        self._last_sent = {}
+        for topic in rates:
+            self._pubs[topic] = rospy.Publisher(topic, Float32, queue_size=10, tcp_nodelay=tcp_nodelay)
+            self._values[topic] = None
+            self._quiet_until[topic] = 0.0
+        self._stopped = threading.Event()
+        self._threads = [threading.Thread(target=self._run, args=(topic, 1.0 / rate))
+                         for topic, rate in rates.items()]
+        for thread in self._threads:
+            thread.daemon = True
+            thread.start()
+
+    def connected(self):
+        """True when every input topic has a subscriber (the node under test is up and connected)."""
+        return all(pub.get_num_connections() > 0 for pub in self._pubs.values())
+
+    def wait_for_subscribers(self, timeout):
+        return wait_until(self.connected, timeout, alive=_alive)
+
+    def set(self, topic, value):
+        """Publish ``value`` now and keep publishing it; return the ROS time of the first message."""
+        with self._lock:
+            self._values[topic] = value
+            self._quiet_until[topic] = 0.0
+            return self._publish(topic, value)
+
+    def stop(self, topic):
+        """Stop publishing ``topic`` (a sensor gone silent); return the ROS time of its last message.
+        :meth:`set` starts it again."""
+        with self._lock:
+            self._values[topic] = None
+            return self._last_sent.get(topic)
+
+    def inject(self, topic, value, quiet):
+        """Publish one ``value`` (a bad reading) without keeping it, then stay silent ``quiet`` s.
+
+        The silence makes a bad value that the node wrongly cached visible: it would be the latest
+        input for several of the node's 10 Hz ticks.
+        """
+        with self._lock:
+            self._quiet_until[topic] = time.monotonic() + quiet
+            return self._publish(topic, value)
+
+    def close(self):
+        """Stop every feeding thread and unregister the publishers."""
+        self._stopped.set()
+        for thread in self._threads:
+            thread.join(2.0)
+        for pub in self._pubs.values():
+            pub.unregister()
+
+    def _run(self, topic, period):
+        while not rospy.is_shutdown() and not self._stopped.wait(period):
+            with self._lock:
+                value = self._values[topic]
+                if value is None or time.monotonic() < self._quiet_until[topic]:
+                    continue
+                try:
+                    self._publish(topic, value)
+                except rospy.ROSException:
+                    return  # the publisher closed: the node is shutting down
+
+    def _publish(self, topic, value):
+        """Publish one message (the caller holds the lock); return its ROS time."""
+        self._last_sent[topic] = rospy.get_time()
+        self._pubs[topic].publish(Float32(value))
+        return self._last_sent[topic]
+
+
+class FakeWarningService(object):
+    """The drone's warning service: sets a fake LED and records every call with its arrival time.
+
+    Like the real drone it publishes the LED colour on a latched topic, GREEN at start, following the
+    calls it accepts; with ``led_topic`` None it publishes none (a drone without LED reports). It can
+    be absent (:meth:`withdraw`, or ``advertise=False``), slow (``delay`` s per call), failing (the
+    handler raises, so the caller gets a ServiceException) or refusing (answers success false, as a
+    broken LED driver would).
+
+    :param on_call: optional function(status, success) called after each answered call.
+    """
+
+    def __init__(self, name, srv_class, led_topic, advertise=True, on_call=None):
+        self._name = name
+        self._srv_class = srv_class
+        self._on_call = on_call
+        self._lock = threading.Lock()
+        self._calls = []
+        self._attempts = []
+        self._delay = 0.0
+        self._failing = False
+        self._refusing = False
+        self._service = None
+        self._led = None
+        self.colour = 'GREEN'
+        if led_topic is not None:
+            self._led = rospy.Publisher(led_topic, String, queue_size=1, latch=True)
+            self._led.publish(String(self.colour))
+        if advertise:
+            self.advertise()
+
+    def advertise(self):
+        self._service = rospy.Service(self._name, self._srv_class, self._handle)
+
+    def withdraw(self):
+        """Unregister the service: the node's calls fail as if the drone were gone."""
+        self._service.shutdown('withdrawn by the test')
+        # The master must have forgotten the service, or the caller would still find it.
+        resolved = rospy.resolve_name(self._name)
+        if wait_until(lambda: not _service_registered(resolved), 5.0) is None:
+            raise AssertionError('the master still lists %s 5 s after its shutdown' % resolved)
+
+    def configure(self, delay=0.0, failing=False, refusing=False):
+        with self._lock:
+            self._delay = delay
+            self._failing = failing
+            self._refusing = refusing
+
+    def calls(self):
+        """Answered calls so far, as (ROS time of arrival in s, status string).
+
+        A status other than NORMAL/WARNING is answered (success false) and listed too, so that a test
+        comparing call sequences sees it.
+        """
+        with self._lock:
+            return list(self._calls)
+
+    def statuses(self):
+        return [status for _, status in self.calls()]
+
+    def attempts(self):
+        """Every call that reached the handler, failed ones included: (time, status)."""
+        with self._lock:
+            return list(self._attempts)
+
+    def clear(self):
+        with self._lock:
+            del self._calls[:]
+            del self._attempts[:]
+
+    def wait_for_calls(self, count, timeout):
+        """The answered calls once there are at least ``count`` of them, or all there are at timeout."""
+        wait_until(lambda: len(self.calls()) >= count, timeout, alive=_alive)
+        return self.calls()
+
+    def _handle(self, request):
+        now = rospy.get_time()
+        with self._lock:
+            self._attempts.append((now, request.status))
+            delay, failing, refusing = self._delay, self._failing, self._refusing
+        if delay > 0.0:
+            time.sleep(delay)
+        if failing:
+            raise rospy.ServiceException('the fake drone was told to fail')
+        colour = None if refusing else COLOURS.get(request.status)
+        with self._lock:
+            self._calls.append((now, request.status))
+            if colour is not None and colour != self.colour:
+                self.colour = colour
+                if self._led is not None:
+                    self._led.publish(String(colour))
+        if self._on_call is not None:
+            self._on_call(request.status, colour is not None)
+        if refusing:
+            message = 'LED driver fault (scripted)'
+        else:
+            message = 'LED set' if colour is not None else 'unknown status'
+        return self._srv_class._response_class(colour is not None, message)
+
+
+def _service_registered(resolved_name):
+    state = rospy.get_master().getSystemState()[2]
+    return any(name == resolved_name for name, _ in state[2])
+
+
+class TopicRecorder(object):
+    """Records every Float32 the node under test publishes on ``topic`` as (ROS time of arrival, value)."""
+
+    def __init__(self, topic, tcp_nodelay=False):
+        self._lock = threading.Lock()
+        self._samples = []
+        self._sub = rospy.Subscriber(topic, Float32, self._callback, queue_size=100,
+                                     tcp_nodelay=tcp_nodelay)
+
+    def samples(self, since=0.0, until=float('inf')):
+        with self._lock:
+            return [(t, v) for t, v in self._samples if since <= t <= until]
+
+    def clear(self):
+        with self._lock:
+            del self._samples[:]
+
+    def wait_for(self, predicate, timeout, since=0.0):
+        """The first sample after ``since`` whose value satisfies ``predicate``, or None at timeout."""
+        def first():
+            return next((s for s in self.samples(since) if predicate(s[1])), None)
+        return wait_until(first, timeout, alive=_alive)
+
+    def max_gap(self, since, until):
+        """Longest interval in s without a sample within [since, until], edges included."""
+        times = [since] + [t for t, _ in self.samples(since, until)] + [until]
+        return max(b - a for a, b in zip(times, times[1:]))
+
+    def close(self):
+        self._sub.unregister()
+
+    def _callback(self, msg):
+        now = rospy.get_time()
+        with self._lock:
+            self._samples.append((now, msg.data))
+
+
+#: What differs between the two sheets' drones: inputs (the one that does not move first) and their
+#: rates, the service, the LED topic and the output the exam node publishes.
+SHEETS = {
+    'altitude': dict(rates={'temperature': 2.0, 'pressure': 5.0}, service='altitude_warning',
+                     srv=AltitudeWarning, led='alt_warn_led', output='altitude',
+                     fixed=('temperature', AIR_TEMPERATURE), moving='pressure'),
+    'depth': dict(rates={'pressure_remote': 2.0, 'pressure_robot': 5.0}, service='depth_warning',
+                  srv=DepthWarning, led='depth_warn_led', output='depth',
+                  fixed=('pressure_remote', REMOTE_PRESSURE), moving='pressure_robot'),
+}
+
+
+class Drone(object):
+    """One fake drone of either sheet: its inputs, its warning service, and the node's output.
+
+    :meth:`fly_to` moves the drone to an altitude (aerial) or depth (underwater) by changing the one
+    input that carries it; the other input stays at its constant value.
+
+    :param mode: ``'altitude'`` (sheet 000) or ``'depth'`` (sheet 001).
+    :param advertise: start with the warning service advertised.
+    :param led: publish the LED topic.
+    :param rates: dict topic -> Hz, to override the default input rates.
+    :param tcp_nodelay: see :class:`SensorFeeder`.
+    :param on_call: see :class:`FakeWarningService`.
+    """
+
+    def __init__(self, mode='altitude', advertise=True, led=True, rates=None, tcp_nodelay=False,
+                 on_call=None):
+        sheet = SHEETS[mode]
+        self.mode = mode
+        self.feeder = SensorFeeder(dict(sheet['rates'], **(rates or {})), tcp_nodelay)
+        self.service = FakeWarningService(sheet['service'], sheet['srv'],
+                                          sheet['led'] if led else None, advertise, on_call)
+        self.output = TopicRecorder(sheet['output'], tcp_nodelay)
+        self.fixed_topic, self.fixed_value = sheet['fixed']
+        self.moving_topic = sheet['moving']
+
+    def input_for(self, value):
+        """The moving input that puts the drone at ``value`` m."""
+        if self.mode == 'altitude':
+            return oracle.pressure_at(value, self.fixed_value)
+        return oracle.pressure_robot_at(value, self.fixed_value)
+
+    def expected(self, fixed, moving):
+        """What the exam node must publish for these two input values."""
+        if self.mode == 'altitude':
+            return oracle.altitude_of(fixed, moving)
+        return oracle.depth_of(moving, fixed)
+
+    def start(self, value, timeout=30.0):
+        """Wait for the node under test to connect, then feed both inputs at ``value`` m."""
+        if not self.feeder.wait_for_subscribers(timeout):
+            raise AssertionError('the exam node never subscribed to both inputs within %.0f s' % timeout)
+        self.feeder.set(self.fixed_topic, self.fixed_value)
+        return self.fly_to(value)
+
+    def fly_to(self, value):
+        """Move to ``value`` m now; return the ROS time of the first reading there."""
+        return self.feeder.set(self.moving_topic, self.input_for(value))
+
+    def fly(self, schedule):
+        """Fly a list of (value in m, seconds to stay); return the start time of each leg.
+
+        The stays are the schedule of the scripted flight, not waits for a result.
+        """
+        starts = []
+        for value, seconds in schedule:
+            starts.append(self.fly_to(value))
+            time.sleep(seconds)
+        return starts
+
+    def settle(self, value, timeout=15.0):
+        """Bring the node to NORMAL at ``value`` m (below threshold) and forget what was recorded.
+
+        Each test starts from the same state: inputs fresh, the last call (if any) NORMAL.
+        """
+        since = self.fly_to(value)
+        published = self.output.wait_for(lambda v: abs(v - value) < 1.0, timeout, since)
+        if published is None:
+            raise AssertionError('the exam node published no %s near %.1f m within %.0f s'
+                                 % (self.mode, value, timeout))
+        if not wait_until(lambda: self.service.statuses()[-1:] in ([], ['NORMAL']), timeout,
+                          alive=_alive):
+            raise AssertionError('the exam node did not return to NORMAL at %.1f m: calls %s'
+                                 % (value, self.service.calls()))
+        self.service.clear()
+
+    def close(self):
+        self.feeder.close()
+        self.output.close()
+
+
+class DroneScenario(unittest.TestCase):
+    """Base of the exam node's scenario tests: one fake drone per class, each test from a settled state.
+
+    Subclasses set ``MODE`` and ``REST`` (a value in m on the safe side of the threshold), and may name
+    in ``FIRST`` the test that must meet the exam node before it ever had an input; unittest runs the
+    tests in the order of their names, so that one is named ``test_01_...``. ``ADVERTISE`` False starts
+    the drone without its warning service, ``LED`` False without its LED topic, ``RATES`` overrides
+    the input rates.
+    """
+    MODE = 'altitude'
+    ADVERTISE = True
+    LED = True
+    RATES = None
+    REST = None
+    FIRST = None
+
+    @classmethod
+    def setUpClass(cls):
+        cls.drone = Drone(cls.MODE, cls.ADVERTISE, cls.LED, cls.RATES)
+
+    def setUp(self):
+        if self._testMethodName != self.FIRST:
+            self.drone.start(self.REST)
+            self.drone.settle(self.REST)
+
+    def assert_formula(self, cases, tolerance):
+        """Each (fixed input, moving input) pair makes the node publish the sheet's value, within
+        ``tolerance`` m; the fixed input is set back afterwards."""
+        drone = self.drone
+        for fixed, moving in cases:
+            expected = drone.expected(fixed, moving)
+            drone.feeder.set(drone.fixed_topic, fixed)
+            since = drone.feeder.set(drone.moving_topic, moving)
+            sample = drone.output.wait_for(lambda v: abs(v - expected) < tolerance, 3.0, since)
+            self.assertIsNotNone(sample, '%s=%r, %s=%r: expected %.4f m, published %s'
+                                 % (drone.fixed_topic, fixed, drone.moving_topic, moving, expected,
+                                    [v for _, v in drone.output.samples(since)][-5:]))
+        drone.feeder.set(drone.fixed_topic, drone.fixed_value)
+
+    def assert_nothing_before_both_inputs(self, first_topic):
+        """Feed ``first_topic`` alone for a while: no output; then the other one: output at once."""
+        drone = self.drone
+        self.assertTrue(drone.feeder.wait_for_subscribers(30.0), 'the exam node never subscribed')
+        if first_topic == drone.fixed_topic:
+            drone.feeder.set(first_topic, drone.fixed_value)
+        else:
+            drone.fly_to(self.REST)
+        time.sleep(1.5)  # the observation window: nothing may be published in it
+        self.assertEqual(drone.output.samples(), [], '%s published with only %s known'
+                         % (drone.mode, first_topic))
+        if first_topic == drone.fixed_topic:
+            both = drone.fly_to(self.REST)
+        else:
+            both = drone.feeder.set(drone.fixed_topic, drone.fixed_value)
+        first = drone.output.wait_for(lambda v: True, 3.0)
+        self.assertIsNotNone(first, 'no %s within 3 s of the second input' % drone.mode)
+        self.assertGreaterEqual(first[0], both, '%s published before the second input came' % drone.mode)

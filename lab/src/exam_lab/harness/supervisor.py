@@ -1,0 +1,294 @@
+"""The lab's supervisor of ROS processes: masters on free ports, nodes in process groups, logs kept.
+
+Everything the lab starts from outside the product goes through :class:`Supervisor`: the operations
+tests, the benchmark, the report generator, the soak run and the grader. One run's processes share a
+log folder and a marker in their environment (``EXAM_LAB_RUN=<log folder>``). roslaunch starts each
+node in a session of its own, so a process group does not hold a launch's nodes; the marker does, since
+children inherit the environment. :meth:`Supervisor.close` therefore ends exactly this run's processes,
+and ``python3 -m exam_lab.harness.supervisor --cleanup DIR`` does the same from a shell trap when the
+Python process that started them died.
+
+Stopping is what a user does: Ctrl-C (SIGINT) to the process group, so rospy shuts down cleanly and
+roslaunch stops its nodes; SIGKILL for whatever is left after a grace period.
+
+Usage::
+
+    with Supervisor(log_dir) as sup:
+        master = sup.start_master()
+        node = sup.start('exam', ['rosrun', 'exam', 'exam_node.py'], master.env)
+        ...
+    # every process of the run is gone here; the logs stay in log_dir
+"""
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+#: Environment variable that marks every process of one supervised run.
+MARKER = 'EXAM_LAB_RUN'
+
+
+def free_port():
+    """A TCP port nobody listens on right now: bind port 0 on loopback and let the kernel choose."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.bind(('127.0.0.1', 0))
+        return sock.getsockname()[1]
+
+
+def ros_env(base, master_uri, log_dir, ip=None):
+    """The environment of a ROS process: ``base`` plus its master, where it logs, what it advertises.
+
+    ROS_HOSTNAME and ROS_IP are dropped unless ``ip`` is given (then ROS_IP=ip), so a test's nodes
+    never advertise an address inherited from the developer's shell.
+    """
+    env = dict(base, ROS_MASTER_URI=master_uri, ROS_LOG_DIR=str(log_dir),
+               ROS_HOME=os.path.join(str(log_dir), 'ros_home'), PYTHONUNBUFFERED='1')
+    env.pop('ROS_HOSTNAME', None)
+    env.pop('ROS_IP', None)
+    if ip is not None:
+        env['ROS_IP'] = ip
+    return env
+
+
+def descendants(pid):
+    """Pids of every living descendant of ``pid``, from the parent links in /proc."""
+    children = {}
+    for entry in os.listdir('/proc'):
+        if entry.isdigit():
+            try:
+                with open('/proc/%s/stat' % entry) as stat:
+                    ppid = int(stat.read().rsplit(')', 1)[1].split()[1])
+            except (OSError, ValueError, IndexError):
+                continue
+            children.setdefault(ppid, []).append(int(entry))
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.append(child)
+            todo.append(child)
+    return found
+
+
+def marked(run_dir):
+    """Pids of the processes whose environment carries ``EXAM_LAB_RUN=run_dir`` (this one excluded)."""
+    marker = ('\0%s=%s\0' % (MARKER, run_dir)).encode()
+    pids = []
+    for entry in os.listdir('/proc'):
+        if not entry.isdigit() or int(entry) == os.getpid():
+            continue
+        try:
+            with open('/proc/%s/environ' % entry, 'rb') as f:
+                environ = b'\0' + f.read()
+        except OSError:
+            continue
+        if marker in environ:
+            pids.append(int(entry))
+    return pids
+
+
+def alive(pid):
+    """True while ``pid`` exists and is not a zombie."""
+    try:
+        with open('/proc/%d/stat' % pid) as f:
+            return f.read().rsplit(')', 1)[1].split()[0] != 'Z'
+    except (OSError, IndexError):
+        return False
+
+
+def end_pids(pids, grace=5.0):
+    """SIGINT each pid, then SIGKILL those still alive after ``grace`` seconds."""
+    for pid in pids:
+        _kill(pid, signal.SIGINT)
+    deadline = time.monotonic() + grace
+    while time.monotonic() < deadline and any(alive(pid) for pid in pids):
+        time.sleep(0.1)
+    for pid in pids:
+        if alive(pid):
+            _kill(pid, signal.SIGKILL)
+
+
+def _kill(pid, sig):
+    try:
+        os.kill(pid, sig)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+def _killpg(pgid, sig):
+    try:
+        os.killpg(pgid, sig)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+class Master(object):
+    """One ``roscore`` on a port of its own, and the environment that talks to it.
+
+    :ivar uri: ``http://127.0.0.1:<port>/``.
+    :ivar env: the supervisor's environment with ROS_MASTER_URI set to :attr:`uri`.
+    """
+
+    def __init__(self, supervisor, name, port):
+        import rosgraph  # only once the ROS environment is known to be there
+        self.supervisor = supervisor
+        self.name = name
+        self.port = port
+        self.uri = 'http://127.0.0.1:%d/' % port
+        self.env = dict(supervisor.env, ROS_MASTER_URI=self.uri)
+        self.graph = rosgraph.Master('/exam_lab', master_uri=self.uri)
+        self.proc = None
+
+    def start(self, timeout=30.0):
+        """Start roscore (again, after :meth:`kill`) and wait until it answers."""
+        self.proc = self.supervisor.start(self.name, ['roscore', '-p', str(self.port)], self.env)
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise RuntimeError('roscore on port %d exited with %s; see %s'
+                                   % (self.port, self.proc.returncode, self.supervisor.log(self.name)))
+            if self.is_online():
+                return self
+            time.sleep(0.1)
+        raise RuntimeError('roscore on port %d did not answer within %.0f s' % (self.port, timeout))
+
+    def is_online(self):
+        try:
+            return self.graph.is_online()
+        except OSError:
+            return False
+
+    def kill(self):
+        """SIGKILL the master and its rosout (a crashed ground station); the port stays ours."""
+        family = descendants(self.proc.pid)
+        _killpg(self.proc.pid, signal.SIGKILL)
+        for pid in family:
+            _kill(pid, signal.SIGKILL)
+        self.proc.wait()
+
+    def system_state(self):
+        """(publishers, subscribers, services) as the master lists them: [(name, [nodes])] each."""
+        return self.graph.getSystemState()
+
+    def publishers(self, topic):
+        return dict(self.system_state()[0]).get(topic, [])
+
+    def subscribers(self, topic):
+        return dict(self.system_state()[1]).get(topic, [])
+
+
+class Supervisor(object):
+    """Starts processes in sessions of their own, logs each to ``<log_dir>/<name>.log``, ends them all.
+
+    :param log_dir: the run's folder (created); logs stay there after :meth:`close`.
+    :param env: the base environment (default: this process's).
+    :param pid_file: if given, every started process's group id is appended to it at once, for a shell
+        trap (the marker cleanup is the better way; this is for scripts that predate it).
+    """
+
+    def __init__(self, log_dir, env=None, pid_file=None):
+        self.log_dir = os.path.abspath(str(log_dir))
+        os.makedirs(self.log_dir, exist_ok=True)
+        self.env = dict(os.environ if env is None else env)
+        self.env[MARKER] = self.log_dir
+        self.env.setdefault('ROS_LOG_DIR', os.path.join(self.log_dir, 'ros_log'))
+        self.env.setdefault('ROS_HOME', os.path.join(self.log_dir, 'ros_home'))
+        self.env['PYTHONUNBUFFERED'] = '1'
+        self.pid_file = pid_file
+        self.procs = []
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def log(self, name):
+        """Path of the log of the process started as ``name``."""
+        return os.path.join(self.log_dir, name + '.log')
+
+    def output(self, name):
+        """What the process started as ``name`` printed so far."""
+        try:
+            with open(self.log(name), errors='replace') as f:
+                return f.read()
+        except OSError:
+            return ''
+
+    def start(self, name, argv, env=None, cwd=None):
+        """Start ``argv`` in the background, in a session (process group) of its own.
+
+        :param env: its environment (default the supervisor's); the run's marker is always added.
+        :returns: the ``subprocess.Popen``; stdout and stderr go to :meth:`log`.
+        """
+        env = dict(self.env if env is None else env)
+        env[MARKER] = self.log_dir
+        with open(self.log(name), 'ab') as out:
+            proc = subprocess.Popen(list(argv), env=env, cwd=cwd, stdout=out, stderr=subprocess.STDOUT,
+                                    stdin=subprocess.DEVNULL, start_new_session=True)
+        self.procs.append(proc)
+        if self.pid_file:
+            with open(self.pid_file, 'a') as f:
+                f.write('%d\n' % proc.pid)
+        return proc
+
+    def run(self, name, argv, timeout, env=None, cwd=None):
+        """Run ``argv`` to completion within ``timeout`` s; its whole process group dies at the limit.
+
+        :returns: ``(status, output, seconds)``; status is the exit code, or None when it was killed
+            at the time limit. The output is also kept in :meth:`log`.
+        """
+        start = time.monotonic()
+        proc = self.start(name, argv, env, cwd)
+        try:
+            status = proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.stop(proc, grace=2.0)
+            status = None
+        if proc in self.procs:
+            self.procs.remove(proc)
+        return status, self.output(name), time.monotonic() - start
+
+    def stop(self, proc, grace=10.0):
+        """Ctrl-C the process group, as a user would; SIGKILL the group and every descendant found
+        beforehand if it is not gone after ``grace`` s. Returns the exit status."""
+        if proc.poll() is None:
+            family = descendants(proc.pid)
+            _killpg(proc.pid, signal.SIGINT)
+            try:
+                proc.wait(timeout=grace)
+            except subprocess.TimeoutExpired:
+                pass
+            # The leader may be gone while a forked child (rosout under roscore) still runs.
+            _killpg(proc.pid, signal.SIGKILL)
+            for pid in family:
+                if alive(pid):
+                    _kill(pid, signal.SIGKILL)
+        proc.wait()
+        if proc in self.procs:
+            self.procs.remove(proc)
+        return proc.returncode
+
+    def start_master(self, name='master', port=None, timeout=30.0):
+        """Start a roscore on ``port`` (default: a free one) and wait until it answers."""
+        return Master(self, name, port or free_port()).start(timeout)
+
+    def close(self, grace=5.0):
+        """Stop what was started, newest first, then anything else that carries this run's marker."""
+        for proc in reversed(list(self.procs)):
+            self.stop(proc, grace)
+        end_pids(marked(self.log_dir), grace)
+
+
+def main(argv):
+    if len(argv) == 2 and argv[0] == '--cleanup':
+        end_pids(marked(os.path.abspath(argv[1])))
+        return 0
+    sys.stderr.write('usage: python3 -m exam_lab.harness.supervisor --cleanup RUN_DIR\n')
+    return 2
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))
