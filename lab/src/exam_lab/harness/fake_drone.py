@@ -234,12 +234,16 @@ def _service_registered(resolved_name):
 
 
 class TopicRecorder(object):
-    """Records every Float32 the node under test publishes on ``topic`` as (ROS time of arrival, value)."""
+    """Records every value the node under test publishes on ``topic`` as (ROS time of arrival, value).
 
-    def __init__(self, topic, tcp_nodelay=False):
+    :param msg_class: the topic's type, any message with a ``data`` field (default std_msgs/Float32;
+        the grader also reads a student's Float64).
+    """
+
+    def __init__(self, topic, tcp_nodelay=False, msg_class=Float32):
         self._lock = threading.Lock()
         self._samples = []
-        self._sub = rospy.Subscriber(topic, Float32, self._callback, queue_size=100,
+        self._sub = rospy.Subscriber(topic, msg_class, self._callback, queue_size=100,
                                      tcp_nodelay=tcp_nodelay)
 
     def samples(self, since=0.0, until=float('inf')):

@@ -52,6 +52,30 @@ def ros_env(base, master_uri, log_dir, ip=None):
     return env
 
 
+#: Variables through which a sourced catkin workspace (and its underlays) reaches a process.
+WORKSPACE_VARS = ('CMAKE_PREFIX_PATH', 'ROS_PACKAGE_PATH', 'PYTHONPATH', 'LD_LIBRARY_PATH',
+                  'PKG_CONFIG_PATH', 'ROSLISP_PACKAGE_DIRECTORIES', 'CPATH', 'PATH')
+
+
+def workspace_env(setup_script, base=None, timeout=60.0):
+    """The environment of ``base`` (default: this process's) once ``setup_script`` is sourced in bash,
+    without any workspace ``base`` had sourced: a catkin workspace's own view, with only its
+    underlays. PATH keeps /usr/bin first (ROS 1 needs the system python3).
+
+    Used to build a package against one workspace and to run its nodes in it (the grader's student
+    workspaces); the caller's own workspace never leaks in.
+    """
+    env = dict(os.environ if base is None else base)
+    for name in WORKSPACE_VARS:
+        env.pop(name, None)
+    env['PATH'] = '/usr/bin:/bin:/usr/sbin:/sbin:/usr/local/bin'
+    out = subprocess.run(['bash', '-c', 'source "$1" >/dev/null 2>&1 && env -0', 'bash', str(setup_script)],
+                         env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, timeout=timeout,
+                         check=True).stdout
+    sourced = dict(item.split('=', 1) for item in out.decode('utf-8', 'replace').split('\0') if '=' in item)
+    return {name: value for name, value in sourced.items() if name not in ('_', 'SHLVL', 'PWD', 'OLDPWD')}
+
+
 def descendants(pid):
     """Pids of every living descendant of ``pid``, from the parent links in /proc."""
     children = {}
