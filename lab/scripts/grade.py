@@ -1,0 +1,55 @@
+#!/usr/bin/env python3
+"""Grade a student's exam package, or a class of them, by running it (docs/grading.md).
+
+    grade.py --submission DIR_OR_ZIP [--sheet altitude|depth] [--out DIR]
+    grade.py --class DIR_OR_ZIP [--sheet altitude|depth] [--out DIR] [--jobs N]
+
+Prints the score table; exits 0 whenever grading completed, whatever the scores, and 1 when the
+grader itself could not run (a missing input, the simulators not building).
+"""
+import argparse
+import os
+import sys
+
+from exam_lab.grader import report, runner
+from exam_lab.grader.sheets import SHEETS
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    what = parser.add_mutually_exclusive_group(required=True)
+    what.add_argument('--submission', help='a folder holding the exam package, or its zip')
+    what.add_argument('--class', dest='klass', help='a folder (or zip) with one sub-folder per student')
+    parser.add_argument('--sheet', choices=list(SHEETS), help='default: detected from the package')
+    parser.add_argument('--out', help='output folder (default: $EXAM_WS/grades/<name>)')
+    parser.add_argument('--jobs', type=int, default=2, help='students graded side by side (class)')
+    args = parser.parse_args(argv)
+    target = args.submission or args.klass
+    if not os.path.exists(target):
+        sys.stderr.write('grade: %s does not exist\n' % target)
+        return 1
+    name = os.path.basename(os.path.abspath(target).rstrip('/'))
+    out = os.path.abspath(args.out or os.path.join(runner.workspace(), 'grades', name))
+    try:
+        if args.submission:
+            record = runner.grade_submission(args.submission, out, args.sheet)
+            print(report.table([record]))
+            for line in report.evidence_lines(record):
+                print('  ' + line)
+            print('grade.json and grade.md in %s' % out)
+        else:
+            def progress(record):
+                sys.stdout.write('graded %s: %s/%s (%.0f s)\n' % (record['student'], record['total'],
+                                                                   record['max'], record['seconds']))
+                sys.stdout.flush()
+            records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=progress)
+            print(report.table(records))
+            print('grades.csv and one folder per student in %s' % out)
+    except RuntimeError as err:
+        sys.stderr.write('grade: %s\n' % err)
+        return 1
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,476 @@
+"""Reading a student's launch files without running them, and writing the copies the grader runs.
+
+No rospy here: this is a small evaluator of roslaunch XML, enough for exam answers. It understands
+``<arg>`` (default / value, passed to ``<include>``), ``<group ns>``, ``if`` / ``unless``,
+``<node>`` (its private ``<param>`` and ``<rosparam>``), ``<param>`` and ``<rosparam>`` (inline YAML or
+``command="load" file=...``) at any level, ``<include>`` of the exam package's own files, and the
+substitutions ``$(arg)``, ``$(find)``, ``$(dirname)``, ``$(env)``, ``$(optenv)``. What it cannot
+evaluate (``$(eval)``, unknown args) is reported, never guessed.
+
+Every parameter keeps the place its literal value comes from (an attribute of an element, a key of
+inline YAML or of a YAML file), followed through ``$(arg ...)``, so the grader can change a threshold
+"however it is named or set" and run the student's own launch file with the new value.
+
+The grader runs a *derived* launch file: the student's, without the drone (the grader's fake drone
+plays it) nor any other package's node or include, every node's output to the screen (the log the
+teacher reads), and optionally one parameter's value changed. Derived files are written next to the
+originals (``.grader-<tag>-<name>``), so ``$(dirname)`` still means what the student meant.
+"""
+import collections
+import os
+import re
+import xml.etree.ElementTree as ET
+
+import yaml
+
+from exam_lab.grader.sheets import PACKAGE, SHEETS, sheet_of_drone
+
+#: Substitution pattern of roslaunch: ``$(command args)``.
+_SUBST = re.compile(r'\$\((\w+)((?:\s+[^)]*)?)\)')
+#: Parameter names that say "threshold", and those that say something else (a rate, a delay...).
+_THRESHOLD_WORDS = ('thresh', 'seuil', 'limit', 'lim', 'max', 'alert', 'warn', 'alarm', 'ceiling')
+_OTHER_WORDS = ('rate', 'delay', 'hz', 'freq', 'period', 'duration', 'time', 'seed', 'profile', 'mode',
+                'count', 'tick', 'iter', 'queue', 'timeout', 'wait')
+
+Node = collections.namedtuple('Node', 'pkg type name ns file')
+#: A parameter: full name, value, where its literal lives (:class:`Origin` or None), owning node.
+Param = collections.namedtuple('Param', 'name value origin node')
+
+
+class Unsupported(Exception):
+    """A construct this evaluator does not understand (the message says which)."""
+
+
+class Origin(object):
+    """Where a literal value lives, so that it can be changed in a derived file.
+
+    ``kind`` is ``'attr'`` (``element.get(key)``), ``'yaml'`` (key path ``key`` in the inline YAML text
+    of ``element``) or ``'yaml_file'`` (key path ``key`` in the file named by ``element``'s ``file``).
+    """
+
+    def __init__(self, path, element, kind, key, yaml_file=None):
+        self.path = path
+        self.element = element
+        self.kind = kind
+        self.key = key
+        self.yaml_file = yaml_file
+
+    def describe(self, package_dir):
+        where = os.path.relpath(self.yaml_file or self.path, package_dir)
+        if self.kind == 'attr':
+            return '%s: <%s name="%s"> %s' % (where, self.element.tag, self.element.get('name'), self.key)
+        return '%s: YAML key %s' % (where, '/'.join(self.key))
+
+
+class Analysis(object):
+    """What one top-level launch file (and the files it includes) would start and set."""
+
+    def __init__(self, path, package_dir):
+        self.path = path
+        self.package_dir = package_dir
+        self.nodes = []
+        self.params = []
+        #: Drone packages started through an ``<include>`` of their own launch files.
+        self.included_drones = []
+        self.problems = []
+        #: path -> parsed tree of every file read (the top one and the exam package's includes).
+        self.trees = collections.OrderedDict()
+
+    @property
+    def exam_nodes(self):
+        return [n for n in self.nodes if n.pkg == PACKAGE]
+
+    def drone_sheets(self):
+        """Sheets whose drone this launch starts (by a node or by including the drone's launch file)."""
+        sheets = [sheet_of_drone(n.pkg) for n in self.nodes if sheet_of_drone(n.pkg)]
+        sheets += [sheet_of_drone(pkg) for pkg in self.included_drones]
+        return sorted(set(sheets))
+
+    def starts_drone(self, sheet):
+        drone = SHEETS[sheet]
+        return any(n.pkg == drone.drone_pkg and n.type == drone.drone_type for n in self.nodes) \
+            or drone.drone_pkg in self.included_drones
+
+    def drone_namespace(self, sheet):
+        """The namespace of the drone node in this launch ('/' when none or at the top)."""
+        for node in self.nodes:
+            if node.pkg == SHEETS[sheet].drone_pkg:
+                return node.ns
+        return '/'
+
+    def exam_params(self):
+        """Parameters the exam node can see: global ones and the exam nodes' private ones."""
+        return [p for p in self.params if p.node is None or p.node.pkg == PACKAGE]
+
+
+def _truth(text):
+    value = text.strip().lower()
+    if value in ('true', '1'):
+        return True
+    if value in ('false', '0'):
+        return False
+    raise Unsupported('if/unless value %r' % text)
+
+
+def _join(ns, name):
+    if name.startswith('/'):
+        return name
+    return (ns.rstrip('/') + '/' + name) if ns != '/' else '/' + name
+
+
+def as_number(value):
+    """``value`` as a float if it is a number (or a string holding one), else None."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return float(value)
+    try:
+        return float(str(value).strip())
+    except ValueError:
+        return None
+
+
+def _yaml_value(text):
+    """A ``<param value>`` as roslaunch types it: bool, int, float or str (no type= attribute)."""
+    try:
+        value = yaml.safe_load(text)
+    except yaml.YAMLError:
+        return text
+    return value if isinstance(value, (bool, int, float)) else text
+
+
+class _Scope(object):
+    """Args of one launch file: name -> (value, Origin of its literal or None)."""
+
+    def __init__(self, path, package_dir, passed=None):
+        self.path = path
+        self.package_dir = package_dir
+        self.args = {}
+        self.passed = passed or {}
+
+    def substitute(self, text):
+        """``text`` with every substitution evaluated, and the Origin when it is exactly one $(arg)."""
+        if text is None:
+            return None, None
+        whole = _SUBST.fullmatch(text.strip())
+        if whole and whole.group(1) == 'arg':
+            name = whole.group(2).strip()
+            if name not in self.args:
+                raise Unsupported('$(arg %s) of an undeclared arg in %s' % (name, self.path))
+            return self.args[name]
+        return _SUBST.sub(self._one, text), None
+
+    def _one(self, match):
+        command, rest = match.group(1), match.group(2).split()
+        if command == 'arg':
+            if not rest or rest[0] not in self.args:
+                raise Unsupported('$(arg %s) of an undeclared arg' % ' '.join(rest))
+            return str(self.args[rest[0]][0])
+        if command == 'find':
+            if rest and rest[0] == PACKAGE:
+                return self.package_dir
+            return '/__pkg__/%s' % (rest[0] if rest else '')
+        if command == 'dirname':
+            return os.path.dirname(self.path)
+        if command in ('env', 'optenv'):
+            return os.environ.get(rest[0], ' '.join(rest[1:])) if rest else ''
+        if command == 'anon':
+            return '_'.join(rest)
+        raise Unsupported('$(%s ...)' % command)
+
+
+def analyse(path, package_dir):
+    """Analyse the launch file ``path`` of the package in ``package_dir``; never raises for content."""
+    analysis = Analysis(path, package_dir)
+    try:
+        _read_file(analysis, path, _Scope(path, package_dir), '/', depth=0)
+    except Unsupported as err:
+        analysis.problems.append('cannot evaluate %s: %s' % (os.path.relpath(path, package_dir), err))
+    return analysis
+
+
+def _read_file(analysis, path, scope, ns, depth):
+    try:
+        tree = ET.parse(path)
+    except (ET.ParseError, OSError) as err:
+        analysis.problems.append('%s is not valid XML: %s' % (os.path.relpath(path, analysis.package_dir), err))
+        return
+    analysis.trees[path] = tree
+    root = tree.getroot()
+    if root.tag != 'launch':
+        analysis.problems.append('%s: the root element is <%s>, not <launch>' % (path, root.tag))
+        return
+    _read_children(analysis, root, scope, ns, None, depth)
+
+
+def _enabled(element, scope):
+    for attr, wanted in (('if', True), ('unless', False)):
+        if element.get(attr) is not None and _truth(scope.substitute(element.get(attr))[0]) != wanted:
+            return False
+    return True
+
+
+def _read_children(analysis, parent, scope, ns, node, depth):
+    for element in list(parent):
+        if not isinstance(element.tag, str) or not _enabled(element, scope):
+            continue
+        tag = element.tag
+        if tag == 'arg':
+            _read_arg(element, scope)
+        elif tag == 'group':
+            group_ns = element.get('ns')
+            inner = _join(ns, scope.substitute(group_ns)[0]) if group_ns else ns
+            _read_children(analysis, element, scope, inner, node, depth)
+        elif tag == 'node':
+            name = scope.substitute(element.get('name'))[0] or ''
+            node_ns = _join(ns, scope.substitute(element.get('ns'))[0]) if element.get('ns') else ns
+            this = Node(scope.substitute(element.get('pkg'))[0], scope.substitute(element.get('type'))[0],
+                        name, node_ns, scope.path)
+            analysis.nodes.append(this)
+            _read_children(analysis, element, scope, _join(node_ns, name), this, depth)
+        elif tag == 'param':
+            _read_param(analysis, element, scope, ns, node)
+        elif tag == 'rosparam':
+            _read_rosparam(analysis, element, scope, ns, node)
+        elif tag == 'include':
+            _read_include(analysis, element, scope, ns, depth)
+
+
+def _read_arg(element, scope):
+    name = element.get('name')
+    for attr in ('value', 'default'):
+        if element.get(attr) is None:
+            continue
+        if attr == 'default' and name in scope.passed:
+            scope.args[name] = scope.passed[name]
+            return
+        value, origin = scope.substitute(element.get(attr))
+        scope.args[name] = (value, origin or Origin(scope.path, element, 'attr', attr))
+        return
+    if name in scope.passed:
+        scope.args[name] = scope.passed[name]
+    else:
+        scope.args[name] = ('', None)  # declared without a value: an error only if used
+
+
+def _read_param(analysis, element, scope, ns, node):
+    name = scope.substitute(element.get('name'))[0]
+    if element.get('value') is None:
+        return  # textfile / command / binfile: not a number a threshold would be
+    raw, origin = scope.substitute(element.get('value'))
+    if origin is None:
+        origin = Origin(scope.path, element, 'attr', 'value')
+    kind = element.get('type')
+    value = raw if kind == 'str' else _yaml_value(raw)
+    analysis.params.append(Param(_join(ns, name), value, origin, node))
+
+
+def _read_rosparam(analysis, element, scope, ns, node):
+    command = element.get('command', 'load')
+    if command != 'load':
+        return
+    base = _join(ns, scope.substitute(element.get('ns'))[0]) if element.get('ns') else ns
+    param = scope.substitute(element.get('param'))[0] if element.get('param') else None
+    if element.get('file'):
+        yaml_file = scope.substitute(element.get('file'))[0]
+        if not yaml_file.startswith(analysis.package_dir) or not os.path.isfile(yaml_file):
+            analysis.problems.append('rosparam file %s not found in the package' % element.get('file'))
+            return
+        with open(yaml_file) as f:
+            text = f.read()
+        kind = 'yaml_file'
+    else:
+        yaml_file = None
+        text = element.text or ''
+        if element.get('subst_value', 'false').lower() in ('true', '1'):
+            text = scope.substitute(text)[0]
+        kind = 'yaml'
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as err:
+        analysis.problems.append('rosparam YAML does not parse: %s' % err)
+        return
+    prefix = _join(base, param) if param else base
+    for key, value in _flatten(data, ()):
+        if not key and not param:
+            continue
+        name = prefix if not key else _join(prefix, '/'.join(key))
+        analysis.params.append(Param(name, value, Origin(scope.path, element, kind, key, yaml_file), node))
+
+
+def _flatten(data, key):
+    if isinstance(data, dict):
+        for k, v in data.items():
+            for item in _flatten(v, key + (str(k),)):
+                yield item
+    else:
+        yield key, data
+
+
+def _read_include(analysis, element, scope, ns, depth):
+    target = scope.substitute(element.get('file'))[0] or ''
+    inner_ns = _join(ns, scope.substitute(element.get('ns'))[0]) if element.get('ns') else ns
+    found = re.match(r'/__pkg__/(\w+)', target)
+    if found:
+        if sheet_of_drone(found.group(1)):
+            analysis.included_drones.append(found.group(1))
+        return  # another package's launch file: not the student's, not analysed
+    if depth > 5 or not os.path.isfile(target):
+        analysis.problems.append('include %s not found' % element.get('file'))
+        return
+    passed = {}
+    for child in element:
+        if child.tag == 'arg' and child.get('value') is not None:
+            value, origin = scope.substitute(child.get('value'))
+            passed[child.get('name')] = (value, origin or Origin(scope.path, child, 'attr', 'value'))
+    _read_file(analysis, target, _Scope(target, analysis.package_dir, passed), inner_ns, depth + 1)
+
+
+# --- choosing --------------------------------------------------------------------------------------
+
+def launch_files(package_dir):
+    """Every ``*.launch`` / ``*.launch.xml`` file of the package (derived copies excluded)."""
+    found = []
+    for dirpath, dirnames, filenames in os.walk(package_dir):
+        dirnames[:] = sorted(d for d in dirnames if not d.startswith('.'))
+        for filename in sorted(filenames):
+            if filename.endswith(('.launch', '.launch.xml')) and not filename.startswith('.grader-'):
+                found.append(os.path.join(dirpath, filename))
+    return found
+
+
+def choose(analyses, sheet):
+    """The analysis of the launch file to grade for ``sheet`` (None when none starts an exam node):
+    the one that starts the sheet's drone, then one named exam.launch, then the first."""
+    def score(a):
+        other = [s for s in a.drone_sheets() if s != sheet]
+        return (bool(a.exam_nodes), sheet in a.drone_sheets(), not other,
+                os.path.basename(a.path) == 'exam.launch')
+    ranked = sorted(analyses, key=score, reverse=True)
+    if not ranked or not ranked[0].exam_nodes:
+        return None
+    return ranked[0]
+
+
+def threshold_param(analysis, sheet):
+    """The parameter of the exam node that is its threshold, however named, and why it was chosen.
+
+    :returns: ``(Param or None, reason)``. A name that says threshold (``threshold``, ``seuil``,
+        ``alt_max``...) wins over the sheet's default value (1300 / 150) under another name; a name
+        that says something else (rate, delay...) is never taken.
+    """
+    default = SHEETS[sheet].threshold
+    best, best_score = None, 0
+    for param in analysis.exam_params():
+        number = as_number(param.value)
+        if number is None:
+            continue
+        base = param.name.rsplit('/', 1)[-1].lower()
+        score = 0
+        if 'thresh' in base or 'seuil' in base:
+            score = 4
+        elif any(word in base for word in _THRESHOLD_WORDS) and not any(w in base for w in _OTHER_WORDS):
+            score = 3
+        elif any(w in base for w in _OTHER_WORDS):
+            continue
+        if number == default:
+            score += 1
+        if score > best_score:
+            best, best_score = param, score
+    if best is None:
+        names = ', '.join(p.name for p in analysis.exam_params()) or 'none'
+        return None, 'no parameter of the launch file looks like a threshold (parameters: %s)' % names
+    how = 'named like a threshold' if best_score >= 3 else 'the sheet\'s value %g' % default
+    return best, '%s = %s (%s)' % (best.name, best.value, how)
+
+
+# --- deriving --------------------------------------------------------------------------------------
+
+def derive(analysis, tag, changes=None):
+    """Write the runnable copy of the analysed launch file; return its path.
+
+    The copy starts only the exam package's nodes (the drone and other packages' nodes and includes
+    are dropped), sends every node's output to the screen, and drops ``launch-prefix`` (a terminal or
+    debugger the grader does not have). ``changes`` maps an :class:`Origin` to the new literal value.
+    Included files of the exam package get derived copies too, and the includes point to them.
+    """
+    changes = changes or {}
+    originals = {}
+    # Remember every element's state, so that several derivations start from the student's files.
+    for tree in analysis.trees.values():
+        for element in tree.iter():
+            originals[element] = (dict(element.attrib), element.text, list(element))
+    try:
+        yaml_files = {}
+        for origin, value in changes.items():
+            _apply(origin, value, analysis, tag, yaml_files)
+        derived = {path: _derived_path(path, tag) for path in analysis.trees}
+        for path, tree in analysis.trees.items():
+            _strip(tree.getroot(), path, analysis, derived)
+            tree.write(derived[path], encoding='unicode')
+        return derived[analysis.path]
+    finally:
+        for element, (attrib, text, children) in originals.items():
+            element.attrib.clear()
+            element.attrib.update(attrib)
+            element.text = text
+            element[:] = children
+
+
+def _derived_path(path, tag):
+    return os.path.join(os.path.dirname(path), '.grader-%s-%s' % (tag, os.path.basename(path)))
+
+
+def _apply(origin, value, analysis, tag, yaml_files):
+    if origin.kind == 'attr':
+        origin.element.set(origin.key, str(value))
+        return
+    if origin.kind == 'yaml':
+        data = yaml.safe_load(origin.element.text or '')
+        origin.element.text = yaml.safe_dump(_set_key(data, origin.key, value), default_flow_style=False)
+        return
+    source = yaml_files.get(origin.yaml_file, origin.yaml_file)
+    with open(source) as f:
+        data = yaml.safe_load(f.read())
+    target = _derived_path(origin.yaml_file, tag)
+    with open(target, 'w') as f:
+        f.write(yaml.safe_dump(_set_key(data, origin.key, value), default_flow_style=False))
+    yaml_files[origin.yaml_file] = target
+    origin.element.set('file', target)
+
+
+def _set_key(data, key, value):
+    if not key:
+        return value
+    data = dict(data or {})
+    data[key[0]] = _set_key(data.get(key[0]), key[1:], value)
+    return data
+
+
+def _strip(parent, path, analysis, derived):
+    scope = _Scope(path, analysis.package_dir)
+    for element in list(parent):
+        if not isinstance(element.tag, str):
+            continue
+        if element.tag in ('node', 'test'):
+            pkg = element.get('pkg', '')
+            if pkg != PACKAGE and '$(arg' not in pkg:
+                parent.remove(element)
+                continue
+            element.set('output', 'screen')
+            element.attrib.pop('launch-prefix', None)
+            element.attrib.pop('machine', None)
+        elif element.tag == 'machine':
+            parent.remove(element)
+            continue
+        elif element.tag == 'include':
+            try:
+                target = scope.substitute(element.get('file'))[0]
+            except Unsupported:
+                target = None
+            if target in derived:
+                element.set('file', derived[target])
+            else:
+                parent.remove(element)
+            continue
+        _strip(element, path, analysis, derived)

@@ -1,0 +1,325 @@
+"""The grader's probe: plays the drone for a student's node and measures what the rubric asks.
+
+Run inside its own rospy process, on the master of one submission, by :mod:`exam_lab.grader.session`::
+
+    python3 -m exam_lab.grader.probe PLAN.json RESULT.json
+
+The drone is the harness's :class:`~exam_lab.harness.fake_drone.Drone`, driven by a script with
+noise-free values from the oracle, so the same package gets the same measurements. The probe only
+measures; the points are given by :mod:`exam_lab.grader.rubric` from the JSON it writes.
+
+Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of question 14a), ``sheet``,
+``threshold`` (student units), ``margin`` (how far beyond the threshold to fly), ``delay`` (s), ``start_timeout``
+(s to wait for the node); for "threshold" also ``fit`` (the main run's calibration) and ``targets``.
+
+The main scenario (times are the script's, all recorded as ROS time of the events):
+
+1. wait for the student's node; note which inputs it subscribes to and what it publishes;
+2. question 11: a few input pairs (one with another temperature / remote pressure), the value the node
+   publishes for each after it settled;
+3. calibration: from those values, the inputs that make the *node's own* value sit ``margin`` below
+   and above the threshold, checked by flying there (a wrong formula costs question 11 only);
+4. the flight: rest below (``REST_S``), a short excursion above (``SHORT_S`` < delay), below again, a long
+   excursion (delay + ``AFTER_S``), below again; every service call is recorded with its arrival time.
+"""
+import json
+import math
+import sys
+import time
+
+import rosgraph
+import rospy
+from std_msgs.msg import Float32, Float64
+
+from exam_lab.harness import oracle
+from exam_lab.harness.fake_drone import Drone, TopicRecorder
+from exam_lab.harness.wait import wait_until
+
+#: Seconds after an input change before the node's output is read (several 10 Hz ticks).
+SETTLE_S = 0.8
+#: Published values older than this after an input change are not read (the change may be half seen).
+IGNORE_S = 0.3
+#: Seconds to wait for the second input's subscription once the node is up.
+SUBSCRIBE_S = 6.0
+#: Seconds to wait for the output publisher once the node subscribed.
+OUTPUT_S = 3.0
+#: The flight: rest below, short excursion above (< delay), gap below, long excursion lasts delay + AFTER_S.
+REST_S = 3.0
+SHORT_S = 3.0
+GAP_S = 2.5
+AFTER_S = 2.5
+#: Message types the probe can read values from.
+VALUE_TYPES = {'std_msgs/Float32': Float32, 'std_msgs/Float64': Float64}
+#: Topics every node has or that are never an answer.
+IGNORED_TOPICS = ('/rosout', '/rosout_agg', '/diagnostics')
+
+
+class Graph(object):
+    """The master's view, restricted to the student's nodes (everyone but this probe and rosout)."""
+
+    def __init__(self):
+        self._master = rosgraph.Master(rospy.get_name())
+
+    def _state(self):
+        try:
+            return self._master.getSystemState()
+        except Exception:  # the master answers; a failure is a transient of the XML-RPC call
+            return [[], [], []]
+
+    def student_nodes(self):
+        nodes = set()
+        for kind in self._state():
+            for _, names in kind:
+                nodes.update(names)
+        return sorted(n for n in nodes if n not in (rospy.get_name(), '/rosout'))
+
+    def summary(self):
+        """{node: {"publishes": [[topic, type]], "subscribes": [...], "services": [name]}}."""
+        pubs, subs, srvs = self._state()
+        try:
+            types = dict(self._master.getTopicTypes())
+        except Exception:
+            types = {}
+        nodes = {n: {'publishes': [], 'subscribes': [], 'services': []} for n in self.student_nodes()}
+        for key, kind in (('publishes', pubs), ('subscribes', subs)):
+            for topic, names in kind:
+                for name in names:
+                    if name in nodes:
+                        nodes[name][key].append([topic, types.get(topic, '?')])
+        for service, names in srvs:
+            for name in names:
+                if name in nodes and not service.startswith(name + '/'):
+                    nodes[name]['services'].append(service)
+        return nodes
+
+    def subscribers(self, topic):
+        names = dict(self._state()[1]).get(topic, [])
+        return sorted(n for n in names if n in self.student_nodes())
+
+
+def _last_value(recorder, since):
+    """The last value published at least IGNORE_S after ``since`` and the number of such samples."""
+    samples = recorder.samples(since + IGNORE_S)
+    return (samples[-1][1] if samples else None), len(samples)
+
+
+def _settled(recorder, since):
+    time.sleep(max(0.0, since + SETTLE_S - rospy.get_time()))
+    return _last_value(recorder, since)
+
+
+class Probe(object):
+
+    def __init__(self, plan):
+        self.plan = plan
+        self.sheet = plan['sheet']
+        self.result = {'kind': plan['kind'], 'sheet': self.sheet, 'threshold': plan['threshold'],
+                       'margin': plan['margin'], 'delay': plan['delay'], 'start_timeout': plan['start_timeout']}
+        self.graph = Graph()
+        self.drone = Drone(self.sheet)
+        self.recorder = self.drone.output
+        self.t0 = rospy.get_time()
+
+    # --- helpers ------------------------------------------------------------------------------------
+
+    def resolved(self, name):
+        return rospy.resolve_name(name)
+
+    def set_inputs(self, fixed, moving):
+        drone = self.drone
+        drone.feeder.set(drone.fixed_topic, fixed)
+        return drone.feeder.set(drone.moving_topic, moving)
+
+    def fly(self, x):
+        """Put the drone where the oracle's value is ``x`` (reference fixed input); return the time."""
+        return self.set_inputs(self.drone.fixed_value, self.drone.input_for(x))
+
+    # --- phases -------------------------------------------------------------------------------------
+
+    def wait_for_node(self):
+        nodes = wait_until(lambda: self.graph.student_nodes() or None, self.plan['start_timeout'], period=0.1)
+        self.result['nodes'] = nodes or []
+        self.result['node_seen_s'] = None if not nodes else rospy.get_time() - self.t0
+        if not nodes:
+            return False
+        inputs = [self.resolved(t) for t in (self.drone.fixed_topic, self.drone.moving_topic)]
+        wait_until(lambda: all(self.graph.subscribers(t) for t in inputs), SUBSCRIBE_S, period=0.1)
+        self.result['subscribed'] = {t: self.graph.subscribers(t) for t in inputs}
+        return True
+
+    def find_output(self):
+        expected = self.resolved(self.plan['output'])
+        found = wait_until(lambda: expected in self._student_publications(), OUTPUT_S, period=0.1)
+        publications = self._student_publications()
+        output = {'expected': expected, 'topic': None, 'type': None,
+                  'candidates': sorted(publications)}
+        if found:
+            output.update(topic=expected, type=publications[expected])
+        else:
+            candidates = sorted(t for t, kind in publications.items() if kind in VALUE_TYPES)
+            preferred = [t for t in candidates if self.plan['output'][:3] in t.lower()] or candidates
+            if preferred:
+                output.update(topic=preferred[0], type=publications[preferred[0]])
+        self.result['output'] = output
+        topic, kind = output['topic'], output['type']
+        if topic is not None and (topic != expected or kind != 'std_msgs/Float32') and kind in VALUE_TYPES:
+            self.recorder.close()
+            self.recorder = TopicRecorder(topic, msg_class=VALUE_TYPES[kind])
+        elif topic is not None and kind not in VALUE_TYPES:
+            self.recorder = None  # a type the probe cannot read values from
+        return topic is not None and self.recorder is not None
+
+    def _student_publications(self):
+        publications = {}
+        for info in self.graph.summary().values():
+            for topic, kind in info['publishes']:
+                if topic not in IGNORED_TOPICS:
+                    publications[topic] = kind
+        return publications
+
+    def formula(self):
+        """Question 11's check points: (fixed input, oracle value) pairs; returns the calibration points."""
+        drone, threshold, margin = self.drone, self.plan['threshold'], self.plan['margin']
+        other_fixed = {'altitude': -5.0, 'depth': 98000.0}[self.sheet]
+        cases = [(drone.fixed_value, threshold - 2 * margin), (drone.fixed_value, threshold + 2 * margin),
+                 (other_fixed, threshold)]
+        points, rows = [], []
+        for fixed, x in cases:
+            if self.sheet == 'altitude':
+                moving = oracle.pressure_at(x, fixed)
+            else:
+                moving = oracle.pressure_robot_at(x, fixed)
+            since = self.set_inputs(fixed, moving)
+            value, count = _settled(self.recorder, since)
+            rows.append({'inputs': {drone.fixed_topic: fixed, drone.moving_topic: moving},
+                         'expected': drone.expected(fixed, moving), 'published': value, 'samples': count})
+            if fixed == drone.fixed_value:
+                points.append((x, value))
+        self.result['formula'] = rows
+        return points
+
+    def calibrate(self, points):
+        """Oracle values ``lo`` / ``hi`` where the node's own value is ``margin`` below / above the
+        threshold: fits value = a*x + b through the check points, flies there, corrects with the
+        fitted slope (twice at most). Falls back to the oracle's values when that fails."""
+        threshold, margin = self.plan['threshold'], self.plan['margin']
+        targets = {'lo': threshold - margin, 'hi': threshold + margin}
+        calibration = {'by': 'oracle', 'reason': '', 'fit': None}
+        usable = [(x, y) for x, y in points if y is not None and math.isfinite(y)]
+        if self.recorder is None or len(usable) < 2:
+            calibration['reason'] = 'no readable output: flying by the oracle\'s values'
+        else:
+            (x1, y1), (x2, y2) = usable[:2]
+            a = (y2 - y1) / (x2 - x1)
+            if not math.isfinite(a) or abs(a) < 1e-3:
+                calibration['reason'] = ('the output hardly depends on the input (slope %.3g): flying by '
+                                         'the oracle\'s values' % a)
+            else:
+                calibration.update(by='own', fit=[a, y1 - a * x1])
+        chosen = {}
+        for side, target in sorted(targets.items()):
+            x = target
+            if calibration['by'] == 'own':
+                a, b = calibration['fit']
+                x = (target - b) / a
+            value = None
+            for _ in range(3):
+                since = self.fly(x)
+                value = _settled(self.recorder, since)[0] if self.recorder is not None else None
+                if calibration['by'] != 'own' or value is None or not math.isfinite(value) \
+                        or abs(value - target) < margin / 3:
+                    break
+                x += (target - value) / calibration['fit'][0]
+            chosen[side] = {'x': x, 'target': target, 'value': value}
+        own_ok = all(v['value'] is not None and math.isfinite(v['value']) for v in chosen.values()) \
+            and chosen['lo']['value'] <= threshold < chosen['hi']['value']
+        if calibration['by'] == 'own' and not own_ok:
+            calibration.update(by='oracle', fit=None, reason=(
+                'the node\'s values did not come out on both sides of the threshold (%s): flying by the '
+                'oracle\'s values' % ', '.join('%s %r' % (k, v['value']) for k, v in sorted(chosen.items()))))
+            chosen = {side: {'x': target, 'target': target, 'value': None} for side, target in targets.items()}
+        calibration.update(chosen)
+        self.result['calibration'] = calibration
+        return chosen['lo']['x'], chosen['hi']['x']
+
+    def flight(self, lo, hi):
+        delay = self.plan['delay']
+        schedule = {}
+        schedule['rest'] = self.fly(lo)
+        time.sleep(REST_S)
+        schedule['short_up'] = self.fly(hi)
+        time.sleep(SHORT_S)
+        schedule['short_down'] = self.fly(lo)
+        time.sleep(GAP_S)
+        schedule['long_up'] = self.fly(hi)
+        time.sleep(delay + AFTER_S)
+        schedule['long_down'] = self.fly(lo)
+        time.sleep(AFTER_S)
+        schedule['end'] = rospy.get_time()
+        self.result['schedule'] = schedule
+        if self.recorder is not None:
+            samples = self.recorder.samples(schedule['rest'], schedule['end'])
+            rate = {'samples': len(samples), 'hz': None, 'max_gap': None}
+            if len(samples) >= 2:
+                span = samples[-1][0] - samples[0][0]
+                rate['hz'] = (len(samples) - 1) / span if span > 0 else None
+                rate['max_gap'] = max(b[0] - a[0] for a, b in zip(samples, samples[1:]))
+                values = [v for _, v in samples]
+                rate['non_finite'] = len([v for v in values if not math.isfinite(v)])
+            self.result['rate'] = rate
+
+    def threshold_check(self):
+        """Question 14a: the node restarted with another threshold; from a value below it, a step to a
+        value that was below the launch file's threshold but is above the new one."""
+        schedule = {'start': self.fly(self.x_of(self.plan['targets']['start']))}
+        time.sleep(REST_S)
+        schedule['step'] = self.fly(self.x_of(self.plan['targets']['step']))
+        time.sleep(self.plan['delay'] + AFTER_S)
+        schedule['end'] = rospy.get_time()
+        self.result['schedule'] = schedule
+
+    def x_of(self, value):
+        """The oracle value at which the node publishes ``value`` (the main run's fit, if any)."""
+        fit = self.plan.get('fit')
+        return value if fit is None else (value - fit[1]) / fit[0]
+
+    def run(self):
+        if self.plan['kind'] == 'main':
+            # Inputs from the start: a node that waits for data before it subscribes to the rest still runs.
+            self.fly(self.plan['threshold'] - self.plan['margin'])
+            if self.wait_for_node():
+                readable = self.find_output()
+                points = self.formula() if readable else []
+                lo, hi = self.calibrate(points)
+                self.flight(lo, hi)
+        else:
+            self.fly(self.x_of(self.plan['targets']['start']))
+            if self.wait_for_node():
+                self.threshold_check()
+        self.result['calls'] = [[t, s] for t, s in self.drone.service.calls()]
+        self.result['graph'] = self.graph.summary()
+        self.result['alive_at_end'] = bool(self.graph.student_nodes())
+        self.result['t0'] = self.t0
+        return self.result
+
+
+def main(argv):
+    if len(argv) != 2:
+        sys.stderr.write('usage: python3 -m exam_lab.grader.probe PLAN.json RESULT.json\n')
+        return 2
+    with open(argv[0]) as f:
+        plan = json.load(f)
+    rospy.init_node('grader_probe', disable_signals=True)
+    probe = Probe(plan)
+    try:
+        result = probe.run()
+    finally:
+        probe.drone.close()
+    with open(argv[1], 'w') as f:
+        json.dump(result, f, indent=1, sort_keys=True)
+    rospy.signal_shutdown('probe done')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,88 @@
+"""The grader's outputs: grade.json, grade.md (for the teacher and the student), grades.csv, and the
+table printed on the terminal. No rospy here.
+"""
+import csv
+import json
+import os
+
+from exam_lab.grader.sheets import ITEMS, SHEETS
+
+#: What no machine scores, with the rubric's points (sheet 000's notes).
+NOT_SCORED = ('comments (4 points), code quality (2 points), and the report: questions 1-9 and the '
+              'explanations of every answer')
+
+
+def _points(x):
+    return ('%.1f' % x).rstrip('0').rstrip('.')
+
+
+def grade_record(student, sheet, items, for_the_teacher, extra=None):
+    """The content of grade.json."""
+    record = {'student': student, 'sheet': sheet, 'total': sum(i['points'] for i in items),
+              'max': sum(i['max'] for i in items), 'items': items, 'for_the_teacher': for_the_teacher}
+    record.update(extra or {})
+    return record
+
+
+def markdown(record):
+    """grade.md: the score table, each lost point's reason, the hints for the teacher."""
+    sheet = SHEETS.get(record['sheet'])
+    title = sheet and 'sheet %s (%s, %s)' % (sheet.seed, sheet.name, sheet.drone_pkg) or 'no sheet'
+    lines = ['# %s: %s / %s' % (record['student'], _points(record['total']), _points(record['max'])),
+             '',
+             'Graded by running the package: %s. Not scored by the machine: %s.' % (title, NOT_SCORED),
+             '',
+             '| item | what is checked | points | evidence |',
+             '|---|---|---|---|']
+    for entry in record['items']:
+        what = ITEMS[entry['id']][1]
+        evidence = entry['evidence'].split('\n', 1)[0].replace('|', '\\|')
+        lines.append('| %s | %s | %s / %s | %s |' % (entry['id'], what, _points(entry['points']),
+                                                     _points(entry['max']), evidence))
+    lines.append('| **total** | | **%s / %s** | |' % (_points(record['total']), _points(record['max'])))
+    details = [e for e in record['items'] if '\n' in e['evidence']]
+    for entry in details:
+        lines += ['', '### %s: details' % entry['id'], '', '```', entry['evidence'].split('\n', 1)[1], '```']
+    lines += ['', '## For the teacher', '']
+    lines += ['- %s' % hint.replace('\n', ' ') for hint in record['for_the_teacher']]
+    return '\n'.join(lines) + '\n'
+
+
+def write_grade(out_dir, record):
+    """Write ``grade.json`` and ``grade.md`` into ``out_dir``."""
+    os.makedirs(out_dir, exist_ok=True)
+    with open(os.path.join(out_dir, 'grade.json'), 'w') as f:
+        json.dump(record, f, indent=1, sort_keys=True)
+        f.write('\n')
+    with open(os.path.join(out_dir, 'grade.md'), 'w') as f:
+        f.write(markdown(record))
+
+
+def write_csv(path, records):
+    """grades.csv: one row per student, each item's points, the total."""
+    with open(path, 'w', newline='') as f:
+        writer = csv.writer(f)
+        writer.writerow(['student', 'sheet'] + list(ITEMS) + ['total', 'max'])
+        for record in records:
+            points = {e['id']: e['points'] for e in record['items']}
+            writer.writerow([record['student'], record['sheet']] +
+                            [_points(points.get(i, 0)) for i in ITEMS] +
+                            [_points(record['total']), _points(record['max'])])
+
+
+def table(records):
+    """The score table printed on the terminal: one row per student (one row for one submission)."""
+    header = ['student', 'sheet'] + list(ITEMS) + ['total']
+    rows = [header]
+    for record in records:
+        points = {e['id']: e['points'] for e in record['items']}
+        rows.append([record['student'], record['sheet'] or '-'] + [_points(points.get(i, 0)) for i in ITEMS] +
+                    ['%s/%s' % (_points(record['total']), _points(record['max']))])
+    widths = [max(len(str(r[c])) for r in rows) for c in range(len(header))]
+    return '\n'.join('  '.join(str(cell).ljust(w) for cell, w in zip(r, widths)).rstrip() for r in rows)
+
+
+def evidence_lines(record):
+    """Each item with points lost, and why (printed under the table for one submission)."""
+    return ['%s %s/%s: %s' % (e['id'], _points(e['points']), _points(e['max']), e['evidence'].split('\n', 1)[0])
+            for e in record['items'] if e['points'] < e['max']]

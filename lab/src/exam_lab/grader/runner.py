@@ -1,0 +1,335 @@
+"""Grading a submission or a class: prepare, run the session (isolated), score, write.
+
+The runner itself never runs a student's code: it unpacks and reads (:mod:`~exam_lab.grader.unpack`,
+:mod:`~exam_lab.grader.launch`, :mod:`~exam_lab.grader.source`), writes the derived launch files and
+the job, and starts :mod:`exam_lab.grader.session` for one submission, as root inside ``unshare
+--net`` (only loopback), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an overall
+time limit. Whatever the session leaves behind is ended by its marker. Then
+:mod:`~exam_lab.grader.rubric` scores and :mod:`~exam_lab.grader.report` writes.
+
+The simulators (``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
+workspace (cached under ``$EXAM_WS/grader/underlay``, rebuilt when their sources change); each student's
+package is built alone in an overlay of its own on top of it, so a student's ``exam`` never meets ours.
+"""
+import concurrent.futures
+import fcntl
+import hashlib
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import traceback
+
+from exam_lab.grader import launch, report, rubric, source, unpack
+from exam_lab.grader.sheets import DELAY, PACKAGE, SHEETS
+from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
+
+#: Time limits, s: the student's catkin_make, the node's start (to registering with the master),
+#: the probe of one run, the whole session of one submission.
+BUILD_TIMEOUT = 180.0
+START_TIMEOUT = 20.0
+RUN_TIMEOUT = 90.0
+SESSION_TIMEOUT = 420.0
+#: The simulator packages of the underlay.
+SIMULATORS = ('drone_sim', 'mydrone', 'submarinedrone')
+
+#: Log lines worth the teacher's eye: warnings, errors, tracebacks.
+_ODD = re.compile(r'\[(WARN|ERROR|FATAL)\]|Traceback|Error\b|Exception\b')
+
+_isolation = {}
+_underlay_lock = threading.Lock()
+
+
+def can_isolate():
+    """True when this process may run a session in a network namespace of its own (root, unshare)."""
+    if 'ok' not in _isolation:
+        try:
+            _isolation['ok'] = os.geteuid() == 0 and shutil.which('unshare') is not None and \
+                subprocess.run(['unshare', '--net', 'true'], timeout=10).returncode == 0
+        except (OSError, subprocess.SubprocessError):
+            _isolation['ok'] = False
+    return _isolation['ok']
+
+
+def _package_path(name):
+    import rospkg
+    return rospkg.RosPack().get_path(name)
+
+
+def ensure_underlay(cache_dir):
+    """The setup.bash of the simulators' workspace, built (or rebuilt) when their sources changed."""
+    with _underlay_lock:
+        os.makedirs(cache_dir, exist_ok=True)
+        with open(os.path.join(cache_dir, '.lock'), 'w') as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # another grader on this machine may be building it
+            sources = [os.path.realpath(_package_path(p)) for p in SIMULATORS]
+            digest = hashlib.sha256()
+            for src in sources:
+                for dirpath, dirnames, filenames in os.walk(src):
+                    dirnames[:] = sorted(d for d in dirnames if d not in ('__pycache__', '.pytest_cache'))
+                    for filename in sorted(filenames):
+                        full = os.path.join(dirpath, filename)
+                        digest.update(full.encode())
+                        with open(full, 'rb') as f:
+                            digest.update(f.read())
+            key = digest.hexdigest()
+            setup = os.path.join(cache_dir, 'devel', 'setup.bash')
+            stamp = os.path.join(cache_dir, 'sources.sha256')
+            if os.path.isfile(setup) and os.path.isfile(stamp) and open(stamp).read() == key:
+                return setup
+            for sub in ('src', 'build', 'devel'):
+                shutil.rmtree(os.path.join(cache_dir, sub), ignore_errors=True)
+            os.makedirs(os.path.join(cache_dir, 'src'))
+            for src in sources:
+                os.symlink(src, os.path.join(cache_dir, 'src', os.path.basename(src)))
+            env = {k: v for k, v in os.environ.items() if k not in WORKSPACE_VARS}
+            env['PATH'] = '/usr/bin:/bin:/usr/sbin:/sbin:/usr/local/bin'
+            env.pop('PWD', None)
+            done = subprocess.run(['catkin_make', '--directory', cache_dir, '-DPYTHON_EXECUTABLE=/usr/bin/python3',
+                                   '-DCATKIN_ENABLE_TESTING=OFF'], cwd=cache_dir, env=env,
+                                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=600)
+            if done.returncode != 0:
+                raise RuntimeError('building the simulators for the grader failed:\n%s'
+                                   % done.stdout.decode('utf-8', 'replace')[-3000:])
+            with open(stamp, 'w') as f:
+                f.write(key)
+            return setup
+
+
+def detect_sheet(wanted, package_dir, analyses):
+    """``(sheet, how it was chosen)``: given, else from package.xml, else the launch files, else the
+    topics the code names; altitude when nothing decides."""
+    if wanted:
+        return wanted, 'sheet %s given' % wanted
+    deps = [d for d in source.dependencies(package_dir) if d in (s.drone_pkg for s in SHEETS.values())]
+    by_deps = [name for name, s in SHEETS.items() if s.drone_pkg in deps]
+    if len(by_deps) == 1:
+        return by_deps[0], 'sheet %s: package.xml depends on %s' % (by_deps[0], SHEETS[by_deps[0]].drone_pkg)
+    by_launch = sorted(set(s for a in analyses for s in a.drone_sheets()))
+    if len(by_launch) == 1:
+        return by_launch[0], 'sheet %s: the launch files start %s' % (by_launch[0], SHEETS[by_launch[0]].drone_pkg)
+    by_code = source.sheets_in_code(package_dir)
+    if len(by_code) == 1:
+        return by_code[0], 'sheet %s: the code names its topics' % by_code[0]
+    return 'altitude', ('sheet altitude by default: the package could be either (depends on %s); '
+                        'give SHEET=depth to grade the other' % (', '.join(deps) or 'neither drone'))
+
+
+def margin_of(threshold):
+    """How far beyond the threshold the probe flies (student units): 10 %, at least 10 m."""
+    return max(0.1 * abs(threshold), 10.0)
+
+
+def prepare(submission, work, wanted_sheet, notes):
+    """Unpack and read a submission; write the workspace, the derived launch files and the job.
+
+    :returns: ``(sheet, static, job)``; ``job`` is None when nothing can be run (no node script).
+    """
+    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes)
+    workspace = os.path.join(work, 'ws')
+    pkg = os.path.join(workspace, 'src', PACKAGE)
+    unpack.copy_package(pkg_source, pkg, notes)
+    analyses = [launch.analyse(path, pkg) for path in launch.launch_files(pkg)]
+    sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
+    notes.insert(0, how)
+    chosen = launch.choose(analyses, sheet)
+    scripts = source.node_scripts(pkg)
+    launched = [n.type for n in chosen.exam_nodes] if chosen else [os.path.basename(p) for p in scripts[:1]]
+    notes.extend(source.make_runnable(pkg, launched))
+    static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses],
+              'params_in_code': source.param_names(pkg), 'launch': None, 'threshold': None}
+    for analysis in analyses:
+        for problem in analysis.problems:
+            notes.append('launch: %s' % problem)
+    threshold_value = SHEETS[sheet].threshold
+    runs = []
+    if chosen is not None:
+        exam = chosen.exam_nodes[0]
+        static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),
+                            'exam_type': exam.type, 'exam_name': exam.name,
+                            'exam_type_found': _executable_in(pkg, exam.type)}
+        param, why = launch.threshold_param(chosen, sheet)
+        static['threshold_reason'] = why
+        if param is not None:
+            threshold_value = launch.as_number(param.value)
+            static['threshold'] = {'name': param.name, 'value': param.value,
+                                   'where': param.origin.describe(pkg) if param.origin else '?'}
+            notes.append('threshold parameter: %s, set in %s' % (why, static['threshold']['where']))
+        main_launch = launch.derive(chosen, 'main')
+        namespace = chosen.drone_namespace(sheet)
+    else:
+        static['threshold_reason'] = 'no launch file starts an exam node, so no parameter'
+        if not scripts:
+            return sheet, static, None
+        notes.append('no launch file starts an exam node: ran %s alone, without parameters'
+                     % os.path.relpath(scripts[0], pkg))
+        main_launch = os.path.join(pkg, '.grader-main-minimal.launch')
+        with open(main_launch, 'w') as f:
+            f.write('<launch><node pkg="%s" type="%s" name="exam" output="screen"/></launch>\n'
+                    % (PACKAGE, os.path.basename(scripts[0])))
+        namespace = '/'
+        param = None
+    margin = margin_of(threshold_value)
+    plan = {'kind': 'main', 'sheet': sheet, 'threshold': threshold_value, 'margin': margin, 'delay': DELAY,
+            'start_timeout': START_TIMEOUT, 'output': SHEETS[sheet].output}
+    runs.append({'tag': 'main', 'launch': main_launch, 'plan': plan})
+    if param is not None and param.origin is not None:
+        lowered = threshold_value - 2 * margin
+        runs.append({'tag': 'threshold', 'launch': launch.derive(chosen, 'threshold', {param.origin: lowered}),
+                     'plan': dict(plan, kind='threshold', threshold=lowered,
+                                  targets={'start': lowered - margin, 'step': threshold_value - margin})})
+    elif param is not None:
+        static['threshold']['not_rewritable'] = 'its value comes from no literal the grader can change'
+    job = {'workspace': workspace, 'namespace': namespace, 'build_timeout': BUILD_TIMEOUT,
+           'run_timeout': RUN_TIMEOUT, 'runs': runs}
+    return sheet, static, job
+
+
+def _executable_in(pkg, name):
+    for dirpath, _, filenames in os.walk(pkg):
+        if name in filenames and os.access(os.path.join(dirpath, name), os.X_OK):
+            return True
+    return False
+
+
+def run_session(job, work, underlay, isolate):
+    """Run the session of one submission; return what it measured (or why it could not)."""
+    log_dir = os.path.join(work, 'logs')
+    os.makedirs(log_dir, exist_ok=True)
+    job = dict(job, underlay=underlay, log_dir=log_dir)
+    job_path = os.path.join(work, 'job.json')
+    with open(job_path, 'w') as f:
+        json.dump(job, f, indent=1, sort_keys=True)
+    argv = [sys.executable, '-m', 'exam_lab.grader.session', job_path]
+    if isolate:
+        argv = ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + argv
+    with Supervisor(os.path.join(work, 'outer')) as sup:
+        status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT)
+    end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
+    path = os.path.join(log_dir, 'session.json')
+    if status == 0 and os.path.isfile(path):
+        with open(path) as f:
+            return json.load(f)
+    why = 'the session did not finish within %.0f s' % SESSION_TIMEOUT if status is None else \
+        'the session failed (exit %s): %s' % (status, session_tail(output))
+    return {'build': None, 'runs': [], 'error': why}
+
+
+def session_tail(output):
+    return '\n'.join(output.strip().splitlines()[-10:])
+
+
+def hints(static, session, notes, pkg, isolate):
+    """The for_the_teacher list: what the machine saw but does not score."""
+    out = list(notes)
+    scripts = source.student_code(pkg) if pkg and os.path.isdir(pkg) else []
+    if scripts:
+        comments, code = source.comment_ratio(scripts)
+        out.append('comments (not scored): %d comment lines for %d lines of code (%.0f %%) in %s'
+                   % (comments, code, 100.0 * comments / max(code, 1),
+                      ', '.join(os.path.relpath(p, pkg) for p in scripts)))
+    probe = rubric.main_probe(session)
+    if probe:
+        for node, info in sorted(probe.get('graph', {}).items()):
+            out.append('node %s: publishes %s; subscribes %s; serves %s' % (
+                node, ', '.join('%s (%s)' % tuple(p) for p in info['publishes'] if p[0] != '/rosout') or 'nothing',
+                ', '.join('%s (%s)' % tuple(s) for s in info['subscribes']) or 'nothing',
+                ', '.join(info['services']) or 'nothing'))
+        calibration = probe.get('calibration') or {}
+        if calibration.get('by') == 'oracle' and calibration.get('reason'):
+            out.append('Q13/Q14 flown by the oracle\'s values: %s' % calibration['reason'])
+    for run in (session or {}).get('runs', []):
+        odd = [l for l in run.get('launch', {}).get('tail', '').splitlines() if _ODD.search(l)]
+        if odd:
+            out.append('%s run, odd lines in the log: %s' % (run['tag'], ' | '.join(odd[:4])))
+    if static and static.get('launch') and static['launch']['file'] and len(static.get('launch_files', [])) > 1:
+        out.append('launch file graded: %s (of %s)' % (static['launch']['file'], ', '.join(static['launch_files'])))
+    out.append('ran in a network namespace with only loopback' if isolate else
+               'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
+    out.append('not scored by the machine: %s' % report.NOT_SCORED)
+    return out
+
+
+def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False):
+    """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record."""
+    start = time.monotonic()
+    student = student or unpack.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
+    isolate = can_isolate() if isolate is None else isolate
+    underlay = underlay or ensure_underlay(default_underlay())  # raises: the grader cannot run
+    os.makedirs(out_dir, exist_ok=True)
+    work = tempfile.mkdtemp(prefix='grade-', dir=out_dir)
+    notes, static, session, chosen_sheet, pkg = [], {}, None, sheet, None
+    try:
+        try:
+            chosen_sheet, static, job = prepare(submission, work, sheet, notes)
+            pkg = os.path.join(work, 'ws', 'src', PACKAGE)
+            if job is None:
+                session = {'build': None, 'runs': [], 'error': 'no script of the package starts a ROS node'}
+            else:
+                session = run_session(job, work, underlay, isolate)
+        except unpack.UnpackError as err:
+            session = {'build': None, 'runs': [], 'error': 'submission refused: %s' % err}
+        except Exception as err:  # a grader bug must not stop the class: say so and carry on
+            session = {'build': None, 'runs': [], 'error': 'the grader failed on this submission: %r' % err}
+            notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
+        chosen_sheet = chosen_sheet or 'altitude'
+        items = rubric.score(chosen_sheet, static, session)
+        record = report.grade_record(student, chosen_sheet, items, hints(static, session, notes, pkg, isolate),
+                                     {'seconds': round(time.monotonic() - start, 1)})
+        logs = os.path.join(out_dir, 'logs')
+        shutil.rmtree(logs, ignore_errors=True)
+        if os.path.isdir(os.path.join(work, 'logs')):
+            shutil.copytree(os.path.join(work, 'logs'), logs,
+                            ignore=shutil.ignore_patterns('ros_home', 'ros_log', 'ros-*'))
+        report.write_grade(out_dir, record)
+        return record
+    finally:
+        if not keep:
+            shutil.rmtree(work, ignore_errors=True)
+
+
+def workspace():
+    """The project's build workspace ($EXAM_WS, set by tools/env.sh; .ws/ by default)."""
+    return os.environ.get('EXAM_WS', os.path.join(os.getcwd(), '.ws'))
+
+
+def default_underlay():
+    return os.path.join(workspace(), 'grader', 'underlay')
+
+
+def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=None):
+    """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv."""
+    os.makedirs(out_dir, exist_ok=True)
+    scratch = tempfile.mkdtemp(prefix='class-', dir=out_dir)
+    try:
+        students = unpack.list_students(class_path, scratch)
+        underlay = ensure_underlay(default_underlay())
+        isolate = can_isolate() if isolate is None else isolate
+        names, seen = [], set()
+        for name, _ in students:
+            unique, n = name, 2
+            while unique in seen:
+                unique, n = '%s_%d' % (name, n), n + 1
+            seen.add(unique)
+            names.append(unique)
+        records = [None] * len(students)
+
+        def one(index):
+            name, folder = names[index], students[index][1]
+            record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate)
+            if progress:
+                progress(record)
+            return record
+
+        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            for index, record in zip(range(len(students)), pool.map(one, range(len(students)))):
+                records[index] = record
+        report.write_csv(os.path.join(out_dir, 'grades.csv'), records)
+        return records
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)

@@ -1,0 +1,45 @@
+"""What the grader needs to know of each exam sheet, and the rubric's maxima. No rospy here.
+
+Topic and service names are the sheets' own (relative, as the drones publish them); the values the
+grader drives with come from :mod:`exam_lab.harness.oracle`, the drone itself is
+:class:`exam_lab.harness.fake_drone.Drone`.
+"""
+import collections
+
+Sheet = collections.namedtuple('Sheet', 'name seed drone_pkg drone_type inputs output service threshold')
+
+SHEETS = collections.OrderedDict([
+    ('altitude', Sheet('altitude', '000', 'mydrone', 'mydrone_node.py', ('temperature', 'pressure'),
+                       'altitude', 'altitude_warning', 1300.0)),
+    ('depth', Sheet('depth', '001', 'submarinedrone', 'submarine_drone_node.py',
+                    ('pressure_robot', 'pressure_remote'), 'depth', 'depth_warning', 150.0)),
+])
+
+#: The package a student must create (question 9).
+PACKAGE = 'exam'
+#: The delay of question 14(b), s (both sheets).
+DELAY = 5.0
+
+#: The rubric (sheet 000's grader notes, used for sheet 001 too): item id -> (points, what it asks).
+ITEMS = collections.OrderedDict([
+    ('runs', (2.0, 'the package builds, the node starts and stays up')),
+    ('Q10', (2.0, 'the node subscribes to both input topics')),
+    ('Q11', (4.0, 'the output topic: Float32 publisher, 10 Hz, values of equation (1)')),
+    ('Q12', (1.0, 'a launch file starts the drone node and the exam node')),
+    ('Q13', (4.0, 'the warning service is called on crossings, and only there')),
+    ('Q14a', (1.0, 'the threshold is a launch-file parameter that the node obeys')),
+    ('Q14b', (3.0, 'WARNING after 5 s beyond the threshold, not for less, NORMAL at once')),
+])
+
+
+def drone_packages():
+    """The simulator packages of both sheets."""
+    return [sheet.drone_pkg for sheet in SHEETS.values()]
+
+
+def sheet_of_drone(pkg):
+    """The sheet whose drone lives in package ``pkg``, or None."""
+    for sheet in SHEETS.values():
+        if sheet.drone_pkg == pkg:
+            return sheet.name
+    return None

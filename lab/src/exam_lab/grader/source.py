@@ -1,0 +1,139 @@
+"""What the grader reads in a student's sources (never runs): the node's scripts, comments, params,
+dependencies; and the fixes a teacher would make before running it. No rospy here.
+"""
+import io
+import os
+import re
+import shutil
+import stat
+import tokenize
+import xml.etree.ElementTree as ET
+
+from exam_lab.grader.sheets import SHEETS
+
+_INIT_NODE = re.compile(r'\binit_node\s*\(')
+_GET_PARAM = re.compile(r'get_param\s*\(\s*[\'"]([^\'"]+)[\'"]')
+
+
+def python_files(package_dir):
+    """The package's Python sources: ``*.py`` files and extension-less scripts with a python shebang."""
+    found = []
+    for dirpath, dirnames, filenames in os.walk(package_dir):
+        dirnames[:] = sorted(d for d in dirnames if not d.startswith('.'))
+        for filename in sorted(filenames):
+            full = os.path.join(dirpath, filename)
+            if filename.endswith('.py') or ('.' not in filename and _shebang(full).find('python') >= 0):
+                found.append(full)
+    return found
+
+
+def _shebang(path):
+    try:
+        with open(path, 'rb') as f:
+            first = f.readline(200)
+    except OSError:
+        return ''
+    return first.decode('utf-8', 'replace').strip() if first.startswith(b'#!') else ''
+
+
+def _read(path):
+    with open(path, 'rb') as f:
+        return f.read().decode('utf-8', 'replace')
+
+
+def node_scripts(package_dir):
+    """Scripts that start a ROS node (call ``init_node``), the likely exam node first."""
+    scripts = [p for p in python_files(package_dir) if _INIT_NODE.search(_read(p))]
+    return sorted(scripts, key=lambda p: ('exam' not in os.path.basename(p), len(p), p))
+
+
+def dependencies(package_dir):
+    """Names of every package that package.xml depends on, in any way."""
+    try:
+        root = ET.parse(os.path.join(package_dir, 'package.xml')).getroot()
+    except (ET.ParseError, OSError):
+        return []
+    return sorted(set((e.text or '').strip() for e in root if e.tag.endswith('depend')))
+
+
+def sheets_in_code(package_dir):
+    """Sheets whose input topic names appear in the package's Python sources."""
+    text = '\n'.join(_read(p) for p in python_files(package_dir))
+    return [name for name, sheet in SHEETS.items()
+            if all(re.search(r'[\'"/]%s[\'"]' % topic, text) for topic in sheet.inputs)]
+
+
+def param_names(package_dir):
+    """Parameter names the Python sources read with ``get_param('...')``."""
+    names = set()
+    for path in python_files(package_dir):
+        names.update(_GET_PARAM.findall(_read(path)))
+    return sorted(names)
+
+
+def comment_ratio(paths):
+    """``(comment lines, code lines)`` of Python files: a line holding a comment or a docstring line
+    counts as commented; code lines are the non-blank lines that are not only comment."""
+    comments = code = 0
+    for path in paths:
+        text = _read(path)
+        commented, only_comment = set(), set()
+        try:
+            tokens = list(tokenize.generate_tokens(io.StringIO(text).readline))
+        except (tokenize.TokenError, IndentationError, SyntaxError):
+            continue
+        previous = tokenize.NEWLINE
+        for tok in tokens:
+            if tok.type == tokenize.COMMENT:
+                commented.add(tok.start[0])
+                if tok.line.strip().startswith('#'):
+                    only_comment.add(tok.start[0])
+            elif tok.type == tokenize.STRING and previous in (tokenize.NEWLINE, tokenize.INDENT,
+                                                              tokenize.DEDENT, tokenize.NL):
+                lines = range(tok.start[0], tok.end[0] + 1)  # a docstring or a bare string
+                commented.update(lines)
+                only_comment.update(lines)
+            if tok.type not in (tokenize.NL, tokenize.COMMENT):
+                previous = tok.type
+        lines = [n for n, line in enumerate(text.splitlines(), 1) if line.strip()]
+        comments += len([n for n in lines if n in commented and not _is_shebang(text, n)])
+        code += len([n for n in lines if n not in only_comment])
+    return comments, code
+
+
+def _is_shebang(text, number):
+    return number == 1 and text.startswith('#!')
+
+
+def make_runnable(package_dir, launched=()):
+    """What a teacher does before running a student's package: make the scripts executable (the sheet
+    asks students to), point a ``python`` shebang to ``python3`` when this machine has no ``python``,
+    give the launched scripts (basenames in ``launched``) a shebang if they have none.
+    Returns a note for each fix."""
+    notes = []
+    has_python = shutil.which('python', path='/usr/local/bin:/usr/bin:/bin') is not None
+    for path in python_files(package_dir):
+        rel = os.path.relpath(path, package_dir)
+        line = _shebang(path)
+        if not line and os.path.basename(path) in launched:
+            text = _read(path)
+            with open(path, 'w') as f:
+                f.write('#!/usr/bin/env python3\n' + text)
+            line = '#!/usr/bin/env python3'
+            notes.append('%s: no shebang line; "%s" added so it can run (line numbers +1)' % (rel, line))
+        if re.match(r'#!\s*(/usr/bin/env\s+|/usr/bin/)python\s*$', line) and not has_python:
+            text = _read(path)
+            with open(path, 'w') as f:
+                f.write('#!/usr/bin/env python3' + text[len(text.split('\n', 1)[0]):])
+            notes.append('%s: shebang "%s" changed to python3 (no python 2 here)' % (rel, line))
+        mode = os.stat(path).st_mode
+        if line and not mode & stat.S_IXUSR:
+            os.chmod(path, mode | stat.S_IXUSR | stat.S_IXGRP | stat.S_IXOTH)
+            notes.append('%s was not executable: made executable (chmod +x), as the sheet asks' % rel)
+    return notes
+
+
+def student_code(package_dir):
+    """The Python files a teacher reads for comments and quality: not setup.py, not tests."""
+    return [p for p in python_files(package_dir) if os.path.basename(p) != 'setup.py'
+            and not any(part in ('test', 'tests') for part in os.path.relpath(p, package_dir).split(os.sep))]
