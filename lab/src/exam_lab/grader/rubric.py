@@ -69,12 +69,12 @@ def score_runs(session):
         for line in launch.get('not_started', []):
             problems.append('%s run: %s' % (run['tag'], line))
         for ended in launch.get('ended', []):
-            problems.append('%s run: node %s %s %s' % (run['tag'], ended['node'],
-                                                       'died' if ended['how'] == 'died' else 'ended',
-                                                       ended['detail']))
+            problems.append('%s run: node %s %s%s' % (run['tag'], ended['node'],
+                                                      'died' if ended['how'] == 'died' else 'ended',
+                                                      ' (%s)' % ended['detail'] if ended['detail'] else ''))
         if probe is None:
             problems.append('%s run: the probe failed: %s' % (run['tag'], run.get('probe_error', '?')))
-        elif not probe.get('nodes'):
+        elif not probe.get('nodes') and not launch.get('ended'):
             problems.append('%s run: no node of the package registered with the master within %.0f s'
                             % (run['tag'], probe.get('start_timeout', 0)))
     if not session.get('runs'):

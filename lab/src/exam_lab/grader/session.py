@@ -21,10 +21,18 @@ import sys
 
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
 
-#: roslaunch's words for a node that ended: "[exam-1] process has died [pid 12, exit code 1, ...]".
-_ENDED = re.compile(r'^\[([^\]]+)\] process has (died|finished cleanly)(.*)$', re.M)
+#: Terminal colour and title sequences roslaunch writes even into a file.
+_ANSI = re.compile(r'\x1b\[[0-9;]*m|\x1b?\]2;[^\n\x07]*\x07?')
+#: roslaunch's words for a node that ended: "[exam-1] process has died [pid 12, exit code 1, ...]";
+#: a required node's death is announced as "REQUIRED process [exam-1] has died!" first.
+_ENDED = re.compile(r'(?:\[([^\]\s]+)\] )?process has (died|finished cleanly)(?: \[pid \d+, (exit code -?\d+))?')
+_REQUIRED = re.compile(r'REQUIRED process \[([^\]]+)\] has died')
 #: Lines of the roslaunch log that say a node could not even be started.
 _NOT_STARTED = re.compile(r'^(ERROR: cannot launch node.*|RLException:.*|.*Invalid roslaunch XML.*)$', re.M)
+#: roslaunch's own chatter, left out of what the teacher reads.
+_CHATTER = re.compile(r'^(\.\.\. |Checking log|Press Ctrl-C|Done checking|started roslaunch|SUMMARY|=+|PARAMETERS|NODES'
+                      r'| \* /|  /|    \S+ \(|auto-starting|setting /run_id|process\[|ROS_MASTER_URI|\[\S+\] killing'
+                      r'|shutting down|done$|log file:|Initiating shutdown|all processes on machine|$)')
 #: Lines kept of a log for the teacher.
 TAIL_LINES = 25
 
@@ -33,11 +41,32 @@ def tail(text, lines=TAIL_LINES):
     return '\n'.join(text.rstrip().splitlines()[-lines:])
 
 
-def launch_outcome(output):
-    """What roslaunch's output says about the student's nodes: ended ones and start failures."""
-    ended = [{'node': m.group(1), 'how': m.group(2), 'detail': m.group(3).strip()}
-             for m in _ENDED.finditer(output)]
-    return {'ended': ended, 'not_started': _NOT_STARTED.findall(output), 'tail': tail(output)}
+def clean(output):
+    """roslaunch's output without colours and without its own chatter: what the nodes printed, and
+    roslaunch's words about them."""
+    kept = []
+    for line in _ANSI.sub('', output).splitlines():
+        if not _CHATTER.match(line.strip('=')) or 'process has' in line:
+            kept.append(line.strip('=') if line.startswith('=') else line)
+    return '\n'.join(kept)
+
+
+def launch_outcome(output, workspace=None):
+    """What roslaunch's output says about the student's nodes: ended ones and start failures.
+    Paths inside ``workspace`` are shown relative to its src/ (``exam/scripts/...``)."""
+    if workspace:
+        output = output.replace(workspace.rstrip('/') + '/src/', '').replace(workspace.rstrip('/'), '<ws>')
+    text = _ANSI.sub('', output)
+    ended, required = [], None
+    for line in text.splitlines():
+        match = _REQUIRED.search(line)
+        if match:
+            required = match.group(1)
+        match = _ENDED.search(line)
+        if match:
+            ended.append({'node': match.group(1) or required or '?', 'how': match.group(2),
+                          'detail': match.group(3) or ''})
+    return {'ended': ended, 'not_started': _NOT_STARTED.findall(text), 'tail': tail(clean(output))}
 
 
 def warned_in_long_excursion(probe):
@@ -73,9 +102,10 @@ def run_one(sup, job, run, node_env):
     else:
         record['probe_error'] = tail(sup.output('probe-%s' % tag), 15)
     record['launch_running'] = launch.poll() is None
+    # Read before stopping: what the nodes print when the grader stops them is not their doing.
+    record['launch'] = launch_outcome(sup.output('launch-%s' % tag), job['workspace'])
     sup.stop(launch)
     sup.stop(master.proc)
-    record['launch'] = launch_outcome(sup.output('launch-%s' % tag))
     return record
 
 

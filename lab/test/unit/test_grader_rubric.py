@@ -1,0 +1,151 @@
+"""The rubric on synthetic measurements: each flaw costs exactly its points, with the numbers."""
+import pytest
+
+from exam_lab.grader import rubric
+from exam_lab.grader.sheets import ITEMS
+
+#: The main run's flight (s): rest 0, short excursion 3-6, long excursion 8.5-16, end 18.5.
+SCHEDULE = {'rest': 0.0, 'short_up': 3.0, 'short_down': 6.0, 'long_up': 8.5, 'long_down': 16.0, 'end': 18.5}
+
+
+def good_calls():
+    return [[-2.0, 'NORMAL'], [8.5 + 5.05, 'WARNING'], [16.0 + 0.08, 'NORMAL']]
+
+
+def measured(calls=None, rate=10.0, formula_error=0.0, output=('/altitude', 'std_msgs/Float32'),
+             subscribed=('/temperature', '/pressure'), warned_in_threshold_run=True, threshold_run=True,
+             died=False):
+    main = {'nodes': ['/exam'], 'node_seen_s': 1.0, 'delay': 5.0, 'start_timeout': 20.0,
+            'subscribed': {t: (['/exam'] if t in subscribed else []) for t in ('/temperature', '/pressure')},
+            'output': {'expected': '/altitude', 'topic': output[0], 'type': output[1], 'candidates': []},
+            'formula': [{'inputs': {'/temperature': 15.0, '/pressure': 89570.9}, 'expected': 1040.0,
+                         'published': 1040.0 + formula_error, 'samples': 5}],
+            'rate': {'hz': rate, 'samples': 185, 'max_gap': 0.1},
+            'calibration': {'by': 'own', 'lo': {'value': 1170.0, 'target': 1170.0},
+                            'hi': {'value': 1430.0, 'target': 1430.0}},
+            'schedule': dict(SCHEDULE), 'calls': calls if calls is not None else good_calls()}
+    runs = [{'tag': 'main', 'probe': main, 'seconds': 30.0,
+             'launch': {'ended': [{'node': 'exam-1', 'how': 'died', 'detail': 'exit code 1'}] if died else [],
+                        'not_started': [], 'tail': ''}}]
+    if threshold_run:
+        second = {'nodes': ['/exam'], 'threshold': 1040.0, 'schedule': {'start': 0.0, 'step': 3.0, 'end': 10.5},
+                  'calls': [[8.02, 'WARNING']] if warned_in_threshold_run else []}
+        runs.append({'tag': 'threshold', 'probe': second, 'seconds': 12.0,
+                     'launch': {'ended': [], 'not_started': [], 'tail': ''}})
+    return {'build': {'status': 0, 'seconds': 3.0, 'tail': '', 'timeout': 180}, 'runs': runs}
+
+
+STATIC = {'launch': {'file': 'launch/exam.launch', 'starts_drone': True, 'exam_type': 'exam_node.py',
+                     'exam_type_found': True},
+          'threshold': {'name': '/threshold', 'value': 1300}, 'params_in_code': ['threshold']}
+
+
+def points(session, static=STATIC):
+    return {i['id']: i['points'] for i in rubric.score('altitude', static, session)}
+
+
+def lost(session, static=STATIC):
+    return {k: ITEMS[k][0] - v for k, v in points(session, static).items() if v < ITEMS[k][0]}
+
+
+def test_a_correct_node_gets_everything():
+    assert lost(measured()) == {}
+    assert sum(points(measured()).values()) == 17
+
+
+def test_a_tick_counter_warning_late_by_a_tick_still_passes():
+    calls = [[8.5 + 5.0 + 0.45, 'WARNING'], [16.4, 'NORMAL']]
+    assert lost(measured(calls=calls)) == {}
+
+
+@pytest.mark.parametrize('latency, ok', [(4.69, False), (4.71, True), (5.49, True), (5.51, False), (6.0, False)])
+def test_warning_window(latency, ok):
+    calls = [[8.5 + latency, 'WARNING'], [16.1, 'NORMAL']]
+    assert lost(measured(calls=calls)) == ({} if ok else {'Q14b': 1.5})
+
+
+def test_calling_every_cycle_is_half_of_q13():
+    calls = [[t / 10.0, 'WARNING' if 13.55 <= t / 10.0 < 16.0 else 'NORMAL'] for t in range(0, 185)]
+    assert lost(measured(calls=calls)) == {'Q13': 2.0}
+    evidence = [i for i in rubric.score('altitude', STATIC, measured(calls=calls)) if i['id'] == 'Q13'][0]['evidence']
+    assert 'in a loop' in evidence and '185 calls' in evidence
+
+
+def test_no_delay_loses_all_of_q14b():
+    calls = [[3.05, 'WARNING'], [6.05, 'NORMAL'], [8.55, 'WARNING'], [16.05, 'NORMAL']]
+    assert lost(measured(calls=calls)) == {'Q14b': 3.0}
+
+
+def test_short_excursion_warning_and_late_normal():
+    calls = [[3.0 + 2.0, 'WARNING'], [6.05, 'NORMAL'], [13.55, 'WARNING'], [17.0, 'NORMAL']]
+    assert lost(measured(calls=calls)) == {'Q14b': 1.5}
+
+
+def test_never_back_to_normal():
+    calls = [[13.55, 'WARNING']]
+    assert lost(measured(calls=calls)) == {'Q13': 2.0, 'Q14b': 0.5}
+
+
+def test_never_warns():
+    assert lost(measured(calls=[], threshold_run=False)) == {'Q13': 4.0, 'Q14a': 0.5, 'Q14b': 3.0}
+
+
+def test_wrong_values_rate_and_topic():
+    # 1040 m: 0.1 % (1.04 m) is more than 0.5 m.
+    assert lost(measured(formula_error=1.1)) == {'Q11': 1.5}
+    assert lost(measured(formula_error=-1.0)) == {}
+    assert lost(measured(rate=8.9)) == {'Q11': 1.0}
+    assert lost(measured(rate=10.9)) == {}
+    assert lost(measured(output=('/alt', 'std_msgs/Float32'))) == {'Q11': 1.5}
+    assert lost(measured(output=('/altitude', 'std_msgs/Float64'))) == {'Q11': 1.5}
+    assert lost(measured(output=(None, None))) == {'Q11': 4.0}
+
+
+def test_absolute_value_tolerance_near_zero():
+    session = measured()
+    row = session['runs'][0]['probe']['formula'][0]
+    row['expected'], row['published'] = 50.0, 50.45
+    assert lost(session) == {}
+    row['published'] = 50.55
+    assert lost(session) == {'Q11': 1.5}
+    row['published'] = float('nan')
+    assert lost(session) == {'Q11': 1.5}
+
+
+def test_relative_value_tolerance():
+    session = measured()
+    row = session['runs'][0]['probe']['formula'][0]
+    row['expected'], row['published'] = 20000.0, 20000.0 + 19.0
+    assert lost(session) == {}
+    row['published'] = 20000.0 + 21.0
+    assert lost(session) == {'Q11': 1.5}
+
+
+def test_one_subscriber():
+    assert lost(measured(subscribed=('/pressure',))) == {'Q10': 1.0}
+
+
+def test_hard_coded_threshold_and_no_parameter():
+    assert lost(measured(warned_in_threshold_run=False)) == {'Q14a': 1.0}
+    static = dict(STATIC, threshold=None, threshold_reason='no parameter of the launch file looks like a threshold')
+    assert lost(measured(threshold_run=False), static) == {'Q14a': 1.0}
+
+
+def test_launch_file_without_drone():
+    static = dict(STATIC, launch=dict(STATIC['launch'], starts_drone=False))
+    assert lost(measured(), static) == {'Q12': 0.5}
+    assert lost(measured(), dict(STATIC, launch=None, launch_files=[])) == {'Q12': 1.0}
+
+
+def test_a_node_that_dies_keeps_the_build_point():
+    assert lost(measured(died=True)) == {'runs': 1.0}
+
+
+def test_nothing_built():
+    session = {'build': {'status': 2, 'seconds': 5.0, 'tail': 'CMake Error', 'timeout': 180}, 'runs': []}
+    items = rubric.score('altitude', STATIC, session)
+    assert {i['id']: i['points'] for i in items} == {'runs': 0, 'Q10': 0, 'Q11': 0, 'Q12': 1, 'Q13': 0,
+                                                     'Q14a': 0, 'Q14b': 0}
+    assert 'CMake Error' in items[0]['evidence']
+    refused = {'build': None, 'runs': [], 'error': 'submission refused: entry climbs out'}
+    assert 'refused' in rubric.score('altitude', {}, refused)[0]['evidence']
