@@ -141,6 +141,16 @@ def test_a_node_that_dies_keeps_the_build_point():
     assert lost(measured(died=True)) == {'runs': 1.0}
 
 
+def test_a_node_that_dies_at_once_gets_nothing_from_its_code():
+    # Whether the probe saw it register before it died must not change a point.
+    for seen in (True, False):
+        session = measured(calls=[], threshold_run=False, died=True, subscribed=())
+        session['runs'][0]['probe']['nodes'] = ['/exam'] if seen else []
+        session['runs'][0]['probe']['output'] = {'expected': '/altitude', 'topic': None, 'type': None,
+                                                 'candidates': []}
+        assert points(session) == {'runs': 1, 'Q10': 0, 'Q11': 0, 'Q12': 1, 'Q13': 0, 'Q14a': 0, 'Q14b': 0}
+
+
 def test_nothing_built():
     session = {'build': {'status': 2, 'seconds': 5.0, 'tail': 'CMake Error', 'timeout': 180}, 'runs': []}
     items = rubric.score('altitude', STATIC, session)

@@ -47,6 +47,12 @@ def node_ran(session):
     return bool(probe and probe.get('nodes'))
 
 
+def stayed_up(session):
+    """True when the node registered in the main run and roslaunch never saw it end."""
+    runs = [r for r in (session or {}).get('runs', []) if r['tag'] == 'main']
+    return node_ran(session) and not runs[0].get('launch', {}).get('ended')
+
+
 def _not_run(session):
     build = (session or {}).get('build') or {}
     if build.get('status') != 0:
@@ -237,8 +243,11 @@ def score_q14a(sheet, static, session):
     if not node_ran(session):
         return item('Q14a', 0, 'parameter %s = %s in the launch file; %s' % (name, threshold['value'], _not_run(session)))
     read = [p for p in static.get('params_in_code', []) if p.strip('~/').split('/')[-1] == name.split('/')[-1]]
-    static_points = 0.5 if read else 0.0
+    # Judged from the code only for a node that runs: one that dies has not shown it uses anything.
+    static_points = 0.5 if read and stayed_up(session) else 0.0
     static_note = ('the code reads %s' % ', '.join(read)) if read else 'the code reads no parameter of that name'
+    if read and not stayed_up(session):
+        static_note += ', but the node died (see runs)'
     probe2 = threshold_probe(session)
     skipped = session.get('threshold_skipped')
     if probe2 is None:

@@ -16,6 +16,7 @@ import fcntl
 import hashlib
 import json
 import os
+import pwd
 import re
 import shutil
 import subprocess
@@ -54,6 +55,30 @@ def can_isolate():
         except (OSError, subprocess.SubprocessError):
             _isolation['ok'] = False
     return _isolation['ok']
+
+
+def unprivileged_user(underlay):
+    """``(uid, gid)`` of ``nobody`` when this root process can run the session as that user (it can
+    read the grader's code and the underlay); None otherwise (then the session runs as this user)."""
+    if 'user' not in _isolation:
+        _isolation['user'] = None
+        try:
+            entry = pwd.getpwnam('nobody')
+            if os.geteuid() == 0 and shutil.which('setpriv'):
+                check = subprocess.run(
+                    _as_user((entry.pw_uid, entry.pw_gid)) + [
+                        sys.executable, '-c', 'import os, sys, exam_lab.grader.session; '
+                        'sys.exit(0 if os.access(sys.argv[1], os.R_OK) else 1)', underlay],
+                    timeout=30, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                if check.returncode == 0:
+                    _isolation['user'] = (entry.pw_uid, entry.pw_gid)
+        except (KeyError, OSError, subprocess.SubprocessError):
+            pass
+    return _isolation['user']
+
+
+def _as_user(user):
+    return ['setpriv', '--reuid=%d' % user[0], '--regid=%d' % user[1], '--clear-groups', '--']
 
 
 def _package_path(name):
@@ -197,8 +222,12 @@ def _executable_in(pkg, name):
     return False
 
 
-def run_session(job, work, underlay, isolate):
-    """Run the session of one submission; return what it measured (or why it could not)."""
+def run_session(job, work, underlay, isolate, user=None):
+    """Run the session of one submission; return what it measured (or why it could not).
+
+    :param isolate: in a network namespace of its own with only loopback (needs root).
+    :param user: ``(uid, gid)`` to run it as (root only): the work folder is handed to that user.
+    """
     log_dir = os.path.join(work, 'logs')
     os.makedirs(log_dir, exist_ok=True)
     job = dict(job, underlay=underlay, log_dir=log_dir)
@@ -206,10 +235,16 @@ def run_session(job, work, underlay, isolate):
     with open(job_path, 'w') as f:
         json.dump(job, f, indent=1, sort_keys=True)
     argv = [sys.executable, '-m', 'exam_lab.grader.session', job_path]
+    env = dict(os.environ, HOME=work)
+    if user is not None:
+        for dirpath, dirnames, filenames in os.walk(work):
+            for name in [dirpath] + [os.path.join(dirpath, n) for n in dirnames + filenames]:
+                os.lchown(name, user[0], user[1])
+        argv = _as_user(user) + argv
     if isolate:
         argv = ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + argv
     with Supervisor(os.path.join(work, 'outer')) as sup:
-        status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT)
+        status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT, env=env)
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
     path = os.path.join(log_dir, 'session.json')
     if status == 0 and os.path.isfile(path):
@@ -224,7 +259,7 @@ def session_tail(output):
     return '\n'.join(output.strip().splitlines()[-10:])
 
 
-def hints(static, session, notes, pkg, isolate):
+def hints(static, session, notes, pkg, isolate, user=None):
     """The for_the_teacher list: what the machine saw but does not score."""
     out = list(notes)
     scripts = source.student_code(pkg) if pkg and os.path.isdir(pkg) else []
@@ -251,6 +286,8 @@ def hints(static, session, notes, pkg, isolate):
         out.append('launch file graded: %s (of %s)' % (static['launch']['file'], ', '.join(static['launch_files'])))
     out.append('ran in a network namespace with only loopback' if isolate else
                'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
+    out.append('ran as user %s' % pwd.getpwuid(user[0]).pw_name if user is not None else
+               'ran as the grading user %s (as root the grader runs it as nobody)' % pwd.getpwuid(os.geteuid()).pw_name)
     out.append('not scored by the machine: %s' % report.NOT_SCORED)
     return out
 
@@ -262,7 +299,9 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     isolate = can_isolate() if isolate is None else isolate
     underlay = underlay or ensure_underlay(default_underlay())  # raises: the grader cannot run
     os.makedirs(out_dir, exist_ok=True)
-    work = tempfile.mkdtemp(prefix='grade-', dir=out_dir)
+    # In the system's temp folder (any user can reach it), not under OUT (which may be private).
+    work = tempfile.mkdtemp(prefix='exam-grade-')
+    user = unprivileged_user(underlay)
     notes, static, session, chosen_sheet, pkg = [], {}, None, sheet, None
     try:
         try:
@@ -271,7 +310,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             if job is None:
                 session = {'build': None, 'runs': [], 'error': 'no script of the package starts a ROS node'}
             else:
-                session = run_session(job, work, underlay, isolate)
+                session = run_session(job, work, underlay, isolate, user)
         except unpack.UnpackError as err:
             session = {'build': None, 'runs': [], 'error': 'submission refused: %s' % err}
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
@@ -279,7 +318,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
         chosen_sheet = chosen_sheet or 'altitude'
         items = rubric.score(chosen_sheet, static, session)
-        record = report.grade_record(student, chosen_sheet, items, hints(static, session, notes, pkg, isolate),
+        record = report.grade_record(student, chosen_sheet, items, hints(static, session, notes, pkg, isolate, user),
                                      {'seconds': round(time.monotonic() - start, 1)})
         logs = os.path.join(out_dir, 'logs')
         shutil.rmtree(logs, ignore_errors=True)
