@@ -234,17 +234,31 @@ def _service_registered(resolved_name):
 
 
 class TopicRecorder(object):
-    """Records every Float32 the node under test publishes on ``topic`` as (ROS time of arrival, value)."""
+    """Records every message on ``topic`` as (ROS time of arrival, ``msg.data``).
 
-    def __init__(self, topic, tcp_nodelay=False):
+    :param msg_type: a message type with a ``data`` field (std_msgs/Float32 by default, String for an
+        LED topic).
+    """
+
+    def __init__(self, topic, msg_type=Float32, tcp_nodelay=False):
         self._lock = threading.Lock()
         self._samples = []
-        self._sub = rospy.Subscriber(topic, Float32, self._callback, queue_size=100,
+        self._sub = rospy.Subscriber(topic, msg_type, self._callback, queue_size=100,
                                      tcp_nodelay=tcp_nodelay)
 
     def samples(self, since=0.0, until=float('inf')):
         with self._lock:
             return [(t, v) for t, v in self._samples if since <= t <= until]
+
+    def values(self):
+        """Every value received so far, in order."""
+        with self._lock:
+            return [v for _, v in self._samples]
+
+    def wait_for_count(self, count, timeout):
+        """The first ``count`` values, or the fewer received by ``timeout`` s."""
+        wait_until(lambda: len(self.values()) >= count, timeout, alive=_alive)
+        return self.values()[:count]
 
     def clear(self):
         with self._lock:
@@ -303,7 +317,7 @@ class Drone(object):
         self.feeder = SensorFeeder(dict(sheet['rates'], **(rates or {})), tcp_nodelay)
         self.service = FakeWarningService(sheet['service'], sheet['srv'],
                                           sheet['led'] if led else None, advertise, on_call)
-        self.output = TopicRecorder(sheet['output'], tcp_nodelay)
+        self.output = TopicRecorder(sheet['output'], tcp_nodelay=tcp_nodelay)
         self.fixed_topic, self.fixed_value = sheet['fixed']
         self.moving_topic = sheet['moving']
 
