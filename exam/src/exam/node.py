@@ -205,7 +205,7 @@ class ExamNode(object):
         else:
             why = 'at or below the threshold %.1f %s' % (debouncer.threshold, mode.unit)
         rospy.loginfo('%s %.1f %s %s: %s', mode.output, value, mode.unit, why, state)
-        self._link.request(state)
+        self._link.want(state)
 
     def _on_led(self, msg):
         """The drone's LED report: lets the link re-send the wanted state after a drone restart."""
