@@ -102,7 +102,7 @@ class ExamNode(object):
         self._timeout = read_number('~timeout', 5.0, lambda x: x > 0.0, 'a number of seconds > 0')
 
         self._lock = threading.Lock()
-        self._inputs = [InputCache(spec.topic, spec.problem) for spec in mode.inputs]
+        self._inputs = [InputCache(spec.topic, spec.why_unusable) for spec in mode.inputs]
         self._debouncer = Debouncer(threshold, delay)
         self._value = None
         self._armed_deadline = None
@@ -141,17 +141,17 @@ class ExamNode(object):
         now = rospy.get_time()
         change = deadline = None
         with self._lock:
-            problem = cache.offer(msg.data, now)
-            if problem is None:
+            reason = cache.offer(msg.data, now)
+            if reason is None:
                 value = self._compute(now)
                 if value is not None:
                     self._value = value
                     change = self._debouncer.update(value, now)
                     deadline = self._debouncer.deadline
-        if problem is not None:
+        if reason is not None:
             # Never cached, never published, never seen by the debouncer: just reported.
             rospy.logwarn_throttle(THROTTLE_S, 'ignoring %s = %r %s: %s'
-                                   % (rospy.resolve_name(spec.topic), msg.data, spec.unit, problem))
+                                   % (rospy.resolve_name(spec.topic), msg.data, spec.unit, reason))
             return
         if change is not None:
             self._announce(change, value)
