@@ -19,7 +19,11 @@ Rules:
 """
 import threading
 
-from exam.debounce import NORMAL
+from exam.debounce import NORMAL, WARNING
+
+#: The colour of the drone's LED in each warning state (the drones' service contract), and back.
+LED_COLOURS = {NORMAL: 'GREEN', WARNING: 'RED'}
+LED_STATES = {colour: state for state, colour in LED_COLOURS.items()}
 
 
 class WarningLink(object):
