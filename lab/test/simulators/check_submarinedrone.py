@@ -32,8 +32,10 @@ class TestSubmarineDroneNode(SimulatorNodeCase):
         # The weather drift stays within 55 Pa of the mean; it moves about 1 Pa/s, so two readings
         # taken up to a second apart still give the depth within a millimetre (plus Float32 rounding).
         self.assertAlmostEqual(readings['/pressure_remote'], hydrostatics.P_ATM, delta=60.0)
-        self.assertAlmostEqual(hydrostatics.depth_m(readings['/pressure_robot'],
-                                                    readings['/pressure_remote']), DEPTH, delta=0.01)
+        # The robot's pressure is the remote's plus that of DEPTH metres of water, within 1 cm of water.
+        expected = hydrostatics.pressure_at_depth_pa(readings['/pressure_remote'], DEPTH)
+        one_cm_pa = hydrostatics.pressure_at_depth_pa(0.0, 0.01)
+        self.assertAlmostEqual(readings['/pressure_robot'], expected, delta=one_cm_pa)
 
 
 if __name__ == '__main__':
