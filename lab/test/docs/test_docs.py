@@ -45,8 +45,8 @@ SPECIAL_ARGS = {'__name', '__ns', '__log', '__ip', '__hostname', '__master'}
 #: How a parameter or launch argument is named in prose: `~threshold`, `threshold:=1500`.
 PRIVATE_NAME = re.compile(r'(?<![\w/.])~([A-Za-z_]\w*)')
 ASSIGNED_NAME = re.compile(r'(?<![\w/:.-])(/?[A-Za-z_]\w*)(?=:=)')
-#: How the code reads a private parameter: rospy.get_param('~x'), read_number('~x', ...), _param('x', ...).
-READ_PARAM = re.compile(r'\b(?:get_param|read_number|_param)\(\s*[\'"]~?(\w+)[\'"]')
+#: How the code reads a private parameter: rospy.get_param('~x'), _param('x', ...).
+READ_PARAM = re.compile(r'\b(?:get_param|_param)\(\s*[\'"]~?(\w+)[\'"]')
 #: drone_sim reads one parameter per sensor: _param(sensor.topic + '_rate', ...).
 READ_SENSOR_PARAM = re.compile(r'\b_param\(\s*\w+\.topic\s*\+\s*[\'"](\w+)[\'"]')
 

@@ -1,11 +1,9 @@
-"""Unit tests that left the answer's packages with their test-only helpers (issue 9): the helpers
-themselves, and the checks of the built-in flights and dives that locate excursions with spans_above.
-No master needed.
+"""The simulators' built-in flights and dives seen through the exam's threshold and delay: each default
+profile has a short excursion (no warning) and a long stay (a warning), located with the oracle's
+spans_above; and the oracle's own helpers. No master needed.
 
-Moved from drone_sim/test/unit/test_profile.py, submarinedrone/test/unit/test_hydrostatics.py,
-mydrone/test/unit/test_flights.py and submarinedrone/test/unit/test_dives.py. What the exam node
-estimates is computed with exam.formulas itself (mydrone's tests carried a copy of the formula, and
-submarinedrone's used depth_m).
+What the exam node estimates is computed with exam.formulas itself: these tests are about the profiles,
+not the formula (the formula is checked against the oracle in exam's unit tests and the lab's rostests).
 """
 
 import pytest
@@ -13,7 +11,7 @@ from hypothesis import given, strategies as st
 
 from drone_sim.profile import Profile
 from exam import formulas
-from exam_lab.harness._from_answer import depth_m, spans_above
+from exam_lab.harness.oracle import depth_of, spans_above
 from mydrone import atmosphere
 from mydrone.flights import FLIGHTS
 from submarinedrone import hydrostatics
@@ -36,7 +34,7 @@ def test_spans_above():
 @given(st.floats(min_value=90000.0, max_value=110000.0), st.floats(min_value=0.0, max_value=11000.0))
 def test_depth_formula_inverts_the_pressure(surface, depth):
     robot = hydrostatics.pressure_at_depth_pa(surface, depth)
-    assert depth_m(robot, surface) == pytest.approx(depth, abs=1e-6)
+    assert depth_of(robot, surface) == pytest.approx(depth, abs=1e-6)
 
 
 # --- mydrone's built-in flights ---------------------------------------------------------------------
