@@ -17,6 +17,7 @@ How one reading travels (each step runs on the thread rospy gives it):
 3. A periodic timer publishes the latest value at ``~rate`` Hz, only while every input is fresh; a stale
    input interrupts a pending excess.
 4. A 1 Hz timer publishes /diagnostics.
+5. A thread of :mod:`drone_sim.master_link` keeps the node registered across a master restart.
 
 State shared by these threads (the caches, the value, the debouncer) is guarded by one lock, held only
 for short computations, never across a publish or a service call.
@@ -50,7 +51,7 @@ import threading
 import rospy
 from std_msgs.msg import Float32, String
 
-from drone_sim import params
+from drone_sim import master_link, params
 from exam import diagnostics
 from exam.debounce import WARNING, Debouncer
 from exam.inputs import InputCache
@@ -249,4 +250,5 @@ def main():
     except params.ParamError as err:
         rospy.logfatal(str(err))
         sys.exit(1)
+    master_link.start()
     rospy.spin()
