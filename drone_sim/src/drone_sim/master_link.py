@@ -16,10 +16,15 @@ node (``getSystemState``, with a short socket timeout), and follows
   each subscription is told of the publishers the master returns (through the node's own XML-RPC
   ``publisherUpdate``, the call a master makes); one info line says what was re-registered.
 
+:func:`open_persistent` serves the other side of a master outage: a service client whose connection
+is open before it is needed calls the service without asking the master.
+
 rospy internals used, all here (python3-rospy 1.15.15 of Debian 12; the same in ROS Noetic's 1.16):
 the topic and service managers of ``rospy.impl.registration`` and their ``get_publications``,
-``get_subscriptions`` and ``get_services`` (the lists RegManager.start registers). Not restored:
-rospy's parameter subscriptions (``get_param_cached``); nothing of ours relies on them.
+``get_subscriptions`` and ``get_services`` (the lists RegManager.start registers); a ServiceProxy's
+``protocol``, ``buff_size`` and ``transport``, and ``rospy.impl.tcpros_base.TCPROSTransport`` (what
+``ServiceProxy.call`` does to open a persistent connection). Not restored: rospy's parameter
+subscriptions (``get_param_cached``); nothing of ours relies on them.
 
 No ROS parameters, topics or services of its own.
 """
@@ -30,6 +35,7 @@ import xmlrpc.client
 import rosgraph
 import rospy
 from rospy.impl import registration
+from rospy.impl.tcpros_base import TCPROSTransport
 
 from drone_sim.outage import (KNOWN, REREGISTER, UNKNOWN, UNREACHABLE, MasterWatch,
                                missing_registrations)
@@ -60,7 +66,7 @@ def _proxy(uri):
 
 
 class MasterError(Exception):
-    """The master answered a call with an error code (a refused registration)."""
+    """The master answered a call with an error code (an unknown service, a refused registration)."""
 
 
 def _value(call, what):
@@ -176,3 +182,30 @@ def start(poll_period=POLL_PERIOD_S):
     rospy.on_shutdown(link.stop)
     return link
 
+
+def open_persistent(name, service_class):
+    """A persistent ``rospy.ServiceProxy`` to the service ``name``, its connection open already, and
+    the service's URI: ``(proxy, uri)``.
+
+    rospy opens a persistent proxy's connection at its first call, through the master; opened here
+    when the service is found, it carries every later call without the master, as long as the serving
+    process lives. A call on it that raises means the connection broke: close the proxy and open a
+    new one.
+
+    :raises Exception: the master is unreachable, does not know the service, or the service does not
+        accept the connection.
+    """
+    proxy = rospy.ServiceProxy(name, service_class, persistent=True)
+    uri = _value(_proxy(rosgraph.get_master_uri()).lookupService(rospy.get_name(), proxy.resolved_name),
+                 'lookupService %s' % proxy.resolved_name)
+    host, port = rospy.core.parse_rosrpc_uri(uri)
+    # As ServiceProxy.call does for its first call (tcpros_service.py).
+    transport = TCPROSTransport(proxy.protocol, proxy.resolved_name)
+    transport.buff_size = proxy.buff_size
+    try:
+        transport.connect(host, port, uri)
+    except Exception:
+        transport.close()
+        raise
+    proxy.transport = transport
+    return proxy, uri
