@@ -86,7 +86,7 @@ def start(snapshot, link_snapshot, mode, service, timeout):
     updater.setHardwareID(rospy.get_name())
     updater.add('inputs', lambda stat: inputs_status(stat, snapshot(), timeout))
     updater.add('warning', lambda stat: warning_status(stat, snapshot(), link_snapshot(), mode, service))
-    guard = OncePerOutage('/diagnostics: reading ~diagnostic_period from the master',
+    guard = OncePerOutage('/diagnostics: reading the diagnostic_period parameter from the master',
                           'the master is unreachable; the statuses are published every %.0f s anyway '
                           '(connected subscribers keep them, a new one finds them once the master is '
                           'back)' % PERIOD_S)
