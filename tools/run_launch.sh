@@ -60,6 +60,7 @@ if [ -n "$reasons" ]; then
   echo "The launch stopped: ${died#REQUIRED }. Its FATAL message (logs: $ROS_LOG_DIR):"
   echo "$reasons"
 else
-  echo "The launch stopped: ${died#REQUIRED } without a FATAL message (its output is above; logs: $ROS_LOG_DIR)"
+  echo "The launch stopped: ${died#REQUIRED } without a FATAL message (its output is above;" \
+    "logs: $ROS_LOG_DIR)"
 fi
 exit 1

@@ -30,14 +30,19 @@ from drone_sim.profile import Profile
 JITTER = 0.3
 #: Step of the search for the drone's start time (s).
 STEP = 0.01
+#: Wall time the launch may take to bring the drone up (s).
+START_WITHIN = 20.0
 
 
 class TruthRecorder(object):
-    """Every value of a topic with its arrival time (wall clock, s)."""
+    """Every value of a topic with its arrival time (monotonic clock, s); ``spanned`` is set once the
+    values cover ``span`` seconds."""
 
-    def __init__(self, topic):
+    def __init__(self, topic, span):
         self._lock = threading.Lock()
         self._samples = []
+        self._span = span
+        self.spanned = threading.Event()
         self._sub = rospy.Subscriber(topic, Float32, self._callback)
 
     def samples(self):
@@ -48,16 +53,8 @@ class TruthRecorder(object):
         now = time.monotonic()
         with self._lock:
             self._samples.append((now, msg.data))
-
-
-def wait_until(predicate, timeout, step=0.05):
-    """Poll ``predicate`` until it is true or ``timeout`` s of wall time pass; return its last value."""
-    deadline = time.monotonic() + timeout
-    while True:
-        value = predicate()
-        if value or time.monotonic() >= deadline or rospy.is_shutdown():
-            return value
-        time.sleep(step)
+            if now - self._samples[0][0] >= self._span:
+                self.spanned.set()
 
 
 def best_fit(profile, samples):
@@ -83,12 +80,12 @@ class LaunchProfile(unittest.TestCase):
         given = rospy.get_param('/%s/profile' % drone)
         self.assertEqual(given, waypoints, '/%s/profile is %r' % (drone, given))
 
-        recorder = TruthRecorder('/%s/%s' % (drone, truth))
-        self.assertTrue(wait_until(recorder.samples, 20.0), 'nothing on /%s/%s' % (drone, truth))
-        start = recorder.samples()[0][0]
-        # A little more than one loop: every waypoint is passed.
-        wait_until(lambda: recorder.samples()[-1][0] - start >= 1.2 * profile.period, 3.0 * profile.period)
+        # A little more than one loop, so every waypoint is passed; the drone may take a while to start.
+        recorder = TruthRecorder('/%s/%s' % (drone, truth), 1.2 * profile.period)
+        self.assertTrue(recorder.spanned.wait(START_WITHIN + 1.2 * profile.period),
+                        '%d samples on /%s/%s' % (len(recorder.samples()), drone, truth))
         samples = recorder.samples()
+        start = samples[0][0]
 
         values = [v for _, v in waypoints]
         slopes = [abs(v1 - v0) / (t1 - t0) for (t0, v0), (t1, v1) in zip(waypoints, waypoints[1:])]
