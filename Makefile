@@ -25,11 +25,12 @@ deps:
 build: deps
 	@tools/build_ws.sh
 
+# `make run ARGS='threshold:=1400 delay:=3'` passes launch arguments.
 run: build
-	@$(ENV) && exec roslaunch exam exam.launch
+	@tools/run_launch.sh exam.launch $(ARGS)
 
 run-submarine: build
-	@$(ENV) && exec roslaunch exam exam_submarine.launch
+	@tools/run_launch.sh exam_submarine.launch $(ARGS)
 
 test: build
 	@tools/run_tests.sh $(TESTS)

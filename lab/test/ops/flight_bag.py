@@ -2,9 +2,11 @@
 """Writes a deterministic flight bag with the rosbag Python API, and computes its altitudes offline.
 
 A recorded bag (`rosbag record /temperature /pressure`) would do as well, but a generated one is exact,
-takes no wall time, and its crossing instants are known in advance. The flight climbs through the
-threshold, stays above it for 16 s and comes back down; temperature and pressure are written at
-different rates (1 Hz and 2 Hz), offset so that no two readings share a timestamp.
+takes no wall time, and its crossing instants are known in advance. The flight lasts 36 s: it climbs
+from 1000 m to 1500 m in 12 s, holds 1500 m for 16 s and is down to 1100 m at 32 s, so it is above
+1300 m from 9.3 s to 30.0 s (about 21 s; the readings, at their own instants, from 9.5 s to 30.0 s).
+Temperature and pressure are written at different rates (1 Hz and 2 Hz), offset so that no two
+readings share a timestamp.
 
 No /clock in the bag: `rosbag play --clock` publishes the clock from the message times itself.
 
@@ -14,10 +16,7 @@ import math
 import struct
 import sys
 
-# Constants of the exam sheet, written out independently of the exam package: this file is the oracle.
-P0_PA = 101325.0
-MU_G_OVER_R = 0.0289644 * 9.80665 / 8.31432
-KELVIN = 273.15
+from exam_lab.harness.oracle import altitude_of, pressure_at as oracle_pressure_at
 
 #: Bag time [s] of the first message; any value works, a realistic epoch keeps logs readable.
 START = 1700000000.0
@@ -44,8 +43,7 @@ def temperature_at(t):
 def pressure_at(t):
     """Pressure [Pa] from the exam's isothermal law at the profile's altitude, with a tiny wiggle so
     that no two computed altitudes are equal."""
-    return (P0_PA * math.exp(-MU_G_OVER_R * profile(t) / (temperature_at(t) + KELVIN))
-            + 0.5 * math.sin(7.0 * t))
+    return oracle_pressure_at(profile(t), temperature_at(t)) + 0.5 * math.sin(7.0 * t)
 
 
 def readings():
@@ -68,11 +66,6 @@ def float32(value):
     return struct.unpack('f', struct.pack('f', value))[0]
 
 
-def altitude(temperature_c, pressure_pa):
-    """The exam sheet's equation (1) solved for h [m]."""
-    return (temperature_c + KELVIN) / MU_G_OVER_R * math.log(P0_PA / pressure_pa)
-
-
 def states(items):
     """The altitudes the exam node may publish: [(from bag time [s], altitude [m])], one per reading
     from the moment both inputs are known, each computed from the latest temperature and pressure."""
@@ -81,7 +74,7 @@ def states(items):
     for t, topic, value in items:
         latest[topic] = float32(value)
         if len(latest) == 2:
-            result.append((t, altitude(latest['temperature'], latest['pressure'])))
+            result.append((t, altitude_of(latest['temperature'], latest['pressure'])))
     return result
 
 
