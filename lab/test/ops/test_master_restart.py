@@ -20,7 +20,6 @@ A watcher connected before the first fault times the whole flight (topics are pe
 connections survive the master); every other check is a process started against the new master.
 """
 import json
-import os
 import time
 
 from exam_lab.harness.supervisor import Supervisor
@@ -43,7 +42,6 @@ DOWN_FOR = 2.0
 REAPPEAR_BOUND = 5.0
 LED_BOUND = 1.0
 NODES = ('/exam', '/mydrone')
-LAUNCH = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'master_restart.launch')
 
 
 def echoed(output):
@@ -121,7 +119,7 @@ def test_master_killed_and_restarted_mid_flight(tmp_path):
         master = procs.start_master()
         env = master.env
         launched = time.monotonic()
-        launch = procs.start('launch', ['roslaunch', LAUNCH, 'threshold:=%g' % THRESHOLD,
+        launch = procs.start('launch', ['roslaunch', 'exam', 'exam.launch', 'threshold:=%g' % THRESHOLD,
                                         'profile:=%s' % json.dumps(PROFILE)], env)
         # Connected before the fault, it records the whole flight (its conditions are never met: it
         # runs until it is stopped).
