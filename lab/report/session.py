@@ -2,7 +2,7 @@
 
 Every process gets ROS_HOME and ROS_LOG_DIR inside this run's private folder (``run_dir``) and the
 variable EXAM_REPORT_RUN=<run_dir>, which the nodes roslaunch starts in sessions of their own inherit
-too, so :func:`leftovers` finds exactly this run's processes and :meth:`Session.close` ends them by pid. tools/report.sh calls ``session.py --cleanup <run_dir>``
+too, so :func:`leftovers` finds exactly this run's processes and :meth:`Session.close` ends them by pid. lab/report/report.sh calls ``session.py --cleanup <run_dir>``
 from its trap in case this Python process itself dies.
 """
 import os

@@ -1,7 +1,8 @@
 """Statistics of the benchmark: stream timing, warning latency, CPU share, crossing script, profiles.
 
-No rospy here, so every number the report prints is computed by code the unit tests in bench/test/
-drive with synthetic timestamps. All times are seconds of ROS time as floats.
+No rospy here, so every number the report prints is computed by code the unit tests in
+lab/test/unit/test_bench_stats.py drive with synthetic timestamps. All times are seconds of ROS time
+as floats.
 """
 
 import collections

@@ -1,7 +1,4 @@
-"""Unit tests of bench/stats.py: synthetic stamps, no master, no clock.
-
-Run with: /usr/bin/python3 -m pytest -q bench/test   (not part of `make test`: bench is not a package)
-"""
+"""Unit tests of lab/bench/stats.py: synthetic stamps, no master, no clock."""
 
 import os
 import random
@@ -9,7 +6,7 @@ import sys
 
 import pytest
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
 
 import stats  # noqa: E402
 

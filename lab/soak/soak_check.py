@@ -15,7 +15,7 @@ runs, and checking the recorded bag offline afterwards.
 It prints the figures and exits non-zero on any mismatch, or when the run saw no WARNING at all.
 
 The pure functions (oracle, matching, memory trend) take plain lists and are unit-tested in
-exam/test/ops/test_soak_check.py.
+lab/test/unit/test_soak_check.py.
 """
 import argparse
 import csv

@@ -1,8 +1,8 @@
 """The measurements of `make bench`, one function per stage, each for one kind of node.
 
-A kind is ``ours`` (exam/scripts/exam_node.py), ``baseline`` (bench/baseline_exam_node.py), ``floor``
-(bench/floor_node.py, the cheapest rospy node with the same topics) or ``ours_without_numpy`` (ours
-through bench/without_numpy.py, the memory experiment). Every stage starts its node(s) in a namespace
+A kind is ``ours`` (exam/scripts/exam_node.py), ``baseline`` (lab/bench/baseline_exam_node.py), ``floor``
+(lab/bench/floor_node.py, the cheapest rospy node with the same topics) or ``ours_without_numpy`` (ours
+through lab/bench/without_numpy.py, the memory experiment). Every stage starts its node(s) in a namespace
 of its own, measures, stops them, and returns a plain dict that report.py renders.
 """
 
@@ -18,7 +18,7 @@ import stats
 
 PYTHON = '/usr/bin/python3'
 BENCH = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.dirname(BENCH)
+REPO = os.path.dirname(os.path.dirname(BENCH))
 SCRIPTS = {
     'ours': os.path.join(REPO, 'exam', 'scripts', 'exam_node.py'),
     'baseline': os.path.join(BENCH, 'baseline_exam_node.py'),
@@ -263,7 +263,7 @@ MEMORY_STEPS = [
     ('+ import numpy', 'import numpy'),
     ('+ import rospy, std_msgs', 'import numpy, rospy, std_msgs.msg'),
     ('+ rospy.init_node', 'import numpy, rospy, std_msgs.msg; rospy.init_node("rss_probe", anonymous=True)'),
-    ('rospy.init_node with numpy blocked (bench/without_numpy.py)',
+    ('rospy.init_node with numpy blocked (lab/bench/without_numpy.py)',
      'import sys; sys.modules["numpy"] = None; import rospy, std_msgs.msg; '
      'rospy.init_node("rss_probe", anonymous=True)'),
 ]

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # `make soak` (not part of `make test`): the default flight of mydrone with the exam node for
 # SOAK_MINUTES (default 30), recorded to a bag while the exam node's memory is sampled, then checked
-# offline by tools/soak_check.py (LED changes and calls against an independent debounce oracle applied
+# offline by lab/soak/soak_check.py (LED changes and calls against an independent debounce oracle applied
 # to the published /altitude, nothing lost or repeated, no memory growth). Prints the figures.
 #   SOAK_MINUTES=3 make soak    a short run (the default flight loops every 100 s: 3 min hold 2 WARNINGs)
 #   SOAK_DIR=/some/dir          where the bag, memory samples and logs go (default .ws/soak/<UTC time>)
 # It runs on a master of its own (free port) and stops every process it started, whatever happens.
 set -euo pipefail
-repo="$(cd "$(dirname "$0")/.." && pwd)"
+repo="$(cd "$(dirname "$0")/../.." && pwd)"
 source "$repo/tools/env.sh"
 
 minutes="${SOAK_MINUTES:-30}"
@@ -56,10 +56,10 @@ start roscore roscore -p "$port"
 start record rosbag record -O "$dir/soak.bag" /temperature /pressure /altitude /alt_warn_led /rosout \
   /diagnostics __name:=soak_record
 start launch roslaunch exam exam.launch threshold:="$threshold" delay:="$delay"
-/usr/bin/python3 "$repo/tools/soak_check.py" sample --seconds "$((minutes * 60))" --csv "$dir/rss.csv"
+/usr/bin/python3 "$repo/lab/soak/soak_check.py" sample --seconds "$((minutes * 60))" --csv "$dir/rss.csv"
 
 # Stop the flight, then the recorder (SIGINT lets it close the bag), then the master.
 for (( i=${#groups[@]}-1; i>=0; i-- )); do stop_group "${groups[i]}"; done
 groups=()
-/usr/bin/python3 "$repo/tools/soak_check.py" check --bag "$dir/soak.bag" --rss "$dir/rss.csv" \
+/usr/bin/python3 "$repo/lab/soak/soak_check.py" check --bag "$dir/soak.bag" --rss "$dir/rss.csv" \
   --threshold "$threshold" --delay "$delay"

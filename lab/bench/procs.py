@@ -2,7 +2,7 @@
 
 Every child runs in its own session (process group), so stopping it also stops anything it forked
 (roscore's rosmaster and rosout). Each group id is appended to ``pid_file`` the moment it exists:
-bench/run.sh's trap kills exactly those groups if this Python process itself dies without cleaning up.
+lab/bench/run.sh's trap kills exactly those groups if this Python process itself dies without cleaning up.
 """
 
 import os

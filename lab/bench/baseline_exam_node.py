@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """BASELINE ONLY: the naive exam node the seed's grader solution describes. Never launched by the product.
 
-bench/run.sh measures the real exam node (exam/scripts/exam_node.py) against this one, so the
+lab/bench/run.sh measures the real exam node (exam/scripts/exam_node.py) against this one, so the
 benchmark shows what the real node's design buys. It is written the obvious way on purpose:
 
 - global variables cache the latest readings (the grader's own solution does this);

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """`make bench`: the exam node against the naive baseline, stage by stage, into docs/benchmarks.md.
 
-Run it through bench/run.sh, which prepares the ROS environment, the log directory and the pid file
+Run it through lab/bench/run.sh, which prepares the ROS environment, the log directory and the pid file
 its trap uses. BENCH_QUICK=1 shrinks every window to a few seconds (a smoke run while developing) and
 writes to a scratch directory instead of docs/, so a smoke run never replaces the real numbers.
 """
@@ -109,7 +109,7 @@ def run_stages(lab, cfg, kinds, profiler, wanted=STAGES):
                                           stages.memory_floor, lab)
         if 'ours' in kinds:
             results['ours_without_numpy'] = guarded(
-                'ours without numpy (bench/without_numpy.py): rate, CPU and RSS over %d s'
+                'ours without numpy (lab/bench/without_numpy.py): rate, CPU and RSS over %d s'
                 % cfg['floor_window'],
                 stages.rate_and_cost, lab, 'ours_without_numpy', cfg['floor_window'])
     if 'latency' in wanted:

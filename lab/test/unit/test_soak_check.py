@@ -1,10 +1,10 @@
-"""Unit tests of the soak check's oracle, matching and memory trend (tools/soak_check.py), no master."""
+"""Unit tests of the soak check's oracle, matching and memory trend (lab/soak/soak_check.py), no master."""
 import os
 import sys
 
 import pytest
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..', 'tools'))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'soak'))
 from soak_check import (NORMAL, WARNING, changes, debounce_oracle, match,  # noqa: E402
                         repeats, rss_trend)
 
