@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """`make bench`: the exam node against the naive baseline, stage by stage, into docs/benchmarks.md.
 
-Run it through lab/bench/run.sh, which prepares the ROS environment, the log directory and the pid file
-its trap uses. BENCH_QUICK=1 shrinks every window to a few seconds (a smoke run while developing) and
+Run it through lab/bench/run.sh, which prepares the ROS environment and the log directory, and whose
+trap ends every process of the run should this one die without doing it. BENCH_QUICK=1 shrinks every window to a few seconds (a smoke run while developing) and
 writes to a scratch directory instead of docs/, so a smoke run never replaces the real numbers.
 """
 
@@ -15,6 +15,8 @@ import signal
 import subprocess
 import sys
 import time
+
+from exam_lab.harness.supervisor import Supervisor
 
 import driver
 import procs
@@ -155,8 +157,7 @@ def main(argv):
     parser.add_argument('--out', required=True, help='directory that receives benchmarks.md')
     parser.add_argument('--figure', required=True, help='path of the fleet plot (PNG)')
     parser.add_argument('--json', required=True, help='path of the raw results (JSON)')
-    parser.add_argument('--log-dir', help='where the nodes write their output')
-    parser.add_argument('--pid-file', help='process groups, for run.sh to clean up')
+    parser.add_argument('--log-dir', help='where the nodes write their output (required to measure)')
     parser.add_argument('--py-spy', default=None, help='py-spy executable: profile missed goals')
     parser.add_argument('--stages', default=','.join(STAGES),
                         help='comma-separated subset of %s (a targeted experiment)' % ', '.join(STAGES))
@@ -172,6 +173,8 @@ def main(argv):
         with open(args.json) as f:
             write_report(json.load(f), args)
         return 0
+    if not args.log_dir:
+        parser.error('--log-dir is required to measure')
     cfg = QUICK if args.quick else FULL
     signal.signal(signal.SIGTERM, _on_sigterm)
 
@@ -182,13 +185,12 @@ def main(argv):
     if not stages.available(stages.SCRIPTS['ours']):
         progress('ours: %s is missing, measuring the baseline only' % stages.SCRIPTS['ours'])
         kinds = ['baseline']
-    env = dict(os.environ, ROS_LOG_DIR=args.log_dir, PYTHONUNBUFFERED='1')
-    children = procs.Children(args.pid_file, args.log_dir)
+    supervisor = Supervisor(args.log_dir)
     try:
-        _, uri = procs.start_master(children, env)
-        progress('master at %s, node output in %s' % (uri, args.log_dir))
-        driver.init(uri)
-        lab = stages.Lab(children, uri, env)
+        master = supervisor.start_master()
+        progress('master at %s, node output in %s' % (master.uri, args.log_dir))
+        driver.init(master.uri)
+        lab = stages.Lab(supervisor, master)
         profiler = None
         if args.py_spy:
             profiler = profiling.Profiler(args.py_spy, args.log_dir, cfg['profile_window'],
@@ -197,7 +199,7 @@ def main(argv):
     finally:
         import rospy
         rospy.signal_shutdown('bench over')
-        children.stop()
+        supervisor.close()
     info['loadavg_end'] = procs.loadavg()
     results.update(machine=info, config=cfg, quick=args.quick, date=date, command=args.command,
                    duration_s=time.monotonic() - t0)

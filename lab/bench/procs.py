@@ -1,26 +1,14 @@
-"""Processes of the benchmark: a master on a free port, the nodes under test, and their CPU and RSS.
+"""What the benchmark measures of its processes, from /proc: CPU share, resident memory, machine load.
 
-Every child runs in its own session (process group), so stopping it also stops anything it forked
-(roscore's rosmaster and rosout). Each group id is appended to ``pid_file`` the moment it exists:
-lab/bench/run.sh's trap kills exactly those groups if this Python process itself dies without cleaning up.
+Starting and stopping them is the harness's job (:class:`exam_lab.harness.supervisor.Supervisor`).
 """
 
 import os
-import signal
-import socket
-import subprocess
 import time
 
 from stats import cpu_percent
 
 CLOCK_TICKS = os.sysconf('SC_CLK_TCK')
-
-
-def free_port():
-    """A TCP port nobody listens on right now: bind to port 0 and let the kernel choose."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
-        sock.bind(('127.0.0.1', 0))
-        return sock.getsockname()[1]
 
 
 def cpu_ticks(pid):
@@ -94,66 +82,3 @@ class CpuWindow:
             else:
                 result[pid] = cpu_percent(now - before, seconds, CLOCK_TICKS)
         return result
-
-
-class Children:
-    """The processes this benchmark started, stopped by their own process group id only."""
-
-    def __init__(self, pid_file, log_dir):
-        self.pid_file = pid_file
-        self.log_dir = log_dir
-        self.procs = []
-
-    def start(self, name, argv, env):
-        """Start ``argv`` in a new session with output to ``<log_dir>/<name>.log``."""
-        log = open(os.path.join(self.log_dir, name + '.log'), 'ab')
-        proc = subprocess.Popen(argv, env=env, stdout=log, stderr=subprocess.STDOUT,
-                                stdin=subprocess.DEVNULL, start_new_session=True)
-        log.close()
-        self.procs.append(proc)
-        with open(self.pid_file, 'a') as f:
-            f.write('%d\n' % proc.pid)
-        return proc
-
-    def stop(self, procs=None, grace=5.0):
-        """SIGINT (rospy's clean shutdown), then SIGKILL after ``grace`` seconds, per process group."""
-        procs = list(self.procs if procs is None else procs)
-        for proc in procs:
-            _signal_group(proc, signal.SIGINT)
-        deadline = time.monotonic() + grace
-        for proc in procs:
-            try:
-                proc.wait(timeout=max(0.1, deadline - time.monotonic()))
-            except subprocess.TimeoutExpired:
-                pass
-            # The leader may be gone while a forked child (rosout under roscore) still runs.
-            _signal_group(proc, signal.SIGKILL)
-            proc.wait()
-            if proc in self.procs:
-                self.procs.remove(proc)
-
-
-def _signal_group(proc, sig):
-    try:
-        os.killpg(proc.pid, sig)
-    except ProcessLookupError:
-        pass
-
-
-def start_master(children, env):
-    """Start ``roscore`` on a free port; return its process and URI once the master answers."""
-    import rosgraph  # the ROS environment is only needed from here on
-
-    port = free_port()
-    uri = 'http://127.0.0.1:%d/' % port
-    env = dict(env, ROS_MASTER_URI=uri)
-    proc = children.start('roscore', ['roscore', '-p', str(port)], env)
-    deadline = time.monotonic() + 30.0
-    master = rosgraph.Master('/bench', master_uri=uri)
-    while time.monotonic() < deadline:
-        if proc.poll() is not None:
-            raise RuntimeError('roscore on port %d exited with %d' % (port, proc.returncode))
-        if master.is_online():
-            return proc, uri
-        time.sleep(0.2)
-    raise RuntimeError('roscore on port %d did not answer within 30 s' % port)

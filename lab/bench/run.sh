@@ -5,15 +5,13 @@
 #   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet), also to $EXAM_WS/bench-quick/
 #   BENCH_PROFILE=1  also profile ours with py-spy (installed from PyPI into a throwaway directory)
 #   BENCH_RENDER_ONLY=1  measure nothing: render the docs again from the last results
-# Every process it starts runs in its own process group listed in a pid file; the trap kills exactly
-# those groups on exit, error or Ctrl-C, so nothing outlives the run.
+# Every process it starts carries the run's log folder in its environment (exam_lab's supervisor); the
+# trap ends exactly those on exit, error or Ctrl-C, so nothing outlives the run.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/../.." && pwd)"
 source "$repo/tools/env.sh"
 
 scratch="$(mktemp -d /tmp/exam-bench.XXXXXX)"
-pid_file="$scratch/pids"
-touch "$pid_file"
 bench_pid=""
 
 cleanup() {
@@ -23,10 +21,8 @@ cleanup() {
     kill -TERM "$bench_pid" 2>/dev/null || true
     wait "$bench_pid" 2>/dev/null || true
   fi
-  # Whatever bench.py could not stop itself (it was killed hard): its children's process groups.
-  while read -r pgid; do
-    kill -KILL -- "-$pgid" 2>/dev/null || true
-  done < "$pid_file"
+  # Whatever bench.py could not stop itself (it was killed hard): every process marked with its logs.
+  /usr/bin/python3 -m exam_lab.harness.supervisor --cleanup "$scratch/logs" || true
   if [ "$status" -eq 0 ]; then
     rm -rf "$scratch"
   else
@@ -38,7 +34,7 @@ trap cleanup EXIT
 trap 'exit 130' INT TERM
 
 mkdir -p "$scratch/logs"
-args=(--log-dir "$scratch/logs" --pid-file "$pid_file")
+args=(--log-dir "$scratch/logs")
 # The exact command, as the report prints it: the BENCH_ variables change what is measured.
 command="$({ env | grep -E '^BENCH_(QUICK|PROFILE|STAGES)=' || true; } | sort | tr '\n' ' ')make bench"
 if [ "$EXAM_WS" != "$repo/.ws" ]; then

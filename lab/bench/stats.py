@@ -124,12 +124,6 @@ def new_rng(seed):
     return random.Random(seed)
 
 
-def pressure_at(altitude, temperature_c):
-    """Pressure (Pa) that the exam node turns back into ``altitude`` (m): equation (1) of the seed."""
-    p0, mu, g, r = 101325.0, 0.0289644, 9.80665, 8.31432
-    return p0 * math.exp(-mu * g * altitude / (r * (temperature_c + 273.15)))
-
-
 def cpu_percent(ticks, seconds, clock_ticks):
     """CPU use in percent of one core from a delta of utime+stime clock ticks over ``seconds``."""
     return 100.0 * ticks / clock_ticks / seconds if seconds > 0 else None

@@ -117,14 +117,6 @@ def test_crossing_script_alternates_and_leaves_time_to_warn():
         assert t_up - t_down >= 0.6
 
 
-def test_pressure_at_inverts_the_seed_formula():
-    import math
-    p = stats.pressure_at(1300.0, 15.0)
-    altitude = 8.31432 * (15.0 + 273.15) / (0.0289644 * 9.80665) * math.log(101325.0 / p)
-    assert altitude == pytest.approx(1300.0, abs=1e-6)
-    assert stats.pressure_at(0.0, 15.0) == pytest.approx(101325.0)
-
-
 def test_within_and_cpu_percent():
     assert stats.within(9.995, 10.0, 0.001)
     assert not stats.within(9.98, 10.0, 0.001)
