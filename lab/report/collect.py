@@ -12,19 +12,22 @@ The order follows the exam sheets:
    with ``threshold:=1500`` (question 14a), recorded too.
 4. The same for the underwater drone on a fresh master: questions 4 to 8, then one full dive.
 
-Everything is bounded in time, and every process started is ended on the way out (see session.py).
-The outputs (with PIDs and ports of this run) go to ``<work>/outputs.json``; render.py fills the report.
+Everything is bounded in time, and every process started is ended on the way out: the harness's
+supervisor runs them all, with their consoles in ``--run-dir`` (report.sh's trap ends them by that
+folder should this process die). The outputs (with PIDs and ports of this run) go to
+``<work>/outputs.json``; render.py fills the report.
 """
 import argparse
 import json
 import os
+import shlex
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from exam_lab.harness.supervisor import Supervisor
+from exam_lab.harness.wait import wait_until
 
-import commands as C  # noqa: E402  (the folder of this script is not a package)
-from session import Master, Session  # noqa: E402
+import command_list
 
 #: Seconds of one recorded run: the default profiles loop in 100 s; the rest is start-up margin.
 DEFAULT_RUN_SECONDS = 106.0
@@ -34,94 +37,110 @@ def log(message):
     print('report: %s' % message, flush=True)
 
 
-def run_all(session, master, commands, results):
-    for command in commands:
-        output, status, seconds = session.run(command, master.env)
-        results[command.key] = {'line': command.line, 'output': output, 'status': status,
-                                'seconds': round(seconds, 1)}
-        log('%-40s exit %s, %.1f s' % (command.line[:40], status, seconds))
+class Run(object):
+    """The report's commands on the harness's supervisor: each runs from the work folder, and its
+    output is collected under its key in :attr:`results` (written to outputs.json)."""
+
+    def __init__(self, supervisor, work_dir):
+        self.supervisor = supervisor
+        self.work_dir = work_dir
+        #: command key -> {'line', 'output', 'status', 'seconds'} or, for a background command,
+        #: {'line', 'console', 'output' once it stopped, 'started' for a launch}.
+        self.results = {}
+
+    def run_all(self, master, commands, cwd=None):
+        """Run each command to completion (bounded by its limit) and keep its output."""
+        for command in commands:
+            status, output, seconds = self.supervisor.run(command.key, shlex.split(command.line),
+                                                          command.limit, master.env,
+                                                          cwd or self.work_dir)
+            if status is None:
+                status = 'killed after %d s' % command.limit
+            self.results[command.key] = {'line': command.line, 'output': output.rstrip(),
+                                         'status': status, 'seconds': round(seconds, 1)}
+            log('%-40s exit %s, %.1f s' % (command.line[:40], status, seconds))
+
+    def background(self, master, command):
+        """Start a background command and note its line (its console is read after it stops)."""
+        self.results[command.key] = {'line': command.line, 'console': self.supervisor.log(command.key)}
+        return self.supervisor.start(command.key, shlex.split(command.line), master.env, self.work_dir)
+
+    def stop(self, procs, commands):
+        """Stop background commands, in this order (Ctrl-C, as a user would), and keep their consoles."""
+        for proc in procs:
+            self.supervisor.stop(proc)
+        for command in commands:
+            self.results[command.key]['output'] = self.supervisor.output(command.key).rstrip()
 
 
-def background(session, master, command, results, name=None):
-    """Start a background command and note its line (its console is read after it stops)."""
-    results[command.key] = {'line': command.line, 'console': session.console(name or command.key)}
-    return session.start(name or command.key, command.line, master.env)
+def wait_for(what, condition, proc, timeout=30.0):
+    """Wait until ``condition()`` is true; raise if ``proc`` exits or ``timeout`` s pass first."""
+    if not wait_until(lambda: bool(condition()), timeout, alive=lambda: proc.poll() is None):
+        raise RuntimeError('%s not there after %.0f s (process exit status %s)'
+                           % (what, timeout, proc.poll()))
 
 
-def finish_console(results, key):
-    """Copy a stopped background command's console into the results."""
-    with open(results[key]['console'], 'rb') as f:
-        results[key]['output'] = f.read().decode('utf-8', 'replace').rstrip()
-
-
-def node_alone(session, master, node_command, sensor_topic, commands, results):
+def node_alone(run, master, node_command, sensor_topic, commands):
     """Questions 3 to 8: one drone node on its own, explored with the command-line tools."""
-    node = background(session, master, node_command, results)
-    session.wait_for(sensor_topic + ' published', lambda: master.publishers(sensor_topic), 30.0, node)
-    run_all(session, master, commands, results)
-    session.stop(node)
-    finish_console(results, node_command.key)
+    node = run.background(master, node_command)
+    wait_for(sensor_topic + ' published', lambda: master.publishers(sensor_topic), node)
+    run.run_all(master, commands)
+    run.stop([node], [node_command])
 
 
-def recorded_run(session, master, record, launch, output_topic, bag_topic):
+def recorded_run(run, master, record, launch, output_topic, bag_topic):
     """Start ``rosbag record`` (subscribed before anything is published), then the launch file."""
-    bag = background(session, master, record, session.results)
-    session.wait_for('rosbag subscribed to ' + bag_topic, lambda: master.subscribers(bag_topic), 30.0, bag)
+    bag = run.background(master, record)
+    wait_for('rosbag subscribed to ' + bag_topic, lambda: master.subscribers(bag_topic), bag)
     started = time.time()
-    proc = background(session, master, launch, session.results)
+    proc = run.background(master, launch)
     # Wall clock as the bag's stamps: the figures count time from this instant.
-    session.results[launch.key]['started'] = started
-    session.wait_for(output_topic + ' published', lambda: master.publishers(output_topic), 30.0, proc)
+    run.results[launch.key]['started'] = started
+    wait_for(output_topic + ' published', lambda: master.publishers(output_topic), proc)
     return bag, proc, started
 
 
-def flight(session, run_seconds):
-    results = session.results
-    master = Master(session, 'flight')
+def flight(run, run_seconds):
+    master = run.supervisor.start_master('flight.master')
     log('mydrone alone on %s' % master.uri)
-    node_alone(session, master, C.MYDRONE_NODE, '/temperature', C.MYDRONE_ALONE, results)
+    node_alone(run, master, command_list.MYDRONE_NODE, '/temperature', command_list.MYDRONE_ALONE)
 
-    scratch = os.path.join(session.run_dir, 'create_pkg')
+    scratch = os.path.join(run.supervisor.log_dir, 'create_pkg')
     os.makedirs(scratch)
-    output, status, _ = session.run(C.CREATE_PKG, master.env, cwd=scratch)
+    create_pkg = command_list.CREATE_PKG
+    run.run_all(master, [create_pkg], cwd=scratch)
     with open(os.path.join(scratch, 'exam', 'package.xml')) as f:
-        created = f.read()
-    results[C.CREATE_PKG.key] = {'line': C.CREATE_PKG.line, 'output': output, 'status': status,
-                                 'package_xml': created}
+        run.results[create_pkg.key]['package_xml'] = f.read()
 
-    high = Master(session, 'high')
+    high = run.supervisor.start_master('high.master')
     log('default flight on %s, threshold 1500 on %s, %.0f s' % (master.uri, high.uri, run_seconds))
-    bag, launch, started = recorded_run(session, master, C.FLIGHT_RECORD, C.FLIGHT_LAUNCH, '/altitude',
-                                        '/alt_warn_led')
-    high_bag, high_launch, _ = recorded_run(session, high, C.HIGH_RECORD, C.HIGH_LAUNCH, '/altitude',
-                                            '/alt_warn_led')
-    run_all(session, master, C.FLIGHT_LIVE, results)
-    run_all(session, high, C.HIGH_LIVE, results)
+    bag, launch, started = recorded_run(run, master, command_list.FLIGHT_RECORD,
+                                        command_list.FLIGHT_LAUNCH, '/altitude', '/alt_warn_led')
+    high_bag, high_launch, _ = recorded_run(run, high, command_list.HIGH_RECORD,
+                                            command_list.HIGH_LAUNCH, '/altitude', '/alt_warn_led')
+    run.run_all(master, command_list.FLIGHT_LIVE)
+    run.run_all(high, command_list.HIGH_LIVE)
     time.sleep(max(0.0, started + run_seconds - time.time()))
     # The bags first, so they end on the running system rather than on its shutdown.
-    for proc in (bag, high_bag, launch, high_launch):
-        session.stop(proc)
-    for key in (C.FLIGHT_RECORD.key, C.FLIGHT_LAUNCH.key, C.HIGH_RECORD.key, C.HIGH_LAUNCH.key):
-        finish_console(results, key)
-    session.stop(high.proc)
-    session.stop(master.proc)
+    run.stop([bag, high_bag, launch, high_launch],
+             [command_list.FLIGHT_RECORD, command_list.FLIGHT_LAUNCH, command_list.HIGH_RECORD,
+              command_list.HIGH_LAUNCH])
+    run.supervisor.stop(high.proc)
+    run.supervisor.stop(master.proc)
 
 
-def dive(session, run_seconds):
-    results = session.results
-    master = Master(session, 'dive')
+def dive(run, run_seconds):
+    master = run.supervisor.start_master('dive.master')
     log('submarine_drone alone on %s' % master.uri)
-    node_alone(session, master, C.SUBMARINE_NODE, '/pressure_robot', C.SUBMARINE_ALONE, results)
+    node_alone(run, master, command_list.SUBMARINE_NODE, '/pressure_robot',
+               command_list.SUBMARINE_ALONE)
     log('default dive on %s, %.0f s' % (master.uri, run_seconds))
-    bag, launch, started = recorded_run(session, master, C.DIVE_RECORD, C.DIVE_LAUNCH, '/depth',
-                                        '/depth_warn_led')
-    run_all(session, master, C.DIVE_LIVE, results)
+    bag, launch, started = recorded_run(run, master, command_list.DIVE_RECORD,
+                                        command_list.DIVE_LAUNCH, '/depth', '/depth_warn_led')
+    run.run_all(master, command_list.DIVE_LIVE)
     time.sleep(max(0.0, started + run_seconds - time.time()))
-    for proc in (bag, launch):
-        session.stop(proc)
-    for key in (C.DIVE_RECORD.key, C.DIVE_LAUNCH.key):
-        finish_console(results, key)
-    session.stop(master.proc)
+    run.stop([bag, launch], [command_list.DIVE_RECORD, command_list.DIVE_LAUNCH])
+    run.supervisor.stop(master.proc)
 
 
 def main():
@@ -135,15 +154,16 @@ def main():
     for name in ('flight.bag', 'flight_1500.bag', 'dive.bag'):
         if os.path.exists(os.path.join(args.work, name)):
             os.remove(os.path.join(args.work, name))
-    with Session(args.run_dir, args.work) as session:
-        flight(session, args.run_seconds)
-        dive(session, args.run_seconds)
-    missing = [c.key for c in C.ALL if c.key not in session.results]
+    with Supervisor(args.run_dir) as supervisor:
+        run = Run(supervisor, args.work)
+        flight(run, args.run_seconds)
+        dive(run, args.run_seconds)
+    missing = [c.key for c in command_list.ALL if c.key not in run.results]
     if missing:
         sys.exit('report: commands not run: %s' % ', '.join(missing))
     with open(os.path.join(args.work, 'outputs.json'), 'w') as f:
-        json.dump(session.results, f, indent=1, sort_keys=True)
-    log('outputs of %d commands in %s' % (len(session.results), os.path.join(args.work, 'outputs.json')))
+        json.dump(run.results, f, indent=1, sort_keys=True)
+    log('outputs of %d commands in %s' % (len(run.results), os.path.join(args.work, 'outputs.json')))
 
 
 if __name__ == '__main__':

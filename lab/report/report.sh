@@ -18,7 +18,7 @@ mkdir -p "$work"
 if [ "${1:-}" != "--render-only" ]; then
   run_dir="$(mktemp -d /tmp/exam-report.XXXXXX)"
   # Whatever happens, end every process this run started (they carry its folder in their environment).
-  trap '/usr/bin/python3 "$repo/lab/report/session.py" --cleanup "$run_dir"; rm -rf "$run_dir"' EXIT
+  trap '/usr/bin/python3 -m exam_lab.harness.supervisor --cleanup "$run_dir"; rm -rf "$run_dir"' EXIT
   /usr/bin/python3 "$repo/lab/report/collect.py" --work "$work" --run-dir "$run_dir"
 fi
 /usr/bin/python3 "$repo/lab/report/render.py" --work "$work" --repo "$repo"
