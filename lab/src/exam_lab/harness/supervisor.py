@@ -26,6 +26,8 @@ import subprocess
 import sys
 import time
 
+from exam_lab.harness.wait import wait_until
+
 #: Environment variable that marks every process of one supervised run.
 MARKER = 'EXAM_LAB_RUN'
 
@@ -253,7 +255,9 @@ class Supervisor(object):
 
     def stop(self, proc, grace=10.0):
         """Ctrl-C the process group, as a user would; SIGKILL the group and every descendant found
-        beforehand if it is not gone after ``grace`` s. Returns the exit status."""
+        beforehand if it is not gone after ``grace`` s. A leader that exits at once may leave children
+        still finishing their work (``rosbag record``'s recorder closing its bag): they get the rest
+        of the grace period too. Returns the exit status."""
         return self.stop_all([proc], grace)[0]
 
     def stop_all(self, procs, grace=10.0):
@@ -270,6 +274,9 @@ class Supervisor(object):
                 proc.wait(timeout=max(0.0, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
                 pass
+        family = [pid for proc in running for pid in families[proc.pid]]
+        wait_until(lambda: not any(alive(pid) for pid in family), max(0.0, deadline - time.monotonic()),
+                   period=0.1)
         for proc in running:
             # The leader may be gone while a forked child (rosout under roscore) still runs.
             _killpg(proc.pid, signal.SIGKILL)

@@ -1,4 +1,6 @@
-"""Supervisor.stop_all: several process groups stopped in one grace period, no master needed."""
+"""Supervisor.stop and stop_all on plain processes, no master needed."""
+import os
+import sys
 import time
 
 from exam_lab.harness.supervisor import Supervisor, alive, descendants
@@ -26,3 +28,15 @@ def test_stop_all_lets_a_clean_exit_keep_its_status(tmp_path):
         quick.wait()
         polite = sup.start('polite', ['sleep', '60'])
         assert sup.stop_all([quick, polite], grace=5.0) == [3, -2]
+
+
+def test_stop_lets_the_children_of_a_leader_that_is_gone_finish(tmp_path):
+    """As rosbag record: the leader exits on Ctrl-C at once, its child still closes its file."""
+    done = tmp_path / 'closed'
+    child = "trap 'sleep 0.5; touch %s; exit 0' INT; while :; do sleep 0.1; done" % done
+    leader = 'import subprocess; subprocess.Popen(["sh", "-c", %r]).wait()' % child
+    with Supervisor(tmp_path) as sup:
+        proc = sup.start('leader', [sys.executable, '-c', leader])
+        assert wait_until(lambda: len(descendants(proc.pid)) > 0, 5.0)
+        sup.stop(proc, grace=5.0)
+        assert os.path.exists(str(done)), 'the child was killed before it finished'
