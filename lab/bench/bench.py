@@ -2,8 +2,9 @@
 """`make bench`: the exam node against the naive baseline, stage by stage, into docs/benchmarks.md.
 
 Run it through lab/bench/run.sh, which prepares the ROS environment and the log directory, and whose
-trap ends every process of the run should this one die without doing it. BENCH_QUICK=1 shrinks every window to a few seconds (a smoke run while developing) and
-writes to a scratch directory instead of docs/, so a smoke run never replaces the real numbers.
+trap ends every process of the run should this one die without doing it. BENCH_QUICK=1 shrinks every
+window to a few seconds (a smoke run while developing) and writes to a scratch directory instead of
+docs/, so a smoke run never replaces the real numbers.
 """
 
 import argparse
