@@ -138,7 +138,7 @@ class SimulatorNode:
     def _on_warning_request(self, request):
         """Set the LED from ``request.status``; log and publish only on change."""
         with self._led_lock:
-            success, message, changed = self._led.request(request.status)
+            success, message, changed = self._led.apply(request.status)
             if changed:
                 self._led_pub.publish(String(data=self._led.colour))
         if changed:

@@ -6,7 +6,7 @@ unit-tested with a fake service.
 Why a thread (exam question 13 done right): a ROS service call is a blocking round trip to another
 process. It may take seconds, and rospy offers no timeout for it. Called from the 10 Hz publishing loop
 (as the seed's model answer does), one slow call would freeze /altitude. Here the callbacks only *state*
-what the LED should show (:meth:`WarningLink.request`, never blocking) and this worker makes it so.
+what the LED should show (:meth:`WarningLink.want`, never blocking) and this worker makes it so.
 
 Rules:
 - Call only when the LED shows something else than wanted: one call per change of state, none while
@@ -19,7 +19,11 @@ Rules:
 """
 import threading
 
-from exam.debounce import NORMAL
+from exam.debounce import NORMAL, WARNING
+
+#: The colour of the drone's LED in each warning state (the drones' service contract), and back.
+LED_COLOURS = {NORMAL: 'GREEN', WARNING: 'RED'}
+LED_STATES = {colour: state for state, colour in LED_COLOURS.items()}
 
 
 class WarningLink(object):
@@ -57,7 +61,7 @@ class WarningLink(object):
             self._cond.notify()
         self._thread.join(timeout)
 
-    def request(self, state):
+    def want(self, state):
         """Make ``state`` the one the LED should show. Never blocks on the service."""
         with self._cond:
             self._wanted = state
@@ -88,7 +92,7 @@ class WarningLink(object):
                 if self._stopped:
                     return
                 state = self._wanted
-            # The lock is released across the call: callbacks keep requesting while it blocks.
+            # The lock is released across the call: callbacks keep calling want() while it blocks.
             reason = self._attempt(state)
             with self._cond:
                 if reason is None:
@@ -98,7 +102,7 @@ class WarningLink(object):
                 self._failing = True
                 self._failures += 1
                 self._last_error = reason
-                # Pause before the next attempt, so an absent service is not hammered; a new request
+                # Pause before the next attempt, so an absent service is not hammered; a new want()
                 # or stop() ends the pause early.
                 if not self._stopped:
                     self._cond.wait(self._retry_period)

@@ -241,21 +241,33 @@ def _service_registered(resolved_name):
 
 
 class TopicRecorder(object):
-    """Records every Float32 the node under test publishes on ``topic`` as (ROS time of arrival, value).
+    """Records every message on ``topic`` as (ROS time of arrival, ``msg.data``).
 
+    :param msg_type: a message type with a ``data`` field (std_msgs/Float32 by default, String for an
+        LED topic).
     :param queue_size: messages rospy may hold for the recorder when it falls behind, the oldest
         dropped beyond; None keeps every one (the bench, measuring rates up to 1 kHz on a loaded machine).
     """
 
-    def __init__(self, topic, tcp_nodelay=False, queue_size=100):
+    def __init__(self, topic, msg_type=Float32, tcp_nodelay=False, queue_size=100):
         self._lock = threading.Lock()
         self._samples = []
-        self._sub = rospy.Subscriber(topic, Float32, self._callback, queue_size=queue_size,
+        self._sub = rospy.Subscriber(topic, msg_type, self._callback, queue_size=queue_size,
                                      tcp_nodelay=tcp_nodelay)
 
     def samples(self, since=0.0, until=float('inf')):
         with self._lock:
             return [(t, v) for t, v in self._samples if since <= t <= until]
+
+    def values(self):
+        """Every value received so far, in order."""
+        with self._lock:
+            return [v for _, v in self._samples]
+
+    def wait_for_count(self, count, timeout):
+        """The first ``count`` values, or the fewer received by ``timeout`` s."""
+        wait_until(lambda: len(self.values()) >= count, timeout, alive=_alive)
+        return self.values()[:count]
 
     def clear(self):
         with self._lock:
@@ -324,7 +336,7 @@ class Drone(object):
         self.feeder = SensorFeeder({name(topic): rate for topic, rate in rates.items()}, tcp_nodelay)
         self.service = FakeWarningService(name(sheet['service']), sheet['srv'],
                                           name(sheet['led']) if led else None, advertise, on_call)
-        self.output = TopicRecorder(name(sheet['output']), tcp_nodelay, queue_size)
+        self.output = TopicRecorder(name(sheet['output']), tcp_nodelay=tcp_nodelay, queue_size=queue_size)
         fixed_topic, self.fixed_value = sheet['fixed']
         self.fixed_topic = name(fixed_topic)
         self.moving_topic = name(sheet['moving'])

@@ -125,6 +125,21 @@ def _killpg(pgid, sig):
         pass
 
 
+def node_pid(name, master_uri=None, caller='/exam_lab'):
+    """Pid of the running node ``name`` (asked over its XML-RPC API), or None when it is not reachable.
+
+    :param master_uri: the master to ask (default: ROS_MASTER_URI of this process).
+    """
+    import rosgraph
+    from xmlrpc.client import ServerProxy
+    try:
+        uri = rosgraph.Master(caller, master_uri=master_uri).lookupNode(name)
+        code, _msg, pid = ServerProxy(uri).getPid(caller)
+        return pid if code == 1 else None
+    except (IOError, OSError, rosgraph.MasterException):
+        return None
+
+
 class Master(object):
     """One ``roscore`` on a port of its own, and the environment that talks to it.
 
@@ -172,6 +187,10 @@ class Master(object):
     def system_state(self):
         """(publishers, subscribers, services) as the master lists them: [(name, [nodes])] each."""
         return self.graph.getSystemState()
+
+    def node_pid(self, name):
+        """Pid of the node ``name`` registered on this master, or None."""
+        return node_pid(name, self.uri)
 
     def publishers(self, topic):
         return dict(self.system_state()[0]).get(topic, [])
