@@ -36,13 +36,13 @@ test: build
 	@tools/run_tests.sh $(TESTS)
 
 report: build
-	@tools/report.sh
+	@lab/report/report.sh
 
 bench: build
-	@bench/run.sh
+	@lab/bench/run.sh
 
 soak: build
-	@tools/soak.sh
+	@lab/soak/soak.sh
 
 clean:
 	rm -rf .ws

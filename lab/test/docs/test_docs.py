@@ -1,7 +1,7 @@
 """The docs against the code: the report's commands still name things that exist, and every parameter
 the docs name is one the code reads, with exactly that name.
 
-- The commands are those of tools/report/commands.py, the list `make report` runs; the template uses
+- The commands are those of lab/report/command_list.py, the list `make report` runs; the template uses
   every one of them, and the committed docs/report.md shows exactly those lines, in the template's order.
 - Each command parses (shlex), starts an installed program, and names packages, scripts, launch files
   and launch arguments, nodes, topics, services, message and service types and parameters that exist
@@ -24,15 +24,15 @@ import pytest
 import yaml
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
-sys.path.insert(0, os.path.join(REPO, 'tools', 'report'))
+sys.path.insert(0, os.path.join(REPO, 'lab', 'report'))
 
-import commands as C  # noqa: E402  (tools/report is not a package)
+import command_list  # noqa: E402  (lab/report is a script folder, not a package)
 
 from mydrone.simulator import SPEC as MYDRONE  # noqa: E402
 from submarinedrone.simulator import SPEC as SUBMARINE  # noqa: E402
 from exam.modes import MODES  # noqa: E402
 
-TEMPLATE = os.path.join(REPO, 'tools', 'report', 'report_template.md')
+TEMPLATE = os.path.join(REPO, 'lab', 'report', 'report_template.md')
 REPORT = os.path.join(REPO, 'docs', 'report.md')
 PROGRAMS = {'rosnode', 'rostopic', 'rosmsg', 'rossrv', 'rosservice', 'rosparam', 'rosrun', 'roslaunch',
             'rosbag', 'catkin_create_pkg'}
@@ -53,7 +53,7 @@ READ_SENSOR_PARAM = re.compile(r'\b_param\(\s*\w+\.topic\s*\+\s*[\'"](\w+)[\'"]'
 
 def code_files():
     """The Python files of the nodes: every package's src/ and scripts/, and the bench nodes."""
-    patterns = ['*/src/*/*.py', '*/scripts/*.py', 'bench/*.py']
+    patterns = ['*/src/*/*.py', '*/scripts/*.py', 'lab/bench/*.py']
     return sorted(f for p in patterns for f in glob.glob(os.path.join(REPO, p)))
 
 
@@ -148,24 +148,24 @@ def package_dir(name):
 
 def test_template_uses_every_command_and_only_known_ones():
     used = {key for _, key in template_keys()}
-    assert used - set(C.BY_KEY) == set(), 'the template names commands that commands.py does not run'
-    assert set(C.BY_KEY) - used == set(), 'commands run by make report that the report never shows'
+    assert used - set(command_list.BY_KEY) == set(), 'the template names commands that command_list.py does not run'
+    assert set(command_list.BY_KEY) - used == set(), 'commands run by make report that the report never shows'
 
 
 def test_committed_report_shows_exactly_the_commands_of_the_list():
     shown = [line[2:] for block in re.findall(r'```console\n(.*?)```', read(REPORT), re.S)
              for line in block.splitlines()[:1]]
-    expected = [C.BY_KEY[key].line for kind, key in template_keys() if kind == 'run']
+    expected = [command_list.BY_KEY[key].line for kind, key in template_keys() if kind == 'run']
     assert shown == expected, 'docs/report.md is out of date: run make report'
 
 
 def test_commands_are_unique_per_key_and_bounded():
-    assert len(C.BY_KEY) == len(C.ALL)
-    for command in C.FOREGROUND:
+    assert len(command_list.BY_KEY) == len(command_list.ALL)
+    for command in command_list.FOREGROUND:
         assert command.limit is not None and command.limit > 0, command.key
 
 
-@pytest.mark.parametrize('command', C.ALL, ids=lambda c: c.key)
+@pytest.mark.parametrize('command', command_list.ALL, ids=lambda c: c.key)
 def test_command_starts_an_installed_ros_program(command):
     words = argv(command)
     assert words[0] in PROGRAMS, command.line
@@ -174,7 +174,7 @@ def test_command_starts_an_installed_ros_program(command):
         pytest.fail('%s would run forever: bound it with timeout -s INT or -n' % command.line)
 
 
-@pytest.mark.parametrize('command', C.ALL, ids=lambda c: c.key)
+@pytest.mark.parametrize('command', command_list.ALL, ids=lambda c: c.key)
 def test_command_names_what_exists(command):
     words = argv(command)
     program, args = words[0], words[1:]

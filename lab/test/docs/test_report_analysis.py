@@ -1,4 +1,4 @@
-"""The numbers docs/report.md states are computed by tools/report/analysis.py: its pure parts, checked on
+"""The numbers docs/report.md states are computed by lab/report/analysis.py: its pure parts, checked on
 synthetic series and against the formulas by hand."""
 import os
 import sys
@@ -6,7 +6,7 @@ import sys
 import pytest
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
-sys.path.insert(0, os.path.join(REPO, 'tools', 'report'))
+sys.path.insert(0, os.path.join(REPO, 'lab', 'report'))
 
 import analysis  # noqa: E402
 

@@ -165,6 +165,13 @@ class FakeWarningService(object):
             self._withdrawn = False
         self._service = rospy.Service(self._name, self._srv_class, self._handle)
 
+    def close(self):
+        """Unregister the service, if advertised, without waiting for the master to forget it
+        (:meth:`withdraw` waits): the end of a drone, not a scripted failure."""
+        if self._service is not None:
+            self._service.shutdown('fake drone closed')
+            self._service = None
+
     def withdraw(self):
         """Unregister the service: the node's calls fail as if the drone were gone, also on a
         persistent connection opened before (rospy keeps serving those after a shutdown)."""
@@ -246,12 +253,14 @@ class TopicRecorder(object):
 
     :param msg_type: a message type with a ``data`` field (std_msgs/Float32 by default, String for an
         LED topic).
+    :param queue_size: messages rospy may hold for the recorder when it falls behind, the oldest
+        dropped beyond; None keeps every one (the bench, measuring rates up to 1 kHz on a loaded machine).
     """
 
-    def __init__(self, topic, msg_type=Float32, tcp_nodelay=False):
+    def __init__(self, topic, msg_type=Float32, tcp_nodelay=False, queue_size=100):
         self._lock = threading.Lock()
         self._samples = []
-        self._sub = rospy.Subscriber(topic, msg_type, self._callback, queue_size=100,
+        self._sub = rospy.Subscriber(topic, msg_type, self._callback, queue_size=queue_size,
                                      tcp_nodelay=tcp_nodelay)
 
     def samples(self, since=0.0, until=float('inf')):
@@ -316,18 +325,29 @@ class Drone(object):
     :param rates: dict topic -> Hz, to override the default input rates.
     :param tcp_nodelay: see :class:`SensorFeeder`.
     :param on_call: see :class:`FakeWarningService`.
+    :param namespace: where the node under test lives (``'/latency_ours_3'``): every topic and the
+        service are resolved in it rather than in this node's namespace, so one process can play the
+        drone of several nodes (the bench). ``rates`` still takes the sheet's relative topic names;
+        :attr:`fixed_topic` and :attr:`moving_topic` are the resolved ones.
+    :param queue_size: of the output recorder, see :class:`TopicRecorder`.
     """
 
     def __init__(self, mode='altitude', advertise=True, led=True, rates=None, tcp_nodelay=False,
-                 on_call=None):
+                 on_call=None, namespace='', queue_size=100):
         sheet = SHEETS[mode]
         self.mode = mode
-        self.feeder = SensorFeeder(dict(sheet['rates'], **(rates or {})), tcp_nodelay)
-        self.service = FakeWarningService(sheet['service'], sheet['srv'],
-                                          sheet['led'] if led else None, advertise, on_call)
-        self.output = TopicRecorder(sheet['output'], tcp_nodelay=tcp_nodelay)
-        self.fixed_topic, self.fixed_value = sheet['fixed']
-        self.moving_topic = sheet['moving']
+
+        def name(relative):
+            return namespace.rstrip('/') + '/' + relative if namespace else relative
+
+        rates = dict(sheet['rates'], **(rates or {}))
+        self.feeder = SensorFeeder({name(topic): rate for topic, rate in rates.items()}, tcp_nodelay)
+        self.service = FakeWarningService(name(sheet['service']), sheet['srv'],
+                                          name(sheet['led']) if led else None, advertise, on_call)
+        self.output = TopicRecorder(name(sheet['output']), tcp_nodelay=tcp_nodelay, queue_size=queue_size)
+        fixed_topic, self.fixed_value = sheet['fixed']
+        self.fixed_topic = name(fixed_topic)
+        self.moving_topic = name(sheet['moving'])
 
     def input_for(self, value):
         """The moving input that puts the drone at ``value`` m."""
@@ -382,6 +402,7 @@ class Drone(object):
     def close(self):
         self.feeder.close()
         self.output.close()
+        self.service.close()
 
 
 class DroneScenario(unittest.TestCase):

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """`make bench`: the exam node against the naive baseline, stage by stage, into docs/benchmarks.md.
 
-Run it through bench/run.sh, which prepares the ROS environment, the log directory and the pid file
-its trap uses. BENCH_QUICK=1 shrinks every window to a few seconds (a smoke run while developing) and
-writes to a scratch directory instead of docs/, so a smoke run never replaces the real numbers.
+Run it through lab/bench/run.sh, which prepares the ROS environment and the log directory, and whose
+trap ends every process of the run should this one die without doing it. BENCH_QUICK=1 shrinks every
+window to a few seconds (a smoke run while developing) and writes to a scratch directory instead of
+docs/, so a smoke run never replaces the real numbers.
 """
 
 import argparse
@@ -15,6 +16,8 @@ import signal
 import subprocess
 import sys
 import time
+
+from exam_lab.harness.supervisor import Supervisor
 
 import driver
 import procs
@@ -109,7 +112,7 @@ def run_stages(lab, cfg, kinds, profiler, wanted=STAGES):
                                           stages.memory_floor, lab)
         if 'ours' in kinds:
             results['ours_without_numpy'] = guarded(
-                'ours without numpy (bench/without_numpy.py): rate, CPU and RSS over %d s'
+                'ours without numpy (lab/bench/without_numpy.py): rate, CPU and RSS over %d s'
                 % cfg['floor_window'],
                 stages.rate_and_cost, lab, 'ours_without_numpy', cfg['floor_window'])
     if 'latency' in wanted:
@@ -155,8 +158,7 @@ def main(argv):
     parser.add_argument('--out', required=True, help='directory that receives benchmarks.md')
     parser.add_argument('--figure', required=True, help='path of the fleet plot (PNG)')
     parser.add_argument('--json', required=True, help='path of the raw results (JSON)')
-    parser.add_argument('--log-dir', help='where the nodes write their output')
-    parser.add_argument('--pid-file', help='process groups, for run.sh to clean up')
+    parser.add_argument('--log-dir', help='where the nodes write their output (required to measure)')
     parser.add_argument('--py-spy', default=None, help='py-spy executable: profile missed goals')
     parser.add_argument('--stages', default=','.join(STAGES),
                         help='comma-separated subset of %s (a targeted experiment)' % ', '.join(STAGES))
@@ -172,6 +174,8 @@ def main(argv):
         with open(args.json) as f:
             write_report(json.load(f), args)
         return 0
+    if not args.log_dir:
+        parser.error('--log-dir is required to measure')
     cfg = QUICK if args.quick else FULL
     signal.signal(signal.SIGTERM, _on_sigterm)
 
@@ -182,13 +186,12 @@ def main(argv):
     if not stages.available(stages.SCRIPTS['ours']):
         progress('ours: %s is missing, measuring the baseline only' % stages.SCRIPTS['ours'])
         kinds = ['baseline']
-    env = dict(os.environ, ROS_LOG_DIR=args.log_dir, PYTHONUNBUFFERED='1')
-    children = procs.Children(args.pid_file, args.log_dir)
+    supervisor = Supervisor(args.log_dir)
     try:
-        _, uri = procs.start_master(children, env)
-        progress('master at %s, node output in %s' % (uri, args.log_dir))
-        driver.init(uri)
-        lab = stages.Lab(children, uri, env)
+        master = supervisor.start_master()
+        progress('master at %s, node output in %s' % (master.uri, args.log_dir))
+        driver.init(master.uri)
+        lab = stages.Lab(supervisor, master)
         profiler = None
         if args.py_spy:
             profiler = profiling.Profiler(args.py_spy, args.log_dir, cfg['profile_window'],
@@ -197,7 +200,7 @@ def main(argv):
     finally:
         import rospy
         rospy.signal_shutdown('bench over')
-        children.stop()
+        supervisor.close()
     info['loadavg_end'] = procs.loadavg()
     results.update(machine=info, config=cfg, quick=args.quick, date=date, command=args.command,
                    duration_s=time.monotonic() - t0)

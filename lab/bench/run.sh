@@ -1,19 +1,17 @@
 #!/usr/bin/env bash
-# `make bench`: measures the exam node against bench/baseline_exam_node.py and writes
+# `make bench`: measures the exam node against lab/bench/baseline_exam_node.py and writes
 # docs/benchmarks.md and docs/figures/bench_fleet.png (about 10 minutes, 15 with BENCH_PROFILE=1).
-#   BENCH_QUICK=1    a few seconds per stage; results go to .ws/bench-quick/, docs/ is untouched
-#   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet), also to .ws/bench-quick/
+#   BENCH_QUICK=1    a few seconds per stage; results go to $EXAM_WS/bench-quick/, docs/ is untouched
+#   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet), also to $EXAM_WS/bench-quick/
 #   BENCH_PROFILE=1  also profile ours with py-spy (installed from PyPI into a throwaway directory)
 #   BENCH_RENDER_ONLY=1  measure nothing: render the docs again from the last results
-# Every process it starts runs in its own process group listed in a pid file; the trap kills exactly
-# those groups on exit, error or Ctrl-C, so nothing outlives the run.
+# Every process it starts carries the run's log folder in its environment (exam_lab's supervisor); the
+# trap ends exactly those on exit, error or Ctrl-C, so nothing outlives the run.
 set -euo pipefail
-repo="$(cd "$(dirname "$0")/.." && pwd)"
+repo="$(cd "$(dirname "$0")/../.." && pwd)"
 source "$repo/tools/env.sh"
 
 scratch="$(mktemp -d /tmp/exam-bench.XXXXXX)"
-pid_file="$scratch/pids"
-touch "$pid_file"
 bench_pid=""
 
 cleanup() {
@@ -23,10 +21,8 @@ cleanup() {
     kill -TERM "$bench_pid" 2>/dev/null || true
     wait "$bench_pid" 2>/dev/null || true
   fi
-  # Whatever bench.py could not stop itself (it was killed hard): its children's process groups.
-  while read -r pgid; do
-    kill -KILL -- "-$pgid" 2>/dev/null || true
-  done < "$pid_file"
+  # Whatever bench.py could not stop itself (it was killed hard): every process marked with its logs.
+  /usr/bin/python3 -m exam_lab.harness.supervisor --cleanup "$scratch/logs" || true
   if [ "$status" -eq 0 ]; then
     rm -rf "$scratch"
   else
@@ -38,7 +34,7 @@ trap cleanup EXIT
 trap 'exit 130' INT TERM
 
 mkdir -p "$scratch/logs"
-args=(--log-dir "$scratch/logs" --pid-file "$pid_file")
+args=(--log-dir "$scratch/logs")
 # The exact command, as the report prints it: the BENCH_ variables change what is measured.
 command="$({ env | grep -E '^BENCH_(QUICK|PROFILE|STAGES)=' || true; } | sort | tr '\n' ' ')make bench"
 if [ "$EXAM_WS" != "$repo/.ws" ]; then
@@ -48,7 +44,7 @@ if [ -n "${BENCH_STAGES:-}" ]; then
   args+=(--stages "$BENCH_STAGES")
 fi
 if [ "${BENCH_QUICK:-0}" = 1 ] || [ -n "${BENCH_STAGES:-}" ]; then
-  out="$repo/.ws/bench-quick"
+  out="$EXAM_WS/bench-quick"
   mkdir -p "$out"
   if [ "${BENCH_QUICK:-0}" = 1 ]; then
     args+=(--quick)
@@ -57,12 +53,12 @@ if [ "${BENCH_QUICK:-0}" = 1 ] || [ -n "${BENCH_STAGES:-}" ]; then
          --command "$command")
 else
   args+=(--out "$repo/docs" --figure "$repo/docs/figures/bench_fleet.png"
-         --json "$repo/bench/results.json" --command "$command")
+         --json "$repo/lab/bench/results.json" --command "$command")
 fi
 
 if [ "${BENCH_RENDER_ONLY:-0}" = 1 ]; then
-  # After editing bench/analysis.md or report.py: the same numbers, rendered again.
-  /usr/bin/python3 "$repo/bench/bench.py" "${args[@]}" --render-only
+  # After editing lab/bench/analysis.md or report.py: the same numbers, rendered again.
+  /usr/bin/python3 "$repo/lab/bench/bench.py" "${args[@]}" --render-only
   exit 0
 fi
 if [ "${BENCH_PROFILE:-0}" = 1 ]; then
@@ -72,6 +68,6 @@ if [ "${BENCH_PROFILE:-0}" = 1 ]; then
 fi
 
 # In the background so the trap runs at once on Ctrl-C instead of after the stage in progress.
-/usr/bin/python3 "$repo/bench/bench.py" "${args[@]}" &
+/usr/bin/python3 "$repo/lab/bench/bench.py" "${args[@]}" &
 bench_pid=$!
 wait "$bench_pid"

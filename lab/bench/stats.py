@@ -1,7 +1,8 @@
 """Statistics of the benchmark: stream timing, warning latency, CPU share, crossing script, profiles.
 
-No rospy here, so every number the report prints is computed by code the unit tests in bench/test/
-drive with synthetic timestamps. All times are seconds of ROS time as floats.
+No rospy here, so every number the report prints is computed by code the unit tests in
+lab/test/unit/test_bench_stats.py drive with synthetic timestamps. All times are seconds of ROS time
+as floats.
 """
 
 import collections
@@ -121,12 +122,6 @@ def crossing_script(count, delay, hold, rng, below=1000.0, above=1600.0):
 def new_rng(seed):
     """A private RNG, so the script does not depend on who else drew from the global one."""
     return random.Random(seed)
-
-
-def pressure_at(altitude, temperature_c):
-    """Pressure (Pa) that the exam node turns back into ``altitude`` (m): equation (1) of the seed."""
-    p0, mu, g, r = 101325.0, 0.0289644, 9.80665, 8.31432
-    return p0 * math.exp(-mu * g * altitude / (r * (temperature_c + 273.15)))
 
 
 def cpu_percent(ticks, seconds, clock_ticks):

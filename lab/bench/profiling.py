@@ -2,7 +2,7 @@
 
 py-spy reads the node's memory from outside (``--nonblocking``: it never pauses the process), so the
 profile shows the node as it runs, every thread included: rospy's receive threads, the timer, the
-service worker. bench/run.sh installs py-spy into a throwaway directory only when asked.
+service worker. lab/bench/run.sh installs py-spy into a throwaway directory only when asked.
 """
 
 import os

@@ -106,7 +106,7 @@ def render(r, figure_rel):
             'engineers ran builds and tests meanwhile, so CPU figures include their interference.'
             % (m['loadavg_start'], m['loadavg_end']), '']
     out += ['## Summary', '',
-            '"ours" is `exam/scripts/exam_node.py`; "baseline" is `bench/baseline_exam_node.py`, the '
+            '"ours" is `exam/scripts/exam_node.py`; "baseline" is `lab/bench/baseline_exam_node.py`, the '
             'naive node of the seed\'s grader solution (globals, one `rospy.Rate(10)` loop that '
             'publishes and calls the service synchronously, the delay as a count of iterations). '
             'Ratio is ours/baseline.' + (
@@ -116,20 +116,20 @@ def render(r, figure_rel):
             _table(['metric', 'ours', 'baseline', 'ratio', 'goal', 'ours vs goal'], goal_rows(r)), '']
     out += ['## How to run', '',
             '`make bench` (about 10 minutes; prints one line per stage). `BENCH_QUICK=1 make bench` '
-            'is a smoke run of about 2 minutes that writes to `.ws/bench-quick/` and leaves this file '
-            'alone, as does `BENCH_STAGES=rate,latency make bench` (a subset of rate, latency, slow, '
-            'max_rate, fleet). `BENCH_PROFILE=1 make bench` (about 15 minutes) also profiles the exam '
-            'node with py-spy and, when the interval sd misses its goal, runs the jitter experiment. '
-            '`BENCH_RENDER_ONLY=1 make bench` renders this file again from `bench/results.json`. '
-            'The benchmark is not part of `make test`; its statistics have unit tests: '
-            '`/usr/bin/python3 -m pytest bench/test`.', '']
+            'is a smoke run of about 2 minutes that writes to `$EXAM_WS/bench-quick/` (`.ws/` by '
+            'default) and leaves this file alone, as does `BENCH_STAGES=rate,latency make bench` (a '
+            'subset of rate, latency, slow, max_rate, fleet). `BENCH_PROFILE=1 make bench` (about 15 '
+            'minutes) also profiles the exam node with py-spy and, when the interval sd misses its '
+            'goal, runs the jitter experiment. `BENCH_RENDER_ONLY=1 make bench` renders this file '
+            'again from `lab/bench/results.json`. The benchmark is not part of `make test`; its '
+            'statistics have unit tests: `lab/test/unit/test_bench_stats.py`.', '']
     out += _method(r)
     out += _floor(r)
     out += _max_rate(r)
     out += _fleet(r, figure_rel)
     out += _errors(r)
     if r.get('analysis'):
-        out += ['## What bounds each result (hand-written: bench/analysis.md)', '',
+        out += ['## What bounds each result (hand-written: lab/bench/analysis.md)', '',
                 r['analysis'].strip(), '']
     if r.get('profile'):
         out += _profile(r['profile'])
@@ -165,7 +165,7 @@ def _method(r):
             'each pair in its own namespace on one master, %d s window after all pairs publish. The '
             'bench starts the nodes itself, in namespaces never reused, instead of through '
             '`exam/scripts/fleet_launch.py`, whose names repeat from one fleet to the next: see '
-            '`fleet()` in bench/stages.py for the rospy hazard that made a reused name kill a node '
+            '`fleet()` in lab/bench/stages.py for the rospy hazard that made a reused name kill a node '
             'of the next fleet.' % c['fleet_window'], '']
 
 
@@ -174,7 +174,7 @@ def _floor(r):
     if not f or 'error' in f:
         return []
     out = ['## Floor: the cheapest rospy node', '',
-           '`bench/floor_node.py` subscribes both inputs and publishes a constant at 10 Hz with a '
+           '`lab/bench/floor_node.py` subscribes both inputs and publishes a constant at 10 Hz with a '
            '`rospy.Timer`, nothing else: CPU %s %% of a core, RSS %s MB, interval sd %s ms (%d s '
            'window). No rospy node doing this job with rospy\'s usual imports can cost less here.'
            % (_fmt(f['cpu_percent']), _fmt(f['rss_mb'], 1), _fmt(f['sd_ms'], 3), f['window_s']), '']
@@ -184,7 +184,7 @@ def _floor(r):
                 _table(['step', 'RSS (MB)'], [(label, _fmt(mb, 1)) for label, mb in steps]), '']
     lean = r.get('ours_without_numpy')
     if isinstance(lean, dict) and 'error' not in lean:
-        out += ['The exam node itself run through `bench/without_numpy.py` (numpy unimportable, so '
+        out += ['The exam node itself run through `lab/bench/without_numpy.py` (numpy unimportable, so '
                 'genpy takes its fallback): RSS %s MB, CPU %s %% of a core, rate %s Hz, interval sd '
                 '%s ms (%d s window).' % (_fmt(lean['rss_mb'], 1), _fmt(lean['cpu_percent']),
                                           _fmt(lean['rate_hz'], 4), _fmt(lean['sd_ms'], 3),
@@ -284,7 +284,7 @@ def _jitter(runs):
              _fmt(x.get('dev_p99_ms'), 3), _fmt(x.get('max_gap_ms'), 1), _fmt(x.get('cpu_percent'), 2),
              _fmt(x.get('machine_busy_percent'), 0)) for x in runs]
     return ['Jitter experiment: each variant at 10 Hz, %d s each, variants interleaved round by round '
-            '(floor, synchronous publish = `bench/floor_node.py _synchronous:=true`):'
+            '(floor, synchronous publish = `lab/bench/floor_node.py _synchronous:=true`):'
             % runs[0].get('window_s', 0), '',
             _table(['variant', 'interval sd (ms)', 'off the mean, median (ms)',
                     'off the mean, p99 (ms)', 'max gap (ms)', 'CPU (% core)',

@@ -5,7 +5,7 @@ Usage: render.py --work DIR --repo DIR   (DIR of collect.py: outputs.json and th
 
 The template is Markdown with placeholders, each replaced by something this run produced:
 
-- ``{{run KEY}}``: a console block with the command line of commands.py and its real output;
+- ``{{run KEY}}``: a console block with the command line of command_list.py and its real output;
 - ``{{line KEY}}``: the command line alone (a background command: a launch, a recording);
 - ``{{value NAME}}``: a number or short text computed from the run (see :func:`facts`);
 - ``{{block NAME}}``: a preformatted block computed from the run (log excerpts, comparisons);
@@ -23,19 +23,16 @@ import re
 import shlex
 import socket
 import subprocess
-import sys
 import textwrap
 import time
 import xml.etree.ElementTree as ET
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from exam import formulas
+from mydrone import atmosphere
 
-import analysis  # noqa: E402
-import commands as C  # noqa: E402
-import figures  # noqa: E402
-
-from exam import formulas  # noqa: E402
-from mydrone import atmosphere  # noqa: E402
+import analysis
+import command_list
+import figures
 
 PLACEHOLDER = re.compile(r'\{\{(run|line|value|block|file|source) ([^ }]+)\}\}')
 ANSI = re.compile(r'\x1b\][^\x07\x1b]*(\x07|\x1b\\)?|\x1b\[[0-9;]*[A-Za-z]|\][0-9];[^\n]*?(?=\n|$)')
@@ -220,11 +217,11 @@ def render(template, outputs, values, blocks, repo):
         kind, key = match.groups()
         if kind == 'run':
             result = outputs[key]
-            if C.BY_KEY[key].line != result['line']:
-                raise KeyError('%s: outputs.json is older than commands.py, run make report' % key)
+            if command_list.BY_KEY[key].line != result['line']:
+                raise KeyError('%s: outputs.json is older than command_list.py, run make report' % key)
             return fence('$ %s\n%s' % (result['line'], clean(result['output'])), 'console')
         if kind == 'line':
-            return '`%s`' % C.BY_KEY[key].line
+            return '`%s`' % command_list.BY_KEY[key].line
         if kind == 'value':
             return values[key]
         if kind == 'block':

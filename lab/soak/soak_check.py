@@ -1,32 +1,33 @@
 #!/usr/bin/env python3
-"""The two halves of `make soak` that are not shell: sampling the exam node's memory while the flight
-runs, and checking the recorded bag offline afterwards.
+"""The measuring halves of `make soak` (soak.py runs the flight): sampling the exam node's memory while
+the flight runs, and checking the recorded bag offline afterwards, which also works on its own:
 
-    soak_check.py sample --seconds S --csv RSS.csv [--node /exam] [--period 5]
     soak_check.py check --bag SOAK.bag --rss RSS.csv [--threshold 1300] [--delay 5] [--node /exam]
 
 `check` replays nothing: it reads /altitude, /alt_warn_led and /rosout from the bag and
-- applies the debounce rule of the exam sheets (question 14b) to the published /altitude values, with an
-  oracle written here from the rule's text, independently of exam.debounce;
+- applies the debounce rule of the exam sheets (question 14b) to the published /altitude values, with
+  the harness's oracle (exam_lab.harness.oracle.debounce_transitions), written from the rule's text
+  independently of exam.debounce;
 - matches every LED change (the drone's latched alt_warn_led) and every delivered service call (the exam
   node's "LED set to ..." log line on /rosout) against the oracle's transitions, in order and in time;
 - reports any transition lost (oracle without LED change) or repeated (two equal calls in a row);
 - compares the exam node's resident memory at the start and the end of the run.
 It prints the figures and exits non-zero on any mismatch, or when the run saw no WARNING at all.
 
-The pure functions (oracle, matching, memory trend) take plain lists and are unit-tested in
-exam/test/ops/test_soak_check.py.
+The pure functions (matching, memory trend) take plain lists and are unit-tested in
+lab/test/unit/test_soak_check.py.
 """
 import argparse
 import csv
-import os
 import re
 import statistics
 import sys
 import time
 import xmlrpc.client
 
-NORMAL, WARNING = 'NORMAL', 'WARNING'
+from exam_lab.harness.oracle import NORMAL, WARNING, debounce_transitions
+from exam_lab.harness.wait import wait_until
+
 LED_STATE = {'GREEN': NORMAL, 'RED': WARNING}
 #: A delivered call, as the exam node logs it (exam/src/exam/node.py, _on_call_delivered).
 CALL_LOG = re.compile(r'LED set to (NORMAL|WARNING)\s*$')
@@ -36,32 +37,6 @@ TOLERANCE_S = 0.5
 #: Memory growth that counts as a leak between the start and the end of the run [KiB], or 3 %.
 RSS_SLACK_KIB = 2048
 RSS_SLACK_RATIO = 0.03
-
-
-def debounce_oracle(readings, threshold, delay):
-    """Transitions [(time, state)] the rule demands for readings [(time s, value)] in time order.
-
-    The rule, from the exam sheets: the state starts NORMAL; it turns WARNING once the value has been
-    above the threshold continuously for `delay` seconds, counted from the first reading above it (any
-    reading at or below cancels the count); it turns NORMAL at the first reading at or below the
-    threshold. A WARNING is due at the instant the delay expires, even between two readings.
-    """
-    transitions = []
-    state = NORMAL
-    excess_since = None
-    for t, value in readings:
-        if state == NORMAL and excess_since is not None and t >= excess_since + delay:
-            state = WARNING
-            transitions.append((excess_since + delay, WARNING))
-        if value > threshold:
-            if excess_since is None:
-                excess_since = t
-        else:
-            excess_since = None
-            if state == WARNING:
-                state = NORMAL
-                transitions.append((t, NORMAL))
-    return transitions
 
 
 def changes(events):
@@ -142,20 +117,19 @@ def read_rss_kib(pid):
     raise ValueError('no VmRSS for pid %d' % pid)
 
 
-def sample(args):
-    master = os.environ['ROS_MASTER_URI']
-    deadline = time.monotonic() + 60.0
-    pid = node_pid(master, args.node)
-    while pid is None and time.monotonic() < deadline:
-        time.sleep(0.5)
-        pid = node_pid(master, args.node)
+def sample(master_uri, node, seconds, csv_path, period=5.0):
+    """Write the resident memory of ``node`` every ``period`` s for ``seconds`` s to ``csv_path``.
+
+    Returns 0, or 1 when the node never came up (60 s) or died meanwhile.
+    """
+    pid = wait_until(lambda: node_pid(master_uri, node), 60.0, period=0.5)
     if pid is None:
-        print('soak: %s never came up' % args.node, file=sys.stderr)
+        print('soak: %s never came up' % node, file=sys.stderr)
         return 1
     print('soak: sampling the memory of %s (pid %d) every %.0f s for %.0f s'
-          % (args.node, pid, args.period, args.seconds))
+          % (node, pid, period, seconds), flush=True)
     start = time.monotonic()
-    with open(args.csv, 'w', newline='') as out:
+    with open(csv_path, 'w', newline='') as out:
         writer = csv.writer(out)
         writer.writerow(['elapsed_s', 'rss_kib'])
         while True:
@@ -163,12 +137,12 @@ def sample(args):
             try:
                 writer.writerow(['%.1f' % elapsed, read_rss_kib(pid)])
             except (OSError, ValueError):
-                print('soak: %s (pid %d) died after %.0f s' % (args.node, pid, elapsed), file=sys.stderr)
+                print('soak: %s (pid %d) died after %.0f s' % (node, pid, elapsed), file=sys.stderr)
                 return 1
             out.flush()
-            if elapsed >= args.seconds:
+            if elapsed >= seconds:
                 return 0
-            time.sleep(min(args.period, max(0.0, args.seconds - elapsed)))
+            time.sleep(min(period, max(0.0, seconds - elapsed)))
 
 
 # --- offline check ----------------------------------------------------------------------------------
@@ -191,22 +165,23 @@ def read_bag(path, node):
     return readings, leds, calls
 
 
-def check(args):
-    readings, leds, calls = read_bag(args.bag, args.node)
+def check(bag, rss_csv, threshold, delay, node='/exam'):
+    """Check the soak run recorded in ``bag`` and ``rss_csv``; print the figures; 0 when it passes."""
+    readings, leds, calls = read_bag(bag, node)
     if not readings:
-        print('soak: FAIL, no /altitude in %s' % args.bag)
+        print('soak: FAIL, no /altitude in %s' % bag)
         return 1
     # Times from the first /altitude on, so every figure and failure reads as "s into the run".
     t0 = readings[0][0]
     readings, leds, calls = ([(t - t0, value) for t, value in events] for events in (readings, leds, calls))
     duration = readings[-1][0]
-    expected = debounce_oracle(readings, args.threshold, args.delay)
+    expected = debounce_transitions(readings, threshold, delay)
     # The LED starts GREEN (NORMAL) before any call: its first, latched message is no transition.
     led_changes = changes([(float('-inf'), NORMAL)] + leds)[1:]
     led_errors, led_problems = match(expected, led_changes)
     call_errors, call_problems = match(expected, calls)
     repeated = repeats(calls)
-    with open(args.rss, newline='') as src:
+    with open(rss_csv, newline='') as src:
         rss = [(float(row['elapsed_s']), int(row['rss_kib'])) for row in csv.DictReader(src)]
     rss_start, rss_end, growth, leak = rss_trend(rss)
 
@@ -218,7 +193,7 @@ def check(args):
     warnings = sum(1 for _t, state in expected if state == WARNING)
     print('soak: %.1f min recorded, %d /altitude messages (%.2f Hz), threshold %.1f m, delay %.1f s'
           % (duration / 60.0, len(readings), (len(readings) - 1) / duration if duration else 0.0,
-             args.threshold, args.delay))
+             threshold, delay))
     print('soak: oracle %d transitions (%d WARNING); LED %d changes (timing %s); calls %d (timing %s); '
           '%d repeated calls' % (len(expected), warnings, len(led_changes), spread(led_errors),
                                  len(calls), spread(call_errors), len(repeated)))
@@ -244,11 +219,6 @@ def check(args):
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     sub = parser.add_subparsers(dest='command', required=True)
-    sampler = sub.add_parser('sample', help='sample the RSS of a node while it runs')
-    sampler.add_argument('--seconds', type=float, required=True)
-    sampler.add_argument('--csv', required=True)
-    sampler.add_argument('--node', default='/exam')
-    sampler.add_argument('--period', type=float, default=5.0)
     checker = sub.add_parser('check', help='check a soak bag offline')
     checker.add_argument('--bag', required=True)
     checker.add_argument('--rss', required=True)
@@ -256,7 +226,7 @@ def main(argv):
     checker.add_argument('--delay', type=float, default=5.0)
     checker.add_argument('--node', default='/exam')
     args = parser.parse_args(argv)
-    return sample(args) if args.command == 'sample' else check(args)
+    return check(args.bag, args.rss, args.threshold, args.delay, args.node)
 
 
 if __name__ == '__main__':

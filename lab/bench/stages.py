@@ -1,8 +1,8 @@
 """The measurements of `make bench`, one function per stage, each for one kind of node.
 
-A kind is ``ours`` (exam/scripts/exam_node.py), ``baseline`` (bench/baseline_exam_node.py), ``floor``
-(bench/floor_node.py, the cheapest rospy node with the same topics) or ``ours_without_numpy`` (ours
-through bench/without_numpy.py, the memory experiment). Every stage starts its node(s) in a namespace
+A kind is ``ours`` (exam/scripts/exam_node.py), ``baseline`` (lab/bench/baseline_exam_node.py), ``floor``
+(lab/bench/floor_node.py, the cheapest rospy node with the same topics) or ``ours_without_numpy`` (ours
+through lab/bench/without_numpy.py, the memory experiment). Every stage starts its node(s) in a namespace
 of its own, measures, stops them, and returns a plain dict that report.py renders.
 """
 
@@ -10,7 +10,7 @@ import os
 import subprocess
 import time
 
-import rosgraph
+from exam_lab.harness.wait import wait_until
 
 import driver
 import procs
@@ -18,7 +18,7 @@ import stats
 
 PYTHON = '/usr/bin/python3'
 BENCH = os.path.dirname(os.path.abspath(__file__))
-REPO = os.path.dirname(BENCH)
+REPO = os.path.dirname(os.path.dirname(BENCH))
 SCRIPTS = {
     'ours': os.path.join(REPO, 'exam', 'scripts', 'exam_node.py'),
     'baseline': os.path.join(BENCH, 'baseline_exam_node.py'),
@@ -44,12 +44,12 @@ def available(path):
 
 
 class Lab:
-    """What every stage needs: the master, the child processes and the environment of the nodes."""
+    """What every stage needs: the harness's supervisor of the child processes and their master."""
 
-    def __init__(self, children, uri, env):
-        self.children = children
-        self.uri = uri
-        self.env = dict(env, ROS_MASTER_URI=uri)
+    def __init__(self, supervisor, master):
+        self.supervisor = supervisor
+        self.master = master
+        self.env = master.env
         self._serial = 0
 
     def namespace(self, stage, kind):
@@ -60,40 +60,36 @@ class Lab:
         command = COMMANDS[kind] if kind in COMMANDS else [SCRIPTS[kind]]
         argv = [PYTHON] + command + ['__ns:=' + ns, '__name:=exam']
         argv += ['_%s:=%s' % (k, v) for k, v in sorted(params.items())]
-        return self.children.start(ns.strip('/') + '_exam', argv, self.env)
+        return self.supervisor.start(ns.strip('/') + '_exam', argv, self.env)
 
     def start_simulator(self, ns):
         argv = [PYTHON, SIMULATOR, '__ns:=' + ns, '__name:=mydrone']
-        return self.children.start(ns.strip('/') + '_mydrone', argv, self.env)
+        return self.supervisor.start(ns.strip('/') + '_mydrone', argv, self.env)
 
 
 class Rig:
-    """One node under test with the bench as its drone: player, fake service, altitude monitor."""
+    """One node under test with the bench as its drone (the harness's fake drone) and a script to fly."""
 
     def __init__(self, lab, kind, ns, steps, slow=0.0, **params):
         self.lab = lab
-        self.service = driver.FakeWarningService(ns + '/altitude_warning', slow)
-        self.monitor = driver.StreamMonitor(ns + '/altitude')
-        self.player = driver.Player(ns, steps)
+        self.drone = driver.drone(ns, slow)
+        self.player = driver.Player(self.drone, steps)
         self.proc = lab.start_node(kind, ns, **params)
 
     def start(self):
         """Play the script once the node is subscribed; raise if it never publishes."""
-        deadline = time.monotonic() + STARTUP_TIMEOUT
-        while not self.player.connected():
-            if self.proc.poll() is not None or time.monotonic() > deadline:
-                raise RuntimeError('node %s did not subscribe (exit code %s)'
-                                   % (self.proc.args, self.proc.poll()))
-            time.sleep(0.05)
+        if not wait_until(self.drone.feeder.connected, STARTUP_TIMEOUT,
+                          alive=lambda: self.proc.poll() is None):
+            raise RuntimeError('node %s did not subscribe (exit code %s)'
+                               % (self.proc.args, self.proc.poll()))
         self.player.start()
-        if not self.monitor.wait_first(STARTUP_TIMEOUT):
+        if self.drone.output.wait_for(lambda value: True, STARTUP_TIMEOUT) is None:
             raise RuntimeError('node %s published no altitude' % (self.proc.args,))
 
     def close(self):
-        self.lab.children.stop([self.proc])
+        self.lab.supervisor.stop(self.proc, grace=5.0)
         self.player.stop()
-        self.monitor.close()
-        self.service.close()
+        self.drone.close()
 
 
 def rate_and_cost(lab, kind, window, rate=None, during=None, **extra):
@@ -109,7 +105,7 @@ def rate_and_cost(lab, kind, window, rate=None, during=None, **extra):
     try:
         rig.start()
         time.sleep(1.0)  # past the first messages' connection setup
-        rig.monitor.reset()
+        rig.drone.output.clear()
         cpu = procs.CpuWindow([rig.proc.pid])
         cpu.start()
         if during is None:
@@ -117,7 +113,7 @@ def rate_and_cost(lab, kind, window, rate=None, during=None, **extra):
         else:
             during(rig.proc.pid, window)
         usage = cpu.stop()[rig.proc.pid]
-        result = stats.interval_stats(rig.monitor.stamps())
+        result = stats.interval_stats(driver.stamps(rig.drone.output))
         result.update(cpu_percent=usage, rss_mb=_mb(procs.rss_kb(rig.proc.pid)),
                       machine_busy_percent=cpu.machine_busy(), window_s=window,
                       loadavg=procs.loadavg())
@@ -137,13 +133,15 @@ def latency(lab, kind, count, delay, hold, seed, slow=0.0):
               threshold=THRESHOLD, delay=delay)
     try:
         rig.start()
-        rig.monitor.reset()
+        rig.drone.output.clear()
         # The last NORMAL call may wait behind a slow call already in flight.
         time.sleep(steps[-1][0] + hold + 2 * slow + 1.0)
         stamps = rig.player.step_stamps
         # Step 0 is the initial reading below; then pairs (above, back below).
         cycles = list(zip(stamps[1::2], stamps[2::2]))
-        warning, normal, anomalies = stats.match_warning_calls(cycles, rig.service.calls(), delay)
+        # Every call as it arrived, before the slow service's delay.
+        calls = rig.drone.service.attempts()
+        warning, normal, anomalies = stats.match_warning_calls(cycles, calls, delay)
         return {
             'excursions': len(cycles),
             'delay_s': delay,
@@ -152,7 +150,7 @@ def latency(lab, kind, count, delay, hold, seed, slow=0.0):
             'normal': stats.summarize_ms(normal),
             'anomalies': anomalies,
             'anomaly_count': len(anomalies),
-            'stream': stats.interval_stats(rig.monitor.stamps()),
+            'stream': stats.interval_stats(driver.stamps(rig.drone.output)),
             'loadavg': procs.loadavg(),
         }
     finally:
@@ -179,24 +177,24 @@ def fleet(lab, kind, count, window):
         pids[ns + '/mydrone'] = started[-1].pid
         started.append(lab.start_node(kind, ns, threshold=THRESHOLD))
         pids[ns + '/exam'] = started[-1].pid
-    monitors = {ns: driver.StreamMonitor(ns + '/altitude') for ns in namespaces}
+    monitors = {ns: driver.recorder(ns + '/altitude') for ns in namespaces}
     try:
         deadline = time.monotonic() + STARTUP_TIMEOUT + 3.0 * count
         silent = [ns for ns, monitor in monitors.items()
-                  if not monitor.wait_first(max(0.1, deadline - time.monotonic()))]
+                  if monitor.wait_for(lambda value: True, max(0.1, deadline - time.monotonic())) is None]
         if silent:
             raise RuntimeError('fleet of %d: no altitude from %s (registered nodes there: %s)'
-                               % (count, ', '.join(silent), registered(lab.uri, silent)))
+                               % (count, ', '.join(silent), registered(lab.master, silent)))
         time.sleep(2.0)
         for monitor in monitors.values():
-            monitor.reset()
+            monitor.clear()
         cpu = procs.CpuWindow(pids.values())
         cpu.start()
         time.sleep(window)
         usage = cpu.stop()
         busy = cpu.machine_busy()
         rss = {name: procs.rss_kb(pid) for name, pid in pids.items()}
-        streams = {ns: stats.interval_stats(m.stamps()) for ns, m in monitors.items()}
+        streams = {ns: stats.interval_stats(driver.stamps(m)) for ns, m in monitors.items()}
         # A pair that fell silent has no rate: it counts as 0 Hz, not as missing.
         rates = [s['rate_hz'] or 0.0 for s in streams.values()]
         return {
@@ -214,7 +212,7 @@ def fleet(lab, kind, count, window):
     finally:
         for monitor in monitors.values():
             monitor.close()
-        lab.children.stop(started)
+        lab.supervisor.stop_all(started, grace=5.0)
 
 
 def _by_role(values_by_pid, pids):
@@ -228,9 +226,9 @@ def _by_role(values_by_pid, pids):
     return roles
 
 
-def registered(uri, namespaces):
+def registered(master, namespaces):
     """Names of the nodes of ``namespaces`` that the master knows: tells a crash from a slow start."""
-    state = rosgraph.Master('/bench', master_uri=uri).getSystemState()
+    state = master.system_state()
     nodes = {node for _, names in state[0] + state[1] + state[2] for node in names}
     return sorted(n for n in nodes if any(n.startswith(ns + '/') for ns in namespaces)) or 'none'
 
@@ -263,7 +261,7 @@ MEMORY_STEPS = [
     ('+ import numpy', 'import numpy'),
     ('+ import rospy, std_msgs', 'import numpy, rospy, std_msgs.msg'),
     ('+ rospy.init_node', 'import numpy, rospy, std_msgs.msg; rospy.init_node("rss_probe", anonymous=True)'),
-    ('rospy.init_node with numpy blocked (bench/without_numpy.py)',
+    ('rospy.init_node with numpy blocked (lab/bench/without_numpy.py)',
      'import sys; sys.modules["numpy"] = None; import rospy, std_msgs.msg; '
      'rospy.init_node("rss_probe", anonymous=True)'),
 ]

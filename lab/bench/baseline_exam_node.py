@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """BASELINE ONLY: the naive exam node the seed's grader solution describes. Never launched by the product.
 
-bench/run.sh measures the real exam node (exam/scripts/exam_node.py) against this one, so the
+lab/bench/run.sh measures the real exam node (exam/scripts/exam_node.py) against this one, so the
 benchmark shows what the real node's design buys. It is written the obvious way on purpose:
 
 - global variables cache the latest readings (the grader's own solution does this);
@@ -9,6 +9,8 @@ benchmark shows what the real node's design buys. It is written the obvious way 
   service stalls publishing, and a crossing is only noticed at the next 10 Hz tick;
 - the delay is a count of loop iterations ("500 fois au dessus" in the seed, here ``~delay`` x 10),
   reset as soon as a tick sees the altitude back at or below the threshold.
+
+The formula is the exam node's own (``exam.formulas.altitude``), so the two differ in design only.
 
 It keeps the drop-in interface of the real node so the same harness drives both: relative names,
 private params, the same initial NORMAL state without a call, and a call only on a change of state.
@@ -27,16 +29,11 @@ Services Called
   altitude_warning (mydrone/AltitudeWarning): "WARNING" or "NORMAL", synchronously in the loop.
 """
 
-import math
-
 import rospy
+from exam.formulas import altitude as altitude_of
 from mydrone.srv import AltitudeWarning
 from std_msgs.msg import Float32
 
-P0 = 101325.0
-MU = 0.0289644
-G = 9.80665
-R = 8.31432
 LOOP_HZ = 10
 
 temperature = None
@@ -68,7 +65,7 @@ def main():
     rate = rospy.Rate(LOOP_HZ)
     while not rospy.is_shutdown():
         if temperature is not None and pressure is not None:
-            altitude = R * (temperature + 273.15) / (MU * G) * math.log(P0 / pressure)
+            altitude = altitude_of(temperature, pressure)
             pub.publish(Float32(altitude))
             if altitude > threshold:
                 ticks_above += 1

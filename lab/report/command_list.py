@@ -2,7 +2,7 @@
 
 One list for both the runner (collect.py) and the report (report_template.md names each command by its
 key), so the report can never show a command that was not run. The docs test
-(exam/test/docs/test_docs.py) checks that each line still parses, that the programs, packages, launch
+(lab/test/docs/test_docs.py) checks that each line still parses, that the programs, packages, launch
 files, nodes, topics, services and parameters it names exist in the code, and that the template uses
 every key.
 
