@@ -107,7 +107,8 @@ class MasterWatch(object):
 class OncePerOutage(object):
     """Logs a periodic task's failures once per run of failures, and its recovery once.
 
-    :param what: what failed, for the messages (e.g. ``"/diagnostics: reading the diagnostic_period parameter from the master"``).
+    :param what: what failed, for the messages (e.g. ``"/diagnostics: reading the diagnostic_period
+        parameter from the master"``).
     :param meaning: what the failure means for the node, for the first message.
     """
 
