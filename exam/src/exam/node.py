@@ -255,7 +255,12 @@ class ExamNode(object):
                 self._debouncer.interrupt()
             value = self._value
         if not stale:
-            self._pub.publish(Float32(value))
+            try:
+                self._pub.publish(Float32(value))
+            except rospy.ROSException:
+                # The publisher closed: rospy is shutting down and this was the timer's last tick.
+                if not rospy.is_shutdown():
+                    raise
             return
         if all(cache.stamp is None for cache in stale):
             rospy.loginfo_throttle(THROTTLE_S, 'waiting for the first reading of %s'
