@@ -27,23 +27,24 @@ deps:
 build: deps
 	@tools/build_ws.sh
 
+# `make run ARGS='threshold:=1400 delay:=3'` passes launch arguments.
 run: build
-	@$(ENV) && exec roslaunch exam exam.launch
+	@tools/run_launch.sh exam.launch $(ARGS)
 
 run-submarine: build
-	@$(ENV) && exec roslaunch exam exam_submarine.launch
+	@tools/run_launch.sh exam_submarine.launch $(ARGS)
 
 test: build
 	@tools/run_tests.sh $(TESTS)
 
 report: build
-	@tools/report.sh
+	@lab/report/report.sh
 
 bench: build
-	@bench/run.sh
+	@lab/bench/run.sh
 
 soak: build
-	@tools/soak.sh
+	@lab/soak/soak.sh
 
 # make grade SUBMISSION=<dir or zip> | CLASS=<dir or zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]
 grade: build

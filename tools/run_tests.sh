@@ -12,9 +12,4 @@ rm -rf "$results"
 cd "$EXAM_WS"
 # catkin's run_tests exits 0 even when tests fail: the verdict comes from the JUnit files below.
 catkin_make "$target" -j1 2>&1 | tee "$EXAM_WS/test.log" | grep -E "^\[(ROSTEST|ROSUNIT)\]|^ *\[(PASSED|FAILED)\]|^SUMMARY|^ \* RESULT|^FAILURE|^ERROR|passed|failed" || true
-# bench/ is no catkin package: its statistics unit tests run here, with the full suite only.
-if [ "$target" = run_tests ]; then
-  /usr/bin/python3 -m pytest -q -p no:cacheprovider "$repo/bench/test" \
-    --junitxml="$results/bench/pytest-bench.xml" | tail -n 1 || true
-fi
 /usr/bin/python3 "$repo/tools/test_summary.py" "$results"

@@ -12,7 +12,7 @@ COLOUR_OF_STATUS = {'NORMAL': GREEN, 'WARNING': RED}
 
 
 class WarningLed:
-    """One LED, GREEN at start. Not thread-safe: the caller serialises requests.
+    """One LED, GREEN at start. Not thread-safe: the caller serialises calls of apply().
 
     :param label: the LED's name on the remote, for messages (e.g. ``"ALT WARN"``).
     """
@@ -21,7 +21,7 @@ class WarningLed:
         self.label = label
         self.colour = GREEN
 
-    def request(self, status):
+    def apply(self, status):
         """Apply one service request.
 
         :param status: the request's ``status`` string.

@@ -103,28 +103,3 @@ def parse_profile(spec, builtins, lower=None, upper=None):
         return Profile(builtins[spec], spec, lower, upper)
     return Profile(spec, 'custom', lower, upper)
 
-
-def spans_above(times, values, threshold):
-    """Intervals where ``values`` stay strictly above ``threshold``.
-
-    Used by the tests and the docs to locate a profile's excursions from sampled values.
-
-    :param times: increasing sample times (s).
-    :param values: the value at each time.
-    :returns: list of ``(first_time_above, last_time_above)``; the duration of a span is
-        ``last - first`` (accurate to one sampling step).
-    """
-    spans = []
-    start = None
-    last = None
-    for t, v in zip(times, values):
-        if v > threshold:
-            if start is None:
-                start = t
-            last = t
-        elif start is not None:
-            spans.append((start, last))
-            start = None
-    if start is not None:
-        spans.append((start, last))
-    return spans

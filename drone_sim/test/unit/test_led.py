@@ -8,17 +8,17 @@ from drone_sim.led import GREEN, RED, WarningLed
 def test_starts_green_and_follows_requests():
     led = WarningLed('ALT WARN')
     assert led.colour == GREEN
-    assert led.request('WARNING') == (True, 'ALT WARN LED set to RED (was GREEN)', True)
+    assert led.apply('WARNING') == (True, 'ALT WARN LED set to RED (was GREEN)', True)
     assert led.colour == RED
-    assert led.request('WARNING') == (True, 'ALT WARN LED already RED', False)
-    assert led.request('NORMAL') == (True, 'ALT WARN LED set to GREEN (was RED)', True)
+    assert led.apply('WARNING') == (True, 'ALT WARN LED already RED', False)
+    assert led.apply('NORMAL') == (True, 'ALT WARN LED set to GREEN (was RED)', True)
     assert led.colour == GREEN
 
 
 def test_refusal_names_accepted_values_and_keeps_the_colour():
     led = WarningLed('DEPTH WARN')
-    led.request('WARNING')
-    success, message, changed = led.request('normal')
+    led.apply('WARNING')
+    success, message, changed = led.apply('normal')
     assert (success, changed, led.colour) == (False, False, RED)
     assert message == ("refused status 'normal': accepted values are 'NORMAL' or 'WARNING'; "
                        "DEPTH WARN LED stays RED")
@@ -27,8 +27,8 @@ def test_refusal_names_accepted_values_and_keeps_the_colour():
 @given(st.text().filter(lambda s: s not in ('NORMAL', 'WARNING')), st.sampled_from(['NORMAL', 'WARNING']))
 def test_any_other_string_is_refused(status, before):
     led = WarningLed('ALT WARN')
-    led.request(before)
+    led.apply(before)
     colour = led.colour
-    success, _, changed = led.request(status)
+    success, _, changed = led.apply(status)
     assert not success and not changed
     assert led.colour == colour

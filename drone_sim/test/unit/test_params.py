@@ -1,10 +1,11 @@
-"""Parameter checks: cast, range, and an error message naming the resolved parameter and value."""
+"""Parameter checks (simulators and exam node): cast, range, and an error message naming the resolved
+parameter and its value."""
 
 import math
 
 import pytest
 
-from drone_sim.params import ParamError, non_negative_float, positive_float, seed
+from drone_sim.params import ParamError, finite_float, non_negative_float, one_of, positive_float, seed
 
 
 def test_positive_float_accepts_and_casts():
@@ -32,3 +33,30 @@ def test_seed():
     for bad in (1.5, '3', True, None):
         with pytest.raises(ParamError, match='/d/seed = .*: must be an integer'):
             seed('/d/seed', bad)
+
+
+def test_finite_float_takes_any_finite_number():
+    assert finite_float('/exam/threshold', -12, 'm') == -12.0
+    assert isinstance(finite_float('/exam/threshold', 1300, 'm'), float)
+
+
+@pytest.mark.parametrize('value', [math.nan, math.inf, -math.inf, 'abc', '1300', True, None, [1300]])
+def test_finite_float_refuses(value):
+    # A numeric string is refused too: the parameter server types unquoted numbers itself.
+    with pytest.raises(ParamError) as err:
+        finite_float('/exam/threshold', value, 'm')
+    assert str(err.value) == 'parameter /exam/threshold = %r: must be a finite number (m)' % (value,)
+
+
+def test_zero_is_the_bound_of_both_ranges():
+    assert non_negative_float('/exam/delay', 0.0, 's') == 0.0
+    with pytest.raises(ParamError, match=r'/exam/timeout = 0\.0: must be a finite number > 0 \(s\)'):
+        positive_float('/exam/timeout', 0.0, 's')
+
+
+def test_one_of():
+    assert one_of('/exam/mode', 'depth', ['altitude', 'depth']) == 'depth'
+    for bad in ('foo', 'Depth', ' depth', 1, None, ['depth']):
+        with pytest.raises(ParamError) as err:
+            one_of('/exam/mode', bad, ['depth', 'altitude'])
+        assert str(err.value) == 'parameter /exam/mode = %r: must be one of altitude, depth' % (bad,)

@@ -1,11 +1,11 @@
-"""Profiles: interpolation, looping, validation messages, parsing, span detection."""
+"""Profiles: interpolation, looping, validation messages, parsing."""
 
 import math
 
 import pytest
 from hypothesis import given, strategies as st
 
-from drone_sim.profile import Profile, parse_profile, spans_above, validate_waypoints
+from drone_sim.profile import Profile, parse_profile, validate_waypoints
 
 TRIANGLE = [[0, 0], [10, 100], [20, 0]]
 
@@ -76,11 +76,3 @@ def test_parse_builtin_name_or_waypoints():
     with pytest.raises(ValueError, match='outside'):
         parse_profile('default', builtins, upper=50)
 
-
-def test_spans_above():
-    times = [0, 1, 2, 3, 4, 5, 6]
-    values = [0, 5, 6, 0, 5, 0, 7]
-    assert spans_above(times, values, 4) == [(1, 2), (4, 4), (6, 6)]
-    assert spans_above(times, values, 10) == []
-    # At the threshold is not above.
-    assert spans_above(times, values, 5) == [(2, 2), (6, 6)]

@@ -19,6 +19,8 @@ The rule, for a value compared with a threshold::
   immediately; the LED must turn green as soon as the drone is back within limits.
 - The delay expires at a known instant (:attr:`deadline`): the node arms a timer for it instead of
   waiting for the next reading or publishing tick, which is what keeps the WARNING latency low.
+- An excess counts only if it was observed continuously: when an input goes stale the node calls
+  :meth:`interrupt`, which cancels the pending excess (the state itself is kept).
 - The state is unknown until the first reading: the node does not claim NORMAL before it has seen a
   value (a restarted node must not turn a red LED green while the drone is still too high).
 - Each transition is reported exactly once; a method returns the new state, or None when nothing

@@ -48,8 +48,8 @@ def depth(pressure_robot_pa, pressure_remote_pa):
     return (pressure_robot_pa - pressure_remote_pa) / (RHO_SEA_WATER * G)
 
 
-def temperature_problem(temperature_c):
-    """Why a temperature reading [degC] is unusable, or None when it is usable.
+def why_unusable_temperature(temperature_c):
+    """Why a temperature reading [degC] is unusable (a reason for the log), or None when it is usable.
 
     NaN and infinities come from a broken sensor driver; at or below absolute zero the kelvin
     temperature would be <= 0 and the altitude formula meaningless.
@@ -61,8 +61,8 @@ def temperature_problem(temperature_c):
     return None
 
 
-def pressure_problem(pressure_pa):
-    """Why a pressure reading [Pa] is unusable, or None when it is usable.
+def why_unusable_pressure(pressure_pa):
+    """Why a pressure reading [Pa] is unusable (a reason for the log), or None when it is usable.
 
     A pressure is absolute, so it is strictly positive; ln(P0/P) needs that too.
     """

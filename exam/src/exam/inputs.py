@@ -14,13 +14,13 @@ class InputCache(object):
     """Latest valid value of one input, its age, and its recent arrival rate.
 
     :param topic: the topic name, used in messages.
-    :param problem: function value -> reason string when the value is unusable, None when usable.
+    :param why_unusable: function value -> why the value is unusable (a string), None when usable.
     :param rate_window: how far back [s] arrivals count for the measured rate.
     """
 
-    def __init__(self, topic, problem, rate_window=10.0):
+    def __init__(self, topic, why_unusable, rate_window=10.0):
         self.topic = topic
-        self._problem = problem
+        self._why_unusable = why_unusable
         self._rate_window = rate_window
         self._arrivals = collections.deque()
         #: Latest usable value, None before the first one.
@@ -32,10 +32,10 @@ class InputCache(object):
 
     def offer(self, value, now):
         """Cache ``value`` if usable. Return None when it was cached, else the reason it was not."""
-        problem = self._problem(value)
-        if problem is not None:
+        reason = self._why_unusable(value)
+        if reason is not None:
             self.rejected += 1
-            return problem
+            return reason
         self.value = value
         self.stamp = now
         self._arrivals.append(now)

@@ -12,8 +12,8 @@ from submarinedrone.srv import DepthWarning
 
 from exam import formulas
 
-#: One input topic and the check its readings must pass.
-Input = collections.namedtuple('Input', 'topic unit problem')
+#: One input topic, its unit, and why_unusable: function reading -> why it is unusable, or None.
+Input = collections.namedtuple('Input', 'topic unit why_unusable')
 
 Mode = collections.namedtuple('Mode', [
     'name',               # value of the ~mode parameter
@@ -29,8 +29,8 @@ Mode = collections.namedtuple('Mode', [
 
 ALTITUDE = Mode(
     name='altitude',
-    inputs=(Input('temperature', 'degC', formulas.temperature_problem),
-            Input('pressure', 'Pa', formulas.pressure_problem)),
+    inputs=(Input('temperature', 'degC', formulas.why_unusable_temperature),
+            Input('pressure', 'Pa', formulas.why_unusable_pressure)),
     compute=formulas.altitude,
     output='altitude',
     unit='m',
@@ -42,8 +42,8 @@ ALTITUDE = Mode(
 
 DEPTH = Mode(
     name='depth',
-    inputs=(Input('pressure_robot', 'Pa', formulas.pressure_problem),
-            Input('pressure_remote', 'Pa', formulas.pressure_problem)),
+    inputs=(Input('pressure_robot', 'Pa', formulas.why_unusable_pressure),
+            Input('pressure_remote', 'Pa', formulas.why_unusable_pressure)),
     compute=formulas.depth,
     output='depth',
     unit='m',

@@ -1,8 +1,10 @@
 """The exam node: altitude (or depth) from the drone's sensors at 10 Hz, and a debounced warning LED.
 
-This module is the only place that talks to ROS. The physics is in :mod:`exam.formulas`, the caching of
-inputs in :mod:`exam.inputs`, the warning rule in :mod:`exam.debounce`, the service calls in
-:mod:`exam.warning_link`, and what differs between the two drones in :mod:`exam.modes`.
+This module is the ROS wiring only: it reads the parameters, creates the publishers, subscribers and
+timers, and hands every event to pure logic: the physics in :mod:`exam.formulas`, the latest reading of
+each input in :mod:`exam.inputs`, the warning rule in :mod:`exam.debounce`, the service calls in
+:mod:`exam.warning_link`, what differs between the two drones in :mod:`exam.modes`. The parameter checks
+are :mod:`drone_sim.params` (shared with the simulators), and /diagnostics is :mod:`exam.diagnostics`.
 
 How one reading travels (each step runs on the thread rospy gives it):
 
@@ -10,15 +12,19 @@ How one reading travels (each step runs on the thread rospy gives it):
    rates, so the latest value of each is kept). If every input is fresh, it computes the value and feeds
    the debouncer *right away*, so a crossing back below the threshold is acted on within the callback.
 2. The debouncer says whether the state changed; if so, the new state is handed to the warning link,
-   whose own thread calls the service (question 13). If an excess has just begun, a one-shot timer is
-   armed for the instant the delay expires (question 14b), so the WARNING is not late by a tick.
-3. A periodic timer publishes the latest value at ``~rate`` Hz, only while every input is fresh.
+   whose own thread calls the service (question 13). While a WARNING is pending, a one-shot timer is
+   armed for the debouncer's ``deadline`` (question 14b), so the WARNING is not late by a reading.
+3. A periodic timer publishes the latest value at ``~rate`` Hz, only while every input is fresh; a stale
+   input interrupts a pending excess.
 4. A 1 Hz timer publishes /diagnostics.
+5. A thread of :mod:`drone_sim.master_link` keeps the node registered across a master restart, and the
+   connection to the warning service is opened ahead of the first call and kept, so a state decided
+   while the master is down still reaches the drone.
 
 State shared by these threads (the caches, the value, the debouncer) is guarded by one lock, held only
 for short computations, never across a publish or a service call.
 
-ROS Parameters (private; units are those of the mode: m for both modes):
+ROS Parameters (private; a value that is given but unusable stops the node with a fatal log naming it):
     ~mode (str, default "altitude"): "altitude" (aerial drone, sheet 000) or "depth" (underwater, 001).
     ~threshold (float, m, default 1300 in altitude mode, 150 in depth mode): the warning limit; only
         values strictly above it are an excess.
@@ -41,68 +47,47 @@ Services called:
     altitude mode: altitude_warning (mydrone/AltitudeWarning) with "NORMAL" or "WARNING".
     depth mode: depth_warning (submarinedrone/DepthWarning) with "NORMAL" or "WARNING".
 """
-import math
 import sys
 import threading
 
-import diagnostic_updater
 import rospy
-from diagnostic_msgs.msg import DiagnosticStatus
 from std_msgs.msg import Float32, String
 
-from exam.debounce import NORMAL, WARNING, Debouncer
+from drone_sim import master_link, params
+from exam import diagnostics
+from exam.debounce import WARNING, Debouncer
 from exam.inputs import InputCache
 from exam.modes import MODES
-from exam.warning_link import WarningLink
+from exam.warning_link import LED_STATES, WarningLink
 
 #: Seconds between two identical warnings on a 10 Hz path, so a fault does not flood /rosout.
 THROTTLE_S = 5.0
 #: Seconds between two attempts while the warning service is absent or failing.
 RETRY_PERIOD_S = 1.0
-#: LED colours reported by the drone, as warning states.
-LED_STATES = {'GREEN': NORMAL, 'RED': WARNING}
-LED_COLOURS = {state: colour for colour, state in LED_STATES.items()}
 
 
-class ParamError(ValueError):
-    """A parameter given to the node is unusable; the message names it and its value."""
-
-
-def read_number(name, default, is_valid, requirement):
-    """Read the private float parameter ``name``; raise ParamError if it is not a finite valid number.
-
-    A value that was given but is wrong is an error, never silently replaced by the default: a typo in
-    a launch file must stop the node, not fly with a threshold nobody chose.
-    """
-    value = rospy.get_param(name, default)
-    number = None
-    if not isinstance(value, bool):  # YAML true/false would otherwise pass as 1.0/0.0
-        try:
-            number = float(value)
-        except (TypeError, ValueError):
-            pass
-    if number is None or not math.isfinite(number) or not is_valid(number):
-        raise ParamError('parameter %s = %r: expected %s' % (rospy.resolve_name(name), value, requirement))
-    return number
+def _param(name, default):
+    """(resolved name, value) of the private parameter ``name``, so an error names what was read."""
+    return rospy.resolve_name('~' + name), rospy.get_param('~' + name, default)
 
 
 class ExamNode(object):
-    """Computes, publishes and watches one value (altitude or depth); see the module docstring."""
+    """Computes, publishes and watches one value (altitude or depth); see the module docstring.
+
+    :raises drone_sim.params.ParamError: a parameter is unusable (nothing has been created then).
+    """
 
     def __init__(self):
-        # 1. Parameters, all validated before anything is created.
-        mode_name = rospy.get_param('~mode', 'altitude')
-        if mode_name not in MODES:
-            raise ParamError('parameter %s = %r: expected one of %s'
-                             % (rospy.resolve_name('~mode'), mode_name, ', '.join(sorted(MODES))))
-        self._mode = mode = MODES[mode_name]
-        threshold = read_number('~threshold', mode.default_threshold, lambda x: True, 'a finite number')
-        delay = read_number('~delay', 5.0, lambda x: x >= 0.0, 'a number of seconds >= 0')
-        rate = read_number('~rate', 10.0, lambda x: x > 0.0, 'a rate in Hz > 0')
-        self._timeout = read_number('~timeout', 5.0, lambda x: x > 0.0, 'a number of seconds > 0')
+        # 1. Parameters, all checked before anything is created. A value that is given but unusable
+        #    stops the node: a typo in a launch file must not fly with a threshold nobody chose.
+        self._mode = mode = MODES[params.one_of(*_param('mode', 'altitude'), choices=MODES)]
+        threshold = params.finite_float(*_param('threshold', mode.default_threshold), unit=mode.unit)
+        delay = params.non_negative_float(*_param('delay', 5.0), unit='s')
+        rate = params.positive_float(*_param('rate', 10.0), unit='Hz')
+        self._timeout = params.positive_float(*_param('timeout', 5.0), unit='s')
 
         self._lock = threading.Lock()
-        self._inputs = [InputCache(spec.topic, spec.problem) for spec in mode.inputs]
+        self._inputs = [InputCache(spec.topic, spec.why_unusable) for spec in mode.inputs]
         self._debouncer = Debouncer(threshold, delay)
         self._value = None
         self._armed_deadline = None
@@ -110,14 +95,11 @@ class ExamNode(object):
         # 2. Outputs and the service link, before any callback can fire.
         self._pub = rospy.Publisher(mode.output, Float32, queue_size=10)
         self._service = rospy.resolve_name(mode.service)
+        self._proxy = None  # the persistent connection to the service, used by the link's thread only
         self._link = WarningLink(self._call_service, self._on_call_failed, self._on_call_delivered,
-                                 retry_period=RETRY_PERIOD_S)
+                                 retry_period=RETRY_PERIOD_S, connect=self._open_service)
         self._link.start()
         rospy.on_shutdown(lambda: self._link.stop(timeout=1.0))
-        self._diagnostics = diagnostic_updater.Updater()
-        self._diagnostics.setHardwareID(rospy.get_name())
-        self._diagnostics.add('inputs', self._diagnose_inputs)
-        self._diagnostics.add('warning', self._diagnose_warning)
 
         rospy.loginfo('%s: mode %s, %s > %.1f %s for %.1f s -> WARNING via %s; publishing %s at %.1f Hz; '
                       'inputs %s stale after %.1f s', rospy.get_name(), mode.name, mode.output, threshold,
@@ -131,7 +113,7 @@ class ExamNode(object):
         rospy.Subscriber(mode.led_topic, String, self._on_led, queue_size=10)
         # reset=True: a timer survives time jumping backwards (rosbag play --loop under sim time).
         rospy.Timer(rospy.Duration(1.0 / rate), self._on_publish_tick, reset=True)
-        rospy.Timer(rospy.Duration(1.0), lambda event: self._diagnostics.update(), reset=True)
+        diagnostics.start(self._snapshot, self._link.snapshot, mode, self._service, self._timeout)
 
     # --- inputs -------------------------------------------------------------------------------------
 
@@ -141,17 +123,17 @@ class ExamNode(object):
         now = rospy.get_time()
         change = deadline = None
         with self._lock:
-            problem = cache.offer(msg.data, now)
-            if problem is None:
+            reason = cache.offer(msg.data, now)
+            if reason is None:
                 value = self._compute(now)
                 if value is not None:
                     self._value = value
                     change = self._debouncer.update(value, now)
                     deadline = self._debouncer.deadline
-        if problem is not None:
+        if reason is not None:
             # Never cached, never published, never seen by the debouncer: just reported.
             rospy.logwarn_throttle(THROTTLE_S, 'ignoring %s = %r %s: %s'
-                                   % (rospy.resolve_name(spec.topic), msg.data, spec.unit, problem))
+                                   % (rospy.resolve_name(spec.topic), msg.data, spec.unit, reason))
             return
         if change is not None:
             self._announce(change, value)
@@ -171,7 +153,7 @@ class ExamNode(object):
     # --- warning ------------------------------------------------------------------------------------
 
     def _arm(self, deadline, now):
-        """Wake up when the pending excess would turn into WARNING (once per deadline)."""
+        """Arm a one-shot timer for the debouncer's ``deadline`` (once per deadline)."""
         with self._lock:
             if deadline == self._armed_deadline:
                 return
@@ -179,7 +161,7 @@ class ExamNode(object):
         rospy.Timer(rospy.Duration(max(deadline - now, 0.0)), self._on_deadline, oneshot=True)
 
     def _on_deadline(self, event):
-        """The delay of an excess has (nearly) run out: WARNING if the excess was never interrupted."""
+        """The timer armed for the deadline fired: the debouncer judges the excess at this instant."""
         now = rospy.get_time()
         change = None
         with self._lock:
@@ -205,7 +187,7 @@ class ExamNode(object):
         else:
             why = 'at or below the threshold %.1f %s' % (debouncer.threshold, mode.unit)
         rospy.loginfo('%s %.1f %s %s: %s', mode.output, value, mode.unit, why, state)
-        self._link.request(state)
+        self._link.want(state)
 
     def _on_led(self, msg):
         """The drone's LED report: lets the link re-send the wanted state after a drone restart."""
@@ -216,10 +198,43 @@ class ExamNode(object):
             return
         self._link.led_reported(state)
 
+    def _open_service(self):
+        """Open the persistent connection to the warning service if none is (link's thread only).
+
+        Called by the link ahead of the first call, and again after a failed one: a connection that
+        is open needs no master, so a state decided while the master is down still reaches the drone.
+        :raises Exception: the service cannot be found or connected to (the link tries again later).
+        """
+        if self._proxy is None:
+            self._proxy, uri = master_link.open_persistent(self._service, self._mode.service_type)
+            rospy.loginfo('%s: connected to %s; the connection is kept for every call'
+                          % (self._service, uri))
+        return True
+
     def _call_service(self, state):
-        """One call of the warning service (runs on the link's thread, may block)."""
-        rospy.wait_for_service(self._service, timeout=RETRY_PERIOD_S)
-        response = rospy.ServiceProxy(self._service, self._mode.service_type)(state)
+        """One call of the warning service (link's thread only, may block).
+
+        On the open connection if there is one; if a call on it raises (the drone restarted, the link
+        broke, the call failed), the connection is closed and the call made once more on a new one,
+        found through the master. A failure on the new one is the link's to retry.
+        """
+        if self._proxy is not None:
+            try:
+                return self._call_on(state)
+            except Exception as err:
+                rospy.loginfo('%s: the call on the open connection failed (%s: %s); calling again on '
+                              'a new connection' % (self._service, type(err).__name__, err))
+        self._open_service()
+        return self._call_on(state)
+
+    def _call_on(self, state):
+        """One call on the open connection; a connection whose call raised is closed and forgotten."""
+        try:
+            response = self._proxy(state)
+        except Exception:
+            self._proxy.close()
+            self._proxy = None
+            raise
         return response.success, response.message
 
     def _on_call_failed(self, state, reason):
@@ -240,7 +255,12 @@ class ExamNode(object):
                 self._debouncer.interrupt()
             value = self._value
         if not stale:
-            self._pub.publish(Float32(value))
+            try:
+                self._pub.publish(Float32(value))
+            except rospy.ROSException:
+                # The publisher closed: rospy is shutting down and this was the timer's last tick.
+                if not rospy.is_shutdown():
+                    raise
             return
         if all(cache.stamp is None for cache in stale):
             rospy.loginfo_throttle(THROTTLE_S, 'waiting for the first reading of %s'
@@ -253,49 +273,23 @@ class ExamNode(object):
 
     # --- diagnostics --------------------------------------------------------------------------------
 
-    def _diagnose_inputs(self, stat):
+    def _snapshot(self):
+        """A copy of the state /diagnostics shows, taken under the lock (see exam.diagnostics)."""
         now = rospy.get_time()
         with self._lock:
-            rows = [(c.topic, c.rate(now), c.age(now), c.rejected) for c in self._inputs]
-        stale = []
-        for topic, rate, age, rejected in rows:
-            stat.add('%s rate [Hz]' % topic, '%.2f' % rate)
-            stat.add('%s age [s]' % topic, 'never received' if age is None else '%.2f' % age)
-            stat.add('%s rejected readings' % topic, rejected)
-            if age is None or age > self._timeout:
-                stale.append(topic)
-        if stale:
-            stat.summary(DiagnosticStatus.WARN, 'stale or missing: %s' % ', '.join(stale))
-        else:
-            stat.summary(DiagnosticStatus.OK, 'all inputs fresh')
-        return stat
-
-    def _diagnose_warning(self, stat):
-        with self._lock:
-            value, state = self._value, self._debouncer.state
-            threshold, deadline = self._debouncer.threshold, self._debouncer.deadline
-        link = self._link.snapshot()
-        unit = self._mode.unit
-        stat.add('%s [%s]' % (self._mode.output, unit), 'none yet' if value is None else '%.2f' % value)
-        stat.add('threshold [%s]' % unit, '%.2f' % threshold)
-        stat.add('state', state or 'unknown (no reading yet)')
-        stat.add('WARNING due at [s]', 'not pending' if deadline is None else '%.3f' % deadline)
-        stat.add('LED wanted', LED_COLOURS.get(link['wanted'], 'nothing yet'))
-        stat.add('LED shows', LED_COLOURS[link['shown']])
-        stat.add('failed service calls', link['failures'])
-        if link['failing']:
-            stat.summary(DiagnosticStatus.ERROR, 'cannot reach %s: %s' % (self._service, link['last_error']))
-        else:
-            stat.summary(DiagnosticStatus.OK, 'state %s, LED %s'
-                         % (state or 'unknown', LED_COLOURS[link['shown']]))
-        return stat
+            return diagnostics.Snapshot(
+                inputs=[diagnostics.InputRow(c.topic, c.rate(now), c.age(now), c.rejected)
+                        for c in self._inputs],
+                value=self._value, state=self._debouncer.state, threshold=self._debouncer.threshold,
+                deadline=self._debouncer.deadline)
 
 
 def main():
     rospy.init_node('exam')
     try:
         ExamNode()
-    except ParamError as err:
+    except params.ParamError as err:
         rospy.logfatal(str(err))
         sys.exit(1)
+    master_link.start()
     rospy.spin()

@@ -39,26 +39,26 @@ def test_depth_at_150_m_by_hand():
 
 @pytest.mark.parametrize('value', [float('nan'), float('inf'), -float('inf'), -273.15, -300.0])
 def test_unusable_temperatures(value):
-    assert formulas.temperature_problem(value) is not None
+    assert formulas.why_unusable_temperature(value) is not None
 
 
 def test_absolute_zero_as_carried_by_a_float32_message_is_unusable():
     as_float32 = struct.unpack('f', struct.pack('f', -273.15))[0]
     assert as_float32 > -273.15  # the rounding that would let it through a bare comparison
-    assert formulas.temperature_problem(as_float32) is not None
+    assert formulas.why_unusable_temperature(as_float32) is not None
 
 
 @pytest.mark.parametrize('value', [-273.14, -40.0, 0.0, 15.0, 60.0])
 def test_usable_temperatures(value):
-    assert formulas.temperature_problem(value) is None
+    assert formulas.why_unusable_temperature(value) is None
 
 
 @pytest.mark.parametrize('value', [float('nan'), float('inf'), -float('inf'), 0.0, -1.0])
 def test_unusable_pressures(value):
-    assert formulas.pressure_problem(value) is not None
+    assert formulas.why_unusable_pressure(value) is not None
 
 
 @pytest.mark.parametrize('value', [1e-3, 50000.0, 101325.0, 2e6])
 def test_usable_pressures(value):
-    assert formulas.pressure_problem(value) is None
+    assert formulas.why_unusable_pressure(value) is None
     assert math.isfinite(formulas.altitude(15.0, value))

@@ -71,18 +71,18 @@ def settle(link):
 
 def test_no_call_for_normal_at_start_since_the_led_starts_green(service, make_link):
     link = make_link()
-    link.request(NORMAL)
+    link.want(NORMAL)
     settle(link)
-    link.request(WARNING)
+    link.want(WARNING)
     assert service.wait_calls(1) == [WARNING]
 
 
 def test_one_call_per_change(service, make_link):
     link = make_link()
-    link.request(WARNING)
+    link.want(WARNING)
     service.wait_calls(1)
-    link.request(WARNING)
-    link.request(NORMAL)
+    link.want(WARNING)
+    link.want(NORMAL)
     assert service.wait_calls(2) == [WARNING, NORMAL]
     settle(link)
     assert service.calls == [WARNING, NORMAL]
@@ -91,7 +91,7 @@ def test_one_call_per_change(service, make_link):
 def test_absent_service_gets_the_latest_state_once_back(service, make_link):
     service.available = False
     link = make_link()
-    link.request(WARNING)
+    link.want(WARNING)
     assert service.entered.wait(WAIT_S)
     service.available = True
     assert service.wait_calls(1) == [WARNING]
@@ -103,22 +103,22 @@ def test_absent_service_gets_the_latest_state_once_back(service, make_link):
 def test_flip_and_flip_back_while_absent_sends_nothing(service, make_link):
     service.available = False
     link = make_link()
-    link.request(WARNING)
+    link.want(WARNING)
     service.entered.wait(WAIT_S)
-    link.request(NORMAL)  # back to what the LED shows
+    link.want(NORMAL)  # back to what the LED shows
     service.available = True
     settle(link)
     assert service.calls == []
 
 
-def test_a_blocked_call_does_not_block_requests(service, make_link):
+def test_a_blocked_call_does_not_block_want(service, make_link):
     service.hold = threading.Event()
     link = make_link()
-    link.request(WARNING)
+    link.want(WARNING)
     assert service.entered.wait(WAIT_S)
-    # The worker is stuck in the call; requesting must return at once.
+    # The worker is stuck in the call; want() must return at once.
     done = threading.Event()
-    threading.Thread(target=lambda: (link.request(NORMAL), link.request(WARNING), done.set())).start()
+    threading.Thread(target=lambda: (link.want(NORMAL), link.want(WARNING), done.set())).start()
     assert done.wait(1.0)
     service.hold.set()
     assert service.wait_calls(1) == [WARNING]
@@ -128,7 +128,7 @@ def test_a_blocked_call_does_not_block_requests(service, make_link):
 
 def test_a_drone_restart_reported_green_makes_it_resend_warning(service, make_link):
     link = make_link()
-    link.request(WARNING)
+    link.want(WARNING)
     service.wait_calls(1)
     link.led_reported(WARNING)  # the drone confirms red: nothing to do
     link.led_reported(NORMAL)   # the drone restarted: green again
@@ -142,7 +142,7 @@ def test_refused_call_counts_as_failure():
                        retry_period=10.0)
     link.start()
     try:
-        link.request(WARNING)
+        link.want(WARNING)
         for _ in range(int(WAIT_S / 0.01)):
             if link.snapshot()['failures']:
                 break
@@ -151,5 +151,65 @@ def test_refused_call_counts_as_failure():
         assert snap['failing'] and snap['failures'] >= 1
         assert 'unknown status' in snap['last_error']
         assert snap['shown'] == NORMAL
+    finally:
+        link.stop(timeout=WAIT_S)
+
+
+class FakeConnection(object):
+    """The node's connect(): fails while ``available`` is False, counts its attempts."""
+
+    def __init__(self):
+        self.available = False
+        self.attempts = 0
+        self.opened = threading.Event()
+
+    def __call__(self):
+        self.attempts += 1
+        if not self.available:
+            raise IOError('no provider for /altitude_warning')
+        self.opened.set()
+        return True
+
+
+def test_the_connection_is_opened_before_any_state_is_due(service):
+    connection = FakeConnection()
+    link = WarningLink(service, lambda state, reason: None, lambda state: None, retry_period=0.01,
+                       connect=connection)
+    link.start()
+    try:
+        # Nothing wanted yet: the worker keeps trying to open the connection, and makes no call.
+        for _ in range(int(WAIT_S / 0.01)):
+            if connection.attempts >= 3:
+                break
+            threading.Event().wait(0.01)
+        assert connection.attempts >= 3 and service.calls == []
+        connection.available = True
+        assert connection.opened.wait(WAIT_S)
+        # Open: no more attempts while idle.
+        attempts = connection.attempts
+        threading.Event().wait(0.1)
+        assert connection.attempts == attempts and service.calls == []
+        link.want(WARNING)
+        assert service.wait_calls(1) == [WARNING]
+    finally:
+        link.stop(timeout=WAIT_S)
+
+
+def test_a_failed_call_has_the_connection_opened_again_while_idle(service):
+    connection = FakeConnection()
+    connection.available = True
+    link = WarningLink(service, lambda state, reason: None, lambda state: None, retry_period=0.01,
+                       connect=connection)
+    link.start()
+    try:
+        assert connection.opened.wait(WAIT_S)
+        service.available = False
+        link.want(WARNING)
+        assert service.entered.wait(WAIT_S)
+        connection.opened.clear()
+        link.want(NORMAL)  # nothing left to deliver: the worker reopens the connection instead
+        assert connection.opened.wait(WAIT_S)
+        settle(link)
+        assert service.calls == []
     finally:
         link.stop(timeout=WAIT_S)

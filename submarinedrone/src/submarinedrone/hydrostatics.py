@@ -26,7 +26,3 @@ def pressure_at_depth_pa(surface_pa, depth_m):
     """Absolute water pressure (Pa) at ``depth_m`` below a surface at ``surface_pa``."""
     return surface_pa + RHO * G * depth_m
 
-
-def depth_m(robot_pa, remote_pa):
-    """The exam sheet's equation (1): depth from the robot's and the remote's pressures (Pa)."""
-    return (robot_pa - remote_pa) / (RHO * G)

@@ -1,7 +1,6 @@
 """Hydrostatics and the weather drift against hand-computed values."""
 
 import pytest
-from hypothesis import given, strategies as st
 
 from submarinedrone import hydrostatics
 
@@ -11,12 +10,6 @@ def test_pressure_at_depth():
     assert hydrostatics.pressure_at_depth_pa(101325.0, 0.0) == 101325.0
     assert hydrostatics.pressure_at_depth_pa(101325.0, 1.0) == pytest.approx(111425.8495)
     assert hydrostatics.pressure_at_depth_pa(101325.0, 150.0) == pytest.approx(1616452.425)
-
-
-@given(st.floats(min_value=90000.0, max_value=110000.0), st.floats(min_value=0.0, max_value=11000.0))
-def test_depth_formula_inverts_the_pressure(surface, depth):
-    robot = hydrostatics.pressure_at_depth_pa(surface, depth)
-    assert hydrostatics.depth_m(robot, surface) == pytest.approx(depth, abs=1e-6)
 
 
 def test_weather_drift_is_small_and_slow():

@@ -164,7 +164,7 @@ class Probe(object):
         topic, kind = output['topic'], output['type']
         if topic is not None and (topic != expected or kind != 'std_msgs/Float32') and kind in VALUE_TYPES:
             self.recorder.close()
-            self.recorder = TopicRecorder(topic, msg_class=VALUE_TYPES[kind])
+            self.recorder = TopicRecorder(topic, msg_type=VALUE_TYPES[kind])
         elif topic is not None and kind not in VALUE_TYPES:
             self.recorder = None  # a type the probe cannot read values from
         return topic is not None and self.recorder is not None

@@ -151,6 +151,7 @@ class FakeWarningService(object):
         self._failing = False
         self._refusing = False
         self._service = None
+        self._withdrawn = False
         self._led = None
         self.colour = 'GREEN'
         if led_topic is not None:
@@ -160,10 +161,22 @@ class FakeWarningService(object):
             self.advertise()
 
     def advertise(self):
+        with self._lock:
+            self._withdrawn = False
         self._service = rospy.Service(self._name, self._srv_class, self._handle)
 
+    def close(self):
+        """Unregister the service, if advertised, without waiting for the master to forget it
+        (:meth:`withdraw` waits): the end of a drone, not a scripted failure."""
+        if self._service is not None:
+            self._service.shutdown('fake drone closed')
+            self._service = None
+
     def withdraw(self):
-        """Unregister the service: the node's calls fail as if the drone were gone."""
+        """Unregister the service: the node's calls fail as if the drone were gone, also on a
+        persistent connection opened before (rospy keeps serving those after a shutdown)."""
+        with self._lock:
+            self._withdrawn = True
         self._service.shutdown('withdrawn by the test')
         # The master must have forgotten the service, or the caller would still find it.
         resolved = rospy.resolve_name(self._name)
@@ -206,6 +219,8 @@ class FakeWarningService(object):
     def _handle(self, request):
         now = rospy.get_time()
         with self._lock:
+            if self._withdrawn:
+                raise rospy.ServiceException('the fake drone is gone (withdrawn by the test)')
             self._attempts.append((now, request.status))
             delay, failing, refusing = self._delay, self._failing, self._refusing
         if delay > 0.0:
@@ -234,21 +249,33 @@ def _service_registered(resolved_name):
 
 
 class TopicRecorder(object):
-    """Records every value the node under test publishes on ``topic`` as (ROS time of arrival, value).
+    """Records every message on ``topic`` as (ROS time of arrival, ``msg.data``).
 
-    :param msg_class: the topic's type, any message with a ``data`` field (default std_msgs/Float32;
-        the grader also reads a student's Float64).
+    :param msg_type: a message type with a ``data`` field (std_msgs/Float32 by default, String for an
+        LED topic).
+    :param queue_size: messages rospy may hold for the recorder when it falls behind, the oldest
+        dropped beyond; None keeps every one (the bench, measuring rates up to 1 kHz on a loaded machine).
     """
 
-    def __init__(self, topic, tcp_nodelay=False, msg_class=Float32):
+    def __init__(self, topic, msg_type=Float32, tcp_nodelay=False, queue_size=100):
         self._lock = threading.Lock()
         self._samples = []
-        self._sub = rospy.Subscriber(topic, msg_class, self._callback, queue_size=100,
+        self._sub = rospy.Subscriber(topic, msg_type, self._callback, queue_size=queue_size,
                                      tcp_nodelay=tcp_nodelay)
 
     def samples(self, since=0.0, until=float('inf')):
         with self._lock:
             return [(t, v) for t, v in self._samples if since <= t <= until]
+
+    def values(self):
+        """Every value received so far, in order."""
+        with self._lock:
+            return [v for _, v in self._samples]
+
+    def wait_for_count(self, count, timeout):
+        """The first ``count`` values, or the fewer received by ``timeout`` s."""
+        wait_until(lambda: len(self.values()) >= count, timeout, alive=_alive)
+        return self.values()[:count]
 
     def clear(self):
         with self._lock:
@@ -298,18 +325,29 @@ class Drone(object):
     :param rates: dict topic -> Hz, to override the default input rates.
     :param tcp_nodelay: see :class:`SensorFeeder`.
     :param on_call: see :class:`FakeWarningService`.
+    :param namespace: where the node under test lives (``'/latency_ours_3'``): every topic and the
+        service are resolved in it rather than in this node's namespace, so one process can play the
+        drone of several nodes (the bench). ``rates`` still takes the sheet's relative topic names;
+        :attr:`fixed_topic` and :attr:`moving_topic` are the resolved ones.
+    :param queue_size: of the output recorder, see :class:`TopicRecorder`.
     """
 
     def __init__(self, mode='altitude', advertise=True, led=True, rates=None, tcp_nodelay=False,
-                 on_call=None):
+                 on_call=None, namespace='', queue_size=100):
         sheet = SHEETS[mode]
         self.mode = mode
-        self.feeder = SensorFeeder(dict(sheet['rates'], **(rates or {})), tcp_nodelay)
-        self.service = FakeWarningService(sheet['service'], sheet['srv'],
-                                          sheet['led'] if led else None, advertise, on_call)
-        self.output = TopicRecorder(sheet['output'], tcp_nodelay)
-        self.fixed_topic, self.fixed_value = sheet['fixed']
-        self.moving_topic = sheet['moving']
+
+        def name(relative):
+            return namespace.rstrip('/') + '/' + relative if namespace else relative
+
+        rates = dict(sheet['rates'], **(rates or {}))
+        self.feeder = SensorFeeder({name(topic): rate for topic, rate in rates.items()}, tcp_nodelay)
+        self.service = FakeWarningService(name(sheet['service']), sheet['srv'],
+                                          name(sheet['led']) if led else None, advertise, on_call)
+        self.output = TopicRecorder(name(sheet['output']), tcp_nodelay=tcp_nodelay, queue_size=queue_size)
+        fixed_topic, self.fixed_value = sheet['fixed']
+        self.fixed_topic = name(fixed_topic)
+        self.moving_topic = name(sheet['moving'])
 
     def input_for(self, value):
         """The moving input that puts the drone at ``value`` m."""
@@ -364,6 +402,7 @@ class Drone(object):
     def close(self):
         self.feeder.close()
         self.output.close()
+        self.service.close()
 
 
 class DroneScenario(unittest.TestCase):

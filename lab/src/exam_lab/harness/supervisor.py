@@ -26,6 +26,8 @@ import subprocess
 import sys
 import time
 
+from exam_lab.harness.wait import wait_until
+
 #: Environment variable that marks every process of one supervised run.
 MARKER = 'EXAM_LAB_RUN'
 
@@ -147,6 +149,21 @@ def _killpg(pgid, sig):
         pass
 
 
+def node_pid(name, master_uri=None, caller='/exam_lab'):
+    """Pid of the running node ``name`` (asked over its XML-RPC API), or None when it is not reachable.
+
+    :param master_uri: the master to ask (default: ROS_MASTER_URI of this process).
+    """
+    import rosgraph
+    from xmlrpc.client import ServerProxy
+    try:
+        uri = rosgraph.Master(caller, master_uri=master_uri).lookupNode(name)
+        code, _msg, pid = ServerProxy(uri).getPid(caller)
+        return pid if code == 1 else None
+    except (IOError, OSError, rosgraph.MasterException):
+        return None
+
+
 class Master(object):
     """One ``roscore`` on a port of its own, and the environment that talks to it.
 
@@ -194,6 +211,10 @@ class Master(object):
     def system_state(self):
         """(publishers, subscribers, services) as the master lists them: [(name, [nodes])] each."""
         return self.graph.getSystemState()
+
+    def node_pid(self, name):
+        """Pid of the node ``name`` registered on this master, or None."""
+        return node_pid(name, self.uri)
 
     def publishers(self, topic):
         return dict(self.system_state()[0]).get(topic, [])
@@ -277,23 +298,39 @@ class Supervisor(object):
 
     def stop(self, proc, grace=10.0):
         """Ctrl-C the process group, as a user would; SIGKILL the group and every descendant found
-        beforehand if it is not gone after ``grace`` s. Returns the exit status."""
-        if proc.poll() is None:
-            family = descendants(proc.pid)
+        beforehand if it is not gone after ``grace`` s. A leader that exits at once may leave children
+        still finishing their work (``rosbag record``'s recorder closing its bag): they get the rest
+        of the grace period too. Returns the exit status."""
+        return self.stop_all([proc], grace)[0]
+
+    def stop_all(self, procs, grace=10.0):
+        """:meth:`stop` for several processes at once: every group gets its Ctrl-C first and they share
+        one grace period, so a fleet of nodes stops as fast as one. Returns their exit statuses."""
+        procs = list(procs)
+        running = [proc for proc in procs if proc.poll() is None]
+        families = {proc.pid: descendants(proc.pid) for proc in running}
+        for proc in running:
             _killpg(proc.pid, signal.SIGINT)
+        deadline = time.monotonic() + grace
+        for proc in running:
             try:
-                proc.wait(timeout=grace)
+                proc.wait(timeout=max(0.0, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
                 pass
+        family = [pid for proc in running for pid in families[proc.pid]]
+        wait_until(lambda: not any(alive(pid) for pid in family), max(0.0, deadline - time.monotonic()),
+                   period=0.1)
+        for proc in running:
             # The leader may be gone while a forked child (rosout under roscore) still runs.
             _killpg(proc.pid, signal.SIGKILL)
-            for pid in family:
+            for pid in families[proc.pid]:
                 if alive(pid):
                     _kill(pid, signal.SIGKILL)
-        proc.wait()
-        if proc in self.procs:
-            self.procs.remove(proc)
-        return proc.returncode
+        for proc in procs:
+            proc.wait()
+            if proc in self.procs:
+                self.procs.remove(proc)
+        return [proc.returncode for proc in procs]
 
     def start_master(self, name='master', port=None, timeout=30.0):
         """Start a roscore on ``port`` (default: a free one) and wait until it answers."""

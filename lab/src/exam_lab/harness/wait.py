@@ -1,15 +1,19 @@
 """Waiting with deadlines: the one polling helper of the lab. No rospy here.
 
 Tests wait for a condition with a deadline, never with a fixed sleep. A condition is *met* when the
-predicate returns anything but ``None`` or ``False``: a value of 0 (an altitude of 0 m, a count of
-zero) is a result, not a failure to wait for.
+predicate returns a true value or any number: ``None``, ``False`` and an empty list (no sample, no
+call yet) mean "not yet", while 0 or 0.0 (an altitude of 0 m, a first stamp at time 0 under sim time)
+is a result, not a failure to wait for.
 """
+import numbers
 import time
 
 
 def met(value):
-    """True when a predicate's result counts as the condition being met."""
-    return value is not None and value is not False
+    """True when a predicate's result counts as the condition being met (see the module docstring)."""
+    if isinstance(value, bool):
+        return value
+    return isinstance(value, numbers.Number) or bool(value)
 
 
 def wait_until(predicate, timeout, period=0.02, alive=None):

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# `make bench`: measures the exam node against lab/bench/baseline_exam_node.py and writes
+# docs/benchmarks.md and docs/figures/bench_fleet.png (about 10 minutes, 15 with BENCH_PROFILE=1).
+#   BENCH_QUICK=1    a few seconds per stage; results go to $EXAM_WS/bench-quick/, docs/ is untouched
+#   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet), also to $EXAM_WS/bench-quick/
+#   BENCH_PROFILE=1  also profile ours with py-spy (installed from PyPI into a throwaway directory)
+#   BENCH_RENDER_ONLY=1  measure nothing: render the docs again from the last results
+# Every process it starts carries the run's log folder in its environment (exam_lab's supervisor); the
+# trap ends exactly those on exit, error or Ctrl-C, so nothing outlives the run.
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/../.." && pwd)"
+source "$repo/tools/env.sh"
+
+scratch="$(mktemp -d /tmp/exam-bench.XXXXXX)"
+bench_pid=""
+
+cleanup() {
+  local status=$?
+  trap - EXIT INT TERM
+  if [ -n "$bench_pid" ] && kill -0 "$bench_pid" 2>/dev/null; then
+    kill -TERM "$bench_pid" 2>/dev/null || true
+    wait "$bench_pid" 2>/dev/null || true
+  fi
+  # Whatever bench.py could not stop itself (it was killed hard): every process marked with its logs.
+  /usr/bin/python3 -m exam_lab.harness.supervisor --cleanup "$scratch/logs" || true
+  if [ "$status" -eq 0 ]; then
+    rm -rf "$scratch"
+  else
+    echo "bench: failed (status $status); node logs kept in $scratch/logs" >&2
+  fi
+  exit "$status"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+mkdir -p "$scratch/logs"
+args=(--log-dir "$scratch/logs")
+# The exact command, as the report prints it: the BENCH_ variables change what is measured.
+command="$({ env | grep -E '^BENCH_(QUICK|PROFILE|STAGES)=' || true; } | sort | tr '\n' ' ')make bench"
+if [ "$EXAM_WS" != "$repo/.ws" ]; then
+  command="EXAM_WS=$EXAM_WS $command"
+fi
+if [ -n "${BENCH_STAGES:-}" ]; then
+  args+=(--stages "$BENCH_STAGES")
+fi
+if [ "${BENCH_QUICK:-0}" = 1 ] || [ -n "${BENCH_STAGES:-}" ]; then
+  out="$EXAM_WS/bench-quick"
+  mkdir -p "$out"
+  if [ "${BENCH_QUICK:-0}" = 1 ]; then
+    args+=(--quick)
+  fi
+  args+=(--out "$out" --figure "$out/bench_fleet.png" --json "$out/bench_results.json"
+         --command "$command")
+else
+  args+=(--out "$repo/docs" --figure "$repo/docs/figures/bench_fleet.png"
+         --json "$repo/lab/bench/results.json" --command "$command")
+fi
+
+if [ "${BENCH_RENDER_ONLY:-0}" = 1 ]; then
+  # After editing lab/bench/analysis.md or report.py: the same numbers, rendered again.
+  /usr/bin/python3 "$repo/lab/bench/bench.py" "${args[@]}" --render-only
+  exit 0
+fi
+if [ "${BENCH_PROFILE:-0}" = 1 ]; then
+  echo "bench: installing py-spy into $scratch/py-spy (BENCH_PROFILE=1)"
+  /usr/bin/python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --target "$scratch/py-spy" py-spy
+  args+=(--py-spy "$scratch/py-spy/bin/py-spy")
+fi
+
+# In the background so the trap runs at once on Ctrl-C instead of after the stage in progress.
+/usr/bin/python3 "$repo/lab/bench/bench.py" "${args[@]}" &
+bench_pid=$!
+wait "$bench_pid"

@@ -1,0 +1,94 @@
+"""Every command line that docs/report.md shows, in the order `make report` runs them. No rospy here.
+
+One list for both the runner (collect.py) and the report (report_template.md names each command by its
+key), so the report can never show a command that was not run. The docs test
+(lab/test/docs/test_docs.py) checks that each line still parses, that the programs, packages, launch
+files, nodes, topics, services and parameters it names exist in the code, and that the template uses
+every key.
+
+A line is split with shlex and run without a shell, from the report's work folder (bags land there).
+``limit`` [s] is a safety net only: commands that would run forever (``rostopic hz``) are bounded by a
+visible ``timeout -s INT``, which stops them as Ctrl-C would.
+"""
+import collections
+
+#: key: the template's name for the command; line: the exact command line; limit: safety timeout [s].
+Command = collections.namedtuple('Command', 'key line limit')
+
+#: Topics of a full flight recorded to a bag: sensors, estimate, LED, ground truth and the log.
+FLIGHT_TOPICS = '/temperature /pressure /altitude /alt_warn_led /mydrone/true_altitude /rosout'
+DIVE_TOPICS = '/pressure_robot /pressure_remote /depth /depth_warn_led /submarine_drone/true_depth /rosout'
+
+# --- sheet 000, questions 3 to 8: the aerial drone's node alone --------------------------------------
+MYDRONE_NODE = Command('mydrone.run', 'rosrun mydrone mydrone_node.py', None)
+MYDRONE_ALONE = [
+    Command('mydrone.rosnode_list', 'rosnode list', 15),
+    Command('mydrone.rosnode_info', 'rosnode info /mydrone', 15),
+    Command('mydrone.rostopic_list', 'rostopic list', 15),
+    Command('mydrone.rostopic_info_rosout', 'rostopic info /rosout', 15),
+    Command('mydrone.rostopic_type', 'rostopic type /temperature', 15),
+    Command('mydrone.rosmsg_info', 'rosmsg info std_msgs/Float32', 15),
+    Command('mydrone.echo_temperature', 'rostopic echo -n 3 /temperature', 20),
+    Command('mydrone.hz_temperature', 'timeout -s INT 10 rostopic hz /temperature', 20),
+    Command('mydrone.hz_pressure', 'timeout -s INT 4 rostopic hz /pressure', 15),
+    Command('mydrone.rosservice_list', 'rosservice list', 15),
+    Command('mydrone.rossrv_show', 'rossrv show mydrone/AltitudeWarning', 15),
+    Command('mydrone.call_warning', 'rosservice call /altitude_warning "status: \'WARNING\'"', 15),
+    Command('mydrone.echo_led', 'rostopic echo -n 1 /alt_warn_led', 15),
+    Command('mydrone.call_normal', 'rosservice call /altitude_warning "status: \'NORMAL\'"', 15),
+    Command('mydrone.call_bad', 'rosservice call /altitude_warning "status: \'RED\'"', 15),
+]
+
+# --- sheet 000, question 9: the package (run in a scratch folder, compared with exam/package.xml) ----
+CREATE_PKG = Command('exam.create_pkg', 'catkin_create_pkg exam rospy std_msgs mydrone submarinedrone', 30)
+
+# --- sheet 000, questions 10 to 14: the exam node with the drone, one full default flight -----------
+FLIGHT_RECORD = Command('flight.record', 'rosbag record -O flight.bag ' + FLIGHT_TOPICS, None)
+FLIGHT_LAUNCH = Command('flight.launch', 'roslaunch exam exam.launch', None)
+FLIGHT_LIVE = [
+    Command('flight.rosnode_list', 'rosnode list', 15),
+    Command('flight.rosnode_info_exam', 'rosnode info /exam', 15),
+    Command('flight.echo_altitude', 'rostopic echo -n 3 /altitude', 15),
+    Command('flight.hz_altitude', 'timeout -s INT 5 rostopic hz /altitude', 15),
+    Command('flight.param_threshold', 'rosparam get /exam/threshold', 15),
+    Command('flight.param_delay', 'rosparam get /exam/delay', 15),
+]
+#: The same flight at the same time on a second master, with the threshold raised (question 14a).
+HIGH_RECORD = Command('high.record', 'rosbag record -O flight_1500.bag /altitude /alt_warn_led', None)
+HIGH_LAUNCH = Command('high.launch', 'roslaunch exam exam.launch threshold:=1500', None)
+HIGH_LIVE = [
+    Command('high.param_threshold', 'rosparam get /exam/threshold', 15),
+]
+
+# --- sheet 001, questions 3 to 8: the underwater drone's node alone ---------------------------------
+SUBMARINE_NODE = Command('submarine.run', 'rosrun submarinedrone submarine_drone_node.py', None)
+SUBMARINE_ALONE = [
+    Command('submarine.rosnode_list', 'rosnode list', 15),
+    Command('submarine.rosnode_info', 'rosnode info /submarine_drone', 15),
+    Command('submarine.rostopic_list', 'rostopic list', 15),
+    Command('submarine.rostopic_type', 'rostopic type /pressure_robot', 15),
+    Command('submarine.rosmsg_info', 'rosmsg info std_msgs/Float32', 15),
+    Command('submarine.echo_pressure_robot', 'rostopic echo -n 3 /pressure_robot', 15),
+    Command('submarine.hz_pressure_robot', 'timeout -s INT 5 rostopic hz /pressure_robot', 15),
+    Command('submarine.hz_pressure_remote', 'timeout -s INT 6 rostopic hz /pressure_remote', 15),
+    Command('submarine.call_warning', 'rosservice call /depth_warning "status: \'WARNING\'"', 15),
+    Command('submarine.call_normal', 'rosservice call /depth_warning "status: \'NORMAL\'"', 15),
+]
+
+# --- sheet 001, questions 10 to 14: the exam node in depth mode, one full default dive --------------
+DIVE_RECORD = Command('dive.record', 'rosbag record -O dive.bag ' + DIVE_TOPICS, None)
+DIVE_LAUNCH = Command('dive.launch', 'roslaunch exam exam_submarine.launch', None)
+DIVE_LIVE = [
+    Command('dive.rosnode_info_exam', 'rosnode info /exam', 15),
+    Command('dive.echo_depth', 'rostopic echo -n 3 /depth', 15),
+    Command('dive.hz_depth', 'timeout -s INT 5 rostopic hz /depth', 15),
+    Command('dive.param_threshold', 'rosparam get /exam/threshold', 15),
+]
+
+#: Processes started in the background (their console is kept; they are stopped with SIGINT).
+BACKGROUND = [MYDRONE_NODE, FLIGHT_RECORD, FLIGHT_LAUNCH, HIGH_RECORD, HIGH_LAUNCH,
+              SUBMARINE_NODE, DIVE_RECORD, DIVE_LAUNCH]
+#: Commands run to completion, output captured.
+FOREGROUND = MYDRONE_ALONE + [CREATE_PKG] + FLIGHT_LIVE + HIGH_LIVE + SUBMARINE_ALONE + DIVE_LIVE
+ALL = BACKGROUND + FOREGROUND
+BY_KEY = {command.key: command for command in ALL}

@@ -1,0 +1,256 @@
+#!/usr/bin/env python3
+"""Fills docs/report.md from report_template.md with the outputs of a run, and draws the figures.
+
+Usage: render.py --work DIR --repo DIR   (DIR of collect.py: outputs.json and the three bags)
+
+The template is Markdown with placeholders, each replaced by something this run produced:
+
+- ``{{run KEY}}``: a console block with the command line of command_list.py and its real output;
+- ``{{line KEY}}``: the command line alone (a background command: a launch, a recording);
+- ``{{value NAME}}``: a number or short text computed from the run (see :func:`facts`);
+- ``{{block NAME}}``: a preformatted block computed from the run (log excerpts, comparisons);
+- ``{{file PATH}}``: a file of the repository, verbatim;
+- ``{{source MODULE:NAME}}``: the source of one function or class of the code, verbatim.
+
+An unknown placeholder or key is an error: the report never shows a hole.
+"""
+import argparse
+import importlib
+import inspect
+import json
+import os
+import re
+import shlex
+import socket
+import subprocess
+import textwrap
+import time
+import xml.etree.ElementTree as ET
+
+from exam import formulas
+from mydrone import atmosphere
+
+import analysis
+import command_list
+import figures
+
+PLACEHOLDER = re.compile(r'\{\{(run|line|value|block|file|source) ([^ }]+)\}\}')
+ANSI = re.compile(r'\x1b\][^\x07\x1b]*(\x07|\x1b\\)?|\x1b\[[0-9;]*[A-Za-z]|\][0-9];[^\n]*?(?=\n|$)')
+
+
+def clean(text):
+    """Console text without colour codes and terminal-title sequences."""
+    return ANSI.sub('', text).replace('\r', '')
+
+
+def last_rate(hz_output):
+    """The last 'average rate' that ``rostopic hz`` printed, as a float."""
+    rates = re.findall(r'average rate: ([0-9.]+)', hz_output)
+    if not rates:
+        raise RuntimeError('rostopic hz printed no rate (a loaded machine?); run make report again:\n'
+                           + hz_output)
+    return float(rates[-1])
+
+
+def console_lines(text, pattern):
+    """Lines of a console that match ``pattern`` (colour codes removed)."""
+    return [line for line in clean(text).splitlines() if re.search(pattern, line)]
+
+
+def param_value(outputs, key):
+    """The number ``rosparam get`` printed."""
+    return float(outputs[key]['output'].strip())
+
+
+def depends(package_xml_text):
+    """{tag: [names]} of the dependency tags of a package.xml."""
+    root = ET.fromstring(package_xml_text)
+    found = {}
+    for element in root:
+        if element.tag.endswith('depend'):
+            found.setdefault(element.tag, []).append(element.text.strip())
+    return found
+
+
+def fmt(value, digits=1):
+    return '%.*f' % (digits, value)
+
+
+def run_facts(work, outputs, name, bag, inputs, compute, output, truth, led, threshold_key, delay):
+    """analysis.summarise of one recorded run, with its origin at the roslaunch start."""
+    series = analysis.read_bag(os.path.join(work, bag))
+    threshold = param_value(outputs, threshold_key)
+    origin = outputs[name]['started']
+    summary = analysis.summarise(series, inputs, compute, output, truth, led, threshold, delay, origin)
+    summary['threshold'] = threshold
+    summary['series'] = series
+    return summary
+
+
+def facts(work, repo, outputs):
+    """Every {{value}} and {{block}} of the template, and the figures (written to docs/figures/)."""
+    delay = param_value(outputs, 'flight.param_delay')
+    flight = run_facts(work, outputs, 'flight.launch', 'flight.bag', ['/temperature', '/pressure'],
+                       formulas.altitude, '/altitude', '/mydrone/true_altitude', '/alt_warn_led',
+                       'flight.param_threshold', delay)
+    high = run_facts(work, outputs, 'high.launch', 'flight_1500.bag', ['/temperature', '/pressure'],
+                     formulas.altitude, '/altitude', '/mydrone/true_altitude', '/alt_warn_led',
+                     'high.param_threshold', delay)
+    dive = run_facts(work, outputs, 'dive.launch', 'dive.bag', ['/pressure_robot', '/pressure_remote'],
+                     formulas.depth, '/depth', '/submarine_drone/true_depth', '/depth_warn_led',
+                     'dive.param_threshold', delay)
+    out = os.path.join(repo, 'docs', 'figures')
+    os.makedirs(out, exist_ok=True)
+    figures.run_figure(os.path.join(out, 'flight.png'), flight, 'mydrone, default flight, exam.launch',
+                       'altitude', 'm', flight['threshold'], delay, '/altitude_warning')
+    figures.run_figure(os.path.join(out, 'dive.png'), dive, 'submarine_drone, default dive, '
+                       'exam_submarine.launch', 'depth', 'm', dive['threshold'], delay, '/depth_warning',
+                       invert=True)
+    curve = [(float(h), analysis.isothermal_error(h)) for h in range(0, 3001, 50)]
+    fixed = [(float(h), analysis.lapse_rate_error(h)) for h in range(0, 3001, 50)]
+    measured = analysis.hold_errors(flight['series'], ['/temperature', '/pressure'], formulas.altitude,
+                                    '/mydrone/true_altitude')
+    figures.model_error_figure(os.path.join(out, 'model_error.png'), curve, fixed, measured,
+                               flight['threshold'])
+    dive_errors = analysis.hold_errors(dive['series'], ['/pressure_robot', '/pressure_remote'],
+                                       formulas.depth, '/submarine_drone/true_depth')
+
+    v = {}
+    for prefix, run in (('flight', flight), ('dive', dive)):
+        episodes = [e for e in run['episodes'] if e[2] is not None]
+        short = [e for e in episodes if e[2] < delay]
+        long_ = [e for e in episodes if e[2] >= delay]
+        if not short or not long_ or len(run['changes']) < 2:
+            raise RuntimeError('%s: expected a short and a long excess and two LED changes; got '
+                               'episodes %s, changes %s' % (prefix, episodes, run['changes']))
+        v[prefix + '.threshold'] = '%g' % run['threshold']
+        v[prefix + '.short_start'] = fmt(short[0][0])
+        v[prefix + '.short_duration'] = fmt(short[0][2])
+        v[prefix + '.long_start'] = fmt(long_[0][0])
+        v[prefix + '.long_end'] = fmt(long_[0][1])
+        v[prefix + '.long_duration'] = fmt(long_[0][2])
+        v[prefix + '.calls'] = str(len(run['changes']))
+        v[prefix + '.red_at'] = fmt([t for t, c in run['changes'] if c == 'RED'][0])
+        v[prefix + '.green_at'] = fmt([t for t, c in run['changes'] if c == 'GREEN'][0])
+        v[prefix + '.warning_lag_ms'] = '%.0f' % (1000 * run['warning_lag'][0])
+        v[prefix + '.normal_lag_ms'] = '%.0f' % (1000 * run['normal_lag'][0])
+        v[prefix + '.rate'] = fmt(run['rate'], 2)
+        v[prefix + '.seconds'] = '%.0f' % run['published'][-1][0]
+        v[prefix + '.changes'] = ', '.join('%s at %.1f s' % (c, t) for t, c in run['changes'])
+    started = outputs['flight.launch']['started']
+    v['run.date'] = time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime(started))
+    v['run.host'] = socket.gethostname()
+    versions = re.findall(r'/rosversion: (\S+)', outputs['flight.launch']['output'])
+    v['run.rosversion'] = versions[0] if versions else 'unknown'
+    v['flight.delay'] = '%g' % delay
+    v['high.threshold'] = '%g' % high['threshold']
+    v['high.calls'] = str(len(high['changes']))
+    v['high.max'] = fmt(max(value for _, value in high['published']))
+    v['high.seconds'] = '%.0f' % high['published'][-1][0]
+    v['flight.max'] = fmt(max(value for _, value in flight['published']))
+    v['flight.true_max'] = fmt(max(value for _, value in flight['truth']))
+
+    v['model.err_1300'] = fmt(analysis.isothermal_error(1300.0))
+    v['model.err_1500'] = fmt(analysis.isothermal_error(1500.0))
+    v['model.err_3000'] = fmt(analysis.isothermal_error(3000.0))
+    v['model.true_at_threshold'] = fmt(analysis.true_altitude_read_as(flight['threshold']))
+    v['model.mean_t_1300'] = '%.2f' % analysis.mean_temperature_error(1300.0)
+    v['model.mean_t_3000'] = '%.1f' % analysis.mean_temperature_error(3000.0)
+    v['model.t_1300'] = '%.2f' % atmosphere.temperature_c(1300.0)
+    v['model.p_1300'] = '%.0f' % atmosphere.pressure_pa(1300.0)
+    v['model.fix_max'] = '%.1e' % max(abs(e) for _, e in fixed)
+    v['model.standard_1300'] = '%.3f' % analysis.standard_altitude(atmosphere.pressure_pa(1300.0))
+    for level in (1200.0, 1500.0):
+        errs = [e for h, e in measured if abs(h - level) < 0.5]
+        v['model.measured_%d' % level] = fmt(analysis.mean(errs))
+        v['model.measured_%d_n' % level] = str(len(errs))
+    v['dive.err_mean_mm'] = '%.1f' % (1000 * analysis.mean(e for _, e in dive_errors))
+    v['dive.err_max_mm'] = '%.0f' % (1000 * max(abs(e) for _, e in dive_errors))
+    v['dive.err_n'] = str(len(dive_errors))
+    v['mydrone.temperature_rate'] = fmt(last_rate(outputs['mydrone.hz_temperature']['output']), 3)
+    v['mydrone.pressure_rate'] = fmt(last_rate(outputs['mydrone.hz_pressure']['output']), 3)
+    v['submarine.robot_rate'] = fmt(last_rate(outputs['submarine.hz_pressure_robot']['output']), 3)
+    v['submarine.remote_rate'] = fmt(last_rate(outputs['submarine.hz_pressure_remote']['output']), 3)
+    v['flight.hz'] = fmt(last_rate(outputs['flight.hz_altitude']['output']), 3)
+    v['dive.hz'] = fmt(last_rate(outputs['dive.hz_depth']['output']), 3)
+
+    b = {}
+    # The exam node's lines only: its start-up summary, its decisions, and its service calls.
+    exam_lines = r'\]: (/exam: |\w+ -?[0-9.]+ m .*: (WARNING|NORMAL)$|/\w+_warning: LED set to|could not set)'
+    b['flight.exam_log'] = '\n'.join(console_lines(outputs['flight.launch']['output'], exam_lines))
+    b['high.exam_log'] = '\n'.join(console_lines(outputs['high.launch']['output'], exam_lines))
+    b['dive.exam_log'] = '\n'.join(console_lines(outputs['dive.launch']['output'], exam_lines))
+    b['flight.drone_log'] = '\n'.join(console_lines(outputs['flight.launch']['output'],
+                                                    r'altitude_warning: ALT WARN'))
+    b['dive.drone_log'] = '\n'.join(console_lines(outputs['dive.launch']['output'],
+                                                  r'depth_warning: DEPTH WARN'))
+    line = 'git ls-files -s -- exam/scripts mydrone/scripts submarinedrone/scripts'
+    listed = subprocess.run(shlex.split(line), cwd=repo, stdout=subprocess.PIPE, check=True)
+    b['scripts.modes'] = '$ %s\n%s' % (line, listed.stdout.decode().rstrip())
+    created = depends(outputs['exam.create_pkg']['package_xml'])
+    with open(os.path.join(repo, 'exam', 'package.xml')) as f:
+        ours = depends(f.read())
+    rows = ['%-20s %-44s %s' % ('tag', 'catkin_create_pkg wrote', 'exam/package.xml has')]
+    for tag in sorted(set(created) | set(ours)):
+        rows.append('%-20s %-44s %s' % (tag, ' '.join(created.get(tag, [])) or '-',
+                                        ' '.join(ours.get(tag, [])) or '-'))
+    b['exam.depends'] = '\n'.join(rows)
+    return v, b
+
+
+def source_of(spec):
+    """Source text of ``module:Name`` or ``module:Class.method``, dedented."""
+    module_name, qualname = spec.split(':')
+    obj = importlib.import_module(module_name)
+    for part in qualname.split('.'):
+        obj = getattr(obj, part)
+    return textwrap.dedent(inspect.getsource(obj)).rstrip()
+
+
+def fence(text, language=''):
+    return '```%s\n%s\n```' % (language, text)
+
+
+def render(template, outputs, values, blocks, repo):
+    """The template with every placeholder replaced; raises KeyError on an unknown one."""
+    def replace(match):
+        kind, key = match.groups()
+        if kind == 'run':
+            result = outputs[key]
+            if command_list.BY_KEY[key].line != result['line']:
+                raise KeyError('%s: outputs.json is older than command_list.py, run make report' % key)
+            return fence('$ %s\n%s' % (result['line'], clean(result['output'])), 'console')
+        if kind == 'line':
+            return '`%s`' % command_list.BY_KEY[key].line
+        if kind == 'value':
+            return values[key]
+        if kind == 'block':
+            return fence(blocks[key], 'text')
+        if kind == 'file':
+            with open(os.path.join(repo, key)) as f:
+                language = {'.launch': 'xml', '.xml': 'xml', '.py': 'python', '.srv': 'text'}
+                return fence(f.read().rstrip(), language.get(os.path.splitext(key)[1], ''))
+        return fence(source_of(key), 'python')
+    return PLACEHOLDER.sub(replace, template)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    parser.add_argument('--work', required=True, help='folder of outputs.json and the bags')
+    parser.add_argument('--repo', required=True, help='the repository (docs/ is written there)')
+    args = parser.parse_args()
+    with open(os.path.join(args.work, 'outputs.json')) as f:
+        outputs = json.load(f)
+    values, blocks = facts(args.work, args.repo, outputs)
+    here = os.path.dirname(os.path.abspath(__file__))
+    with open(os.path.join(here, 'report_template.md')) as f:
+        template = f.read()
+    text = render(template, outputs, values, blocks, args.repo)
+    # The template's own comment lines (<!-- ... -->) stay: they say how the file is made.
+    with open(os.path.join(args.repo, 'docs', 'report.md'), 'w') as f:
+        f.write(text)
+    print('report: docs/report.md and docs/figures/{flight,dive,model_error}.png written')
+
+
+if __name__ == '__main__':
+    main()

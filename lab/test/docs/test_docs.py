@@ -1,0 +1,246 @@
+"""The docs against the code: the report's commands still name things that exist, and every parameter
+the docs name is one the code reads, with exactly that name.
+
+- The commands are those of lab/report/command_list.py, the list `make report` runs; the template uses
+  every one of them, and the committed docs/report.md shows exactly those lines, in the template's order.
+- Each command parses (shlex), starts an installed program, and names packages, scripts, launch files
+  and launch arguments, nodes, topics, services, message and service types and parameters that exist
+  in this repository's code (or in ROS itself, for /rosout and std_msgs).
+- Every ``~name`` and ``name:=`` in docs/*.md and README.md is a private parameter (or private topic) the
+  code reads, a launch argument, or a topic being remapped.
+
+Run by `make test` (lab/CMakeLists.txt registers it); no ROS master needed.
+"""
+import glob
+import importlib
+import os
+import re
+import shlex
+import shutil
+import sys
+import xml.etree.ElementTree as ET
+
+import pytest
+import yaml
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
+sys.path.insert(0, os.path.join(REPO, 'lab', 'report'))
+
+import command_list  # noqa: E402  (lab/report is a script folder, not a package)
+
+from mydrone.simulator import SPEC as MYDRONE  # noqa: E402
+from submarinedrone.simulator import SPEC as SUBMARINE  # noqa: E402
+from exam.modes import MODES  # noqa: E402
+
+TEMPLATE = os.path.join(REPO, 'lab', 'report', 'report_template.md')
+REPORT = os.path.join(REPO, 'docs', 'report.md')
+PROGRAMS = {'rosnode', 'rostopic', 'rosmsg', 'rossrv', 'rosservice', 'rosparam', 'rosrun', 'roslaunch',
+            'rosbag', 'catkin_create_pkg'}
+#: Node names the launch files give (name="...") and ROS's own logging node.
+ROS_TOPICS = {'/rosout', '/rosout_agg'}
+#: Private services rospy gives every node (``~get_loggers``), named in the docs like parameters.
+ROS_PRIVATE_NAMES = {'get_loggers', 'set_logger_level'}
+#: Special arguments every ROS node understands (remapping of its name, namespace, log file...).
+SPECIAL_ARGS = {'__name', '__ns', '__log', '__ip', '__hostname', '__master'}
+#: How a parameter or launch argument is named in prose: `~threshold`, `threshold:=1500`.
+PRIVATE_NAME = re.compile(r'(?<![\w/.])~([A-Za-z_]\w*)')
+ASSIGNED_NAME = re.compile(r'(?<![\w/:.-])(/?[A-Za-z_]\w*)(?=:=)')
+#: How the code reads a private parameter: rospy.get_param('~x'), _param('x', ...).
+READ_PARAM = re.compile(r'\b(?:get_param|_param)\(\s*[\'"]~?(\w+)[\'"]')
+#: drone_sim reads one parameter per sensor: _param(sensor.topic + '_rate', ...).
+READ_SENSOR_PARAM = re.compile(r'\b_param\(\s*\w+\.topic\s*\+\s*[\'"](\w+)[\'"]')
+
+
+def code_files():
+    """The Python files of the nodes: every package's src/ and scripts/, and the bench nodes."""
+    patterns = ['*/src/*/*.py', '*/scripts/*.py', 'lab/bench/*.py']
+    return sorted(f for p in patterns for f in glob.glob(os.path.join(REPO, p)))
+
+
+def read(path):
+    with open(path) as f:
+        return f.read()
+
+
+def private_names_in_code():
+    """Every private parameter some node reads, the drones' private topics (``~true_altitude``), and the
+    private services of every rospy node."""
+    names = set(ROS_PRIVATE_NAMES)
+    sensor_suffixes = set()
+    for path in code_files():
+        text = read(path)
+        names.update(READ_PARAM.findall(text))
+        sensor_suffixes.update(READ_SENSOR_PARAM.findall(text))
+    for spec in (MYDRONE, SUBMARINE):
+        names.update(sensor.topic + suffix for sensor in spec.sensors for suffix in sensor_suffixes)
+        names.add(spec.truth_topic)
+    return names
+
+
+def launch_files():
+    return sorted(glob.glob(os.path.join(REPO, '*', 'launch', '*.launch')))
+
+
+def launch_args(path):
+    return {arg.get('name') for arg in ET.parse(path).getroot().iter('arg')}
+
+
+def launch_node_names():
+    names = set()
+    for path in launch_files():
+        names.update('/' + node.get('name') for node in ET.parse(path).getroot().iter('node'))
+    return names
+
+
+def graph_names():
+    """Topics, services and nodes the code creates, as they resolve in the root namespace."""
+    names = set(ROS_TOPICS) | launch_node_names()
+    for spec in (MYDRONE, SUBMARINE):
+        node = '/' + spec.node_name
+        names.update([node, node + '/' + spec.truth_topic, '/' + spec.service_name, '/' + spec.led_topic])
+        names.update('/' + sensor.topic for sensor in spec.sensors)
+    for mode in MODES.values():
+        names.update('/' + topic for topic in [mode.output, mode.service, mode.led_topic]
+                     + [spec.topic for spec in mode.inputs])
+    return names
+
+
+def unknown_names(text, private_names, args, topics):
+    """The ``~name`` and ``name:=`` of ``text`` that no code reads and no launch file declares."""
+    unknown = set()
+    for name in PRIVATE_NAME.findall(text):
+        if name not in private_names:
+            unknown.add('~' + name)
+    for name in ASSIGNED_NAME.findall(text):
+        if name in SPECIAL_ARGS or name in args:
+            continue
+        if name.startswith('_') and name[1:] in private_names:  # rosrun's _param:=value
+            continue
+        if name.startswith('/') and name in topics:  # a remapping: /altitude:=/elsewhere
+            continue
+        unknown.add(name + ':=')
+    return unknown
+
+
+def template_keys():
+    """Keys of {{run KEY}} and {{line KEY}} placeholders, in the template's order."""
+    return re.findall(r'\{\{(run|line) ([^ }]+)\}\}', read(TEMPLATE))
+
+
+def argv(command):
+    """The command's words, without a leading ``timeout -s INT <s>``."""
+    words = shlex.split(command.line)
+    if words[0] == 'timeout':
+        assert words[1:3] == ['-s', 'INT'] and float(words[3]) > 0, command.line
+        words = words[4:]
+    return words
+
+
+def package_dir(name):
+    """The folder of the catkin package ``name`` in this repository (lab/ holds exam_lab), or None."""
+    for manifest in glob.glob(os.path.join(REPO, '*', 'package.xml')):
+        if ET.parse(manifest).getroot().findtext('name') == name:
+            return os.path.dirname(manifest)
+    return None
+
+
+# --- the command list and the report ---------------------------------------------------------------
+
+def test_template_uses_every_command_and_only_known_ones():
+    used = {key for _, key in template_keys()}
+    assert used - set(command_list.BY_KEY) == set(), 'the template names commands that command_list.py does not run'
+    assert set(command_list.BY_KEY) - used == set(), 'commands run by make report that the report never shows'
+
+
+def test_committed_report_shows_exactly_the_commands_of_the_list():
+    shown = [line[2:] for block in re.findall(r'```console\n(.*?)```', read(REPORT), re.S)
+             for line in block.splitlines()[:1]]
+    expected = [command_list.BY_KEY[key].line for kind, key in template_keys() if kind == 'run']
+    assert shown == expected, 'docs/report.md is out of date: run make report'
+
+
+def test_commands_are_unique_per_key_and_bounded():
+    assert len(command_list.BY_KEY) == len(command_list.ALL)
+    for command in command_list.FOREGROUND:
+        assert command.limit is not None and command.limit > 0, command.key
+
+
+@pytest.mark.parametrize('command', command_list.ALL, ids=lambda c: c.key)
+def test_command_starts_an_installed_ros_program(command):
+    words = argv(command)
+    assert words[0] in PROGRAMS, command.line
+    assert shutil.which(words[0]) is not None, '%s is not installed' % words[0]
+    if command.line.startswith('rostopic hz') or command.line.startswith('rostopic echo /'):
+        pytest.fail('%s would run forever: bound it with timeout -s INT or -n' % command.line)
+
+
+@pytest.mark.parametrize('command', command_list.ALL, ids=lambda c: c.key)
+def test_command_names_what_exists(command):
+    words = argv(command)
+    program, args = words[0], words[1:]
+    names = graph_names()
+    if program == 'rosrun':
+        script = os.path.join(package_dir(args[0]), 'scripts', args[1])
+        assert os.access(script, os.X_OK), '%s is not an executable script' % script
+    elif program == 'roslaunch':
+        path = os.path.join(package_dir(args[0]), 'launch', args[1])
+        declared = launch_args(path)
+        for assignment in args[2:]:
+            assert assignment.split(':=')[0] in declared, '%s: %s declares no such arg' % (assignment, path)
+    elif program == 'catkin_create_pkg':
+        assert args[0] == 'exam' and package_dir('exam')
+        for dependency in args[1:]:
+            assert package_dir(dependency) or dependency in ('rospy', 'std_msgs'), dependency
+    elif program == 'rosparam':
+        assert args[0] == 'get'
+        node, name = args[1].rsplit('/', 1)
+        assert node in names and name in private_names_in_code(), args[1]
+    elif program in ('rosmsg', 'rossrv'):
+        package, name = args[1].split('/')
+        module = importlib.import_module('%s.%s' % (package, 'msg' if program == 'rosmsg' else 'srv'))
+        assert hasattr(module, name), args[1]
+    elif program == 'rosservice' and args[0] == 'call':
+        assert args[1] in names, args[1]
+        request = yaml.safe_load(args[2])
+        service_type = [m.service_type for m in MODES.values() if '/' + m.service == args[1]][0]
+        assert set(request) == set(service_type._request_class.__slots__), command.line
+    else:
+        # rosnode/rostopic/rosbag/rosservice list: every graph name given must exist in the code.
+        for word in args:
+            if word.startswith('/'):
+                assert word in names, '%s names %s, which no node creates' % (command.line, word)
+
+
+# --- parameters named in the docs -----------------------------------------------------------------
+
+def doc_files():
+    files = sorted(glob.glob(os.path.join(REPO, 'docs', '*.md'))) + [TEMPLATE]
+    readme = os.path.join(REPO, 'README.md')
+    return files + ([readme] if os.path.exists(readme) else [])
+
+
+@pytest.mark.parametrize('path', doc_files(), ids=lambda p: os.path.relpath(p, REPO))
+def test_every_parameter_named_in_the_docs_is_read_by_the_code(path):
+    args = set().union(*(launch_args(p) for p in launch_files()))
+    assert unknown_names(read(path), private_names_in_code(), args, graph_names()) == set()
+
+
+@pytest.mark.parametrize('module', ['exam.node', 'mydrone.simulator', 'submarinedrone.simulator',
+                                    'drone_sim.simulator'])
+def test_node_docstrings_name_only_parameters_the_code_reads(module):
+    text = importlib.import_module(module).__doc__
+    assert unknown_names(text, private_names_in_code(), set(), set()) == set()
+
+
+def test_the_check_catches_a_parameter_the_code_does_not_read():
+    # The checker itself must be able to fail: misspelt names, in both notations, are reported.
+    text = 'Set `~thresold` or run `roslaunch exam exam.launch thresold:=1500`; `~threshold` is fine.'
+    args = set().union(*(launch_args(p) for p in launch_files()))
+    assert unknown_names(text, private_names_in_code(), args, graph_names()) == {'~thresold', 'thresold:='}
+
+
+def test_code_scan_finds_the_parameters_of_both_nodes():
+    names = private_names_in_code()
+    for expected in ('mode', 'threshold', 'delay', 'rate', 'timeout', 'profile', 'seed',
+                     'temperature_rate', 'pressure_noise', 'pressure_robot_rate', 'true_depth'):
+        assert expected in names

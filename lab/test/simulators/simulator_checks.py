@@ -1,0 +1,102 @@
+"""Checks shared by the two simulators' rostests (check_mydrone.py, check_submarinedrone.py).
+
+Both drones come from the same generic node (drone_sim.simulator), so one test case checks both; each
+drone's check subclasses SimulatorNodeCase and fills in its names and expected readings. The rostest
+file runs the node with zero noise and a constant profile, so every reading has an exact expected value.
+"""
+
+import subprocess
+import unittest
+
+import rospy
+import rosservice
+from std_msgs.msg import Float32, String
+
+from exam_lab.harness.fake_drone import TopicRecorder
+from exam_lab.harness.wait import wait_until
+
+DEADLINE = 30.0  # s; generous, the test machine is shared
+
+
+class SimulatorNodeCase(unittest.TestCase):
+    """Subclasses set the class attributes below and implement check_readings."""
+
+    PACKAGE = None  # e.g. 'mydrone'
+    SCRIPT = None  # e.g. 'mydrone_node.py'
+    NODE = None  # the node's default name, e.g. 'mydrone'
+    SENSOR_TOPICS = ()  # absolute names of the Float32 sensor topics
+    TRUTH_TOPIC = None  # absolute name of the private truth topic
+    TRUE_VALUE = None  # the constant profile value of the .test file
+    SERVICE = None  # absolute service name
+    SERVICE_TYPE = None  # the service class
+    LED_TOPIC = None  # absolute name of the latched LED topic
+    # (private param, value as given on a command line): each must stop the node with a fatal log
+    # naming the resolved parameter
+    BAD_PARAMS = ()
+
+    def check_readings(self, readings):
+        """Assert the first reading of each sensor topic; ``readings`` maps topic -> value."""
+        raise NotImplementedError
+
+    def test_advertised_types(self):
+        expected = {topic: 'std_msgs/Float32' for topic in self.SENSOR_TOPICS + (self.TRUTH_TOPIC,)}
+        expected[self.LED_TOPIC] = 'std_msgs/String'
+
+        def advertised():
+            published = dict(rospy.get_published_topics())
+            return {t: published.get(t) for t in expected}
+        wait_until(lambda: advertised() == expected, DEADLINE)
+        self.assertEqual(advertised(), expected)
+        rospy.wait_for_service(self.SERVICE, timeout=DEADLINE)
+        self.assertEqual(rosservice.get_service_type(self.SERVICE), self.SERVICE_TYPE._type)
+
+    def test_readings_and_truth(self):
+        recorders = {t: TopicRecorder(t, Float32) for t in self.SENSOR_TOPICS + (self.TRUTH_TOPIC,)}
+        readings = {t: r.wait_for_count(1, DEADLINE) for t, r in recorders.items()}
+        for recorder in recorders.values():
+            recorder.close()
+        for topic, values in readings.items():
+            self.assertEqual(len(values), 1, 'no message on %s within %.0f s' % (topic, DEADLINE))
+        self.assertAlmostEqual(readings[self.TRUTH_TOPIC][0], self.TRUE_VALUE, places=3)
+        self.check_readings({t: v[0] for t, v in readings.items()})
+
+    def test_service_drives_latched_led(self):
+        led = TopicRecorder(self.LED_TOPIC, String)
+        self.assertEqual(led.wait_for_count(1, DEADLINE), ['GREEN'], 'the latched LED must start GREEN')
+        rospy.wait_for_service(self.SERVICE, timeout=DEADLINE)
+        call = rospy.ServiceProxy(self.SERVICE, self.SERVICE_TYPE)
+        responses = [call(status) for status in ('warning', 'WARNING', 'WARNING', 'BOOM', 'NORMAL')]
+        self.assertEqual([r.success for r in responses], [False, True, True, False, True])
+        for refused in (responses[0], responses[3]):
+            self.assertIn("'NORMAL'", refused.message)
+            self.assertIn("'WARNING'", refused.message)
+        self.assertIn('RED', responses[1].message)
+        self.assertIn('GREEN', responses[4].message)
+        # One message per change: a refused or repeated request publishes nothing. The node publishes
+        # before it answers, so all three are on their way by now.
+        self.assertEqual(led.wait_for_count(3, DEADLINE), ['GREEN', 'RED', 'GREEN'])
+        led.close()
+        # A late subscriber gets the current colour from the latch.
+        late = TopicRecorder(self.LED_TOPIC, String)
+        self.assertEqual(late.wait_for_count(1, DEADLINE), ['GREEN'])
+        late.close()
+
+    def test_bad_params_exit_nonzero(self):
+        # One namespace per case: `_name:=value` stays on the parameter server after the node exits,
+        # and would otherwise be the first bad value the next case's node meets.
+        # No subTest: rosunit's XML runner drops subtest failures and reports the test as passed.
+        outcomes = []
+        for i, (param, value) in enumerate(self.BAD_PARAMS):
+            namespace = '/bad%d' % i
+            resolved = '%s/%s/%s' % (namespace, self.NODE, param)
+            try:
+                done = subprocess.run(['rosrun', self.PACKAGE, self.SCRIPT, '__ns:=' + namespace,
+                                       '_%s:=%s' % (param, value)],
+                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                      universal_newlines=True, timeout=DEADLINE)
+            finally:
+                rospy.delete_param(namespace)
+            outcomes.append((param, value, done.returncode != 0, resolved in done.stdout, done.stdout))
+        # Compared as a whole, so a failure shows every case with the node's output.
+        self.assertEqual([o[:4] for o in outcomes], [o[:2] + (True, True) for o in outcomes],
+                         '\n'.join(o[4] for o in outcomes))
