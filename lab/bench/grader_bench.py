@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """The grader's speed, and whether grading students side by side keeps its timing checks fair.
 
-    python3 lab/bench/grader_bench.py [--students 20] [--jobs 2,3] [--out DIR]
+    python3 lab/bench/grader_bench.py [--students 20] [--jobs 2,3] [--out DIR] [--record]
+    python3 lab/bench/grader_bench.py --from-results DIR/results.json [--record]
 
-(from the repository, after ``make build`` and ``source tools/env.sh``; runs standalone). Three phases:
+(from the repository, after ``make build`` and ``source tools/env.sh``; runs standalone, about 20
+minutes, and is not part of ``make bench``). Phases:
 
 1. *alone*: each distinct package (the flawed and good student packages of lab/test/grader, and our
    exam node) graded one at a time (JOBS=1): the reference points and timings, and one submission's
@@ -12,9 +14,11 @@
    side: its wall time, and for every student the points and the timings the rubric judges (rate,
    WARNING latency, NORMAL latency) against the same package graded alone.
 
-Prints a Markdown section (docs/benchmarks.md, "The grader") and writes ``results.json`` in --out.
+Prints a Markdown section and writes ``results.json`` in --out; ``--record`` also writes the section
+to lab/bench/grader.md, which lab/bench/report.py appends to docs/benchmarks.md ("The grader").
 """
 import argparse
+import datetime
 import json
 import os
 import shutil
@@ -82,11 +86,19 @@ def main(argv=None):
     parser.add_argument('--students', type=int, default=20)
     parser.add_argument('--jobs', default='2,3')
     parser.add_argument('--out', default=None)
+    parser.add_argument('--record', action='store_true', help='write the section to lab/bench/grader.md')
+    parser.add_argument('--from-results', help='render the section of an earlier run\'s results.json')
     args = parser.parse_args(argv)
+    if args.from_results:
+        with open(args.from_results) as f:
+            return publish(json.load(f), args.record)
+    started = time.monotonic()
     out = args.out or tempfile.mkdtemp(prefix='grader-bench-')
     kinds = packages()
     runner.ensure_underlay(runner.default_underlay())
-    results = {'alone': {}, 'classes': []}
+    results = {'alone': {}, 'classes': [], 'date': datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M'),
+               'load_start': list(os.getloadavg()), 'command': 'python3 lab/bench/grader_bench.py '
+               '--students %d --jobs %s' % (args.students, args.jobs)}
 
     alone_dir = os.path.join(out, 'alone-class')
     os.makedirs(alone_dir)
@@ -111,9 +123,19 @@ def main(argv=None):
         results['classes'].append({'jobs': jobs, 'students': args.students, 'wall': wall, 'rows': rows})
         print('JOBS=%d: %d students in %.0f s' % (jobs, args.students, wall), file=sys.stderr)
 
+    results['load_end'] = list(os.getloadavg())
+    results['total_s'] = time.monotonic() - started
     with open(os.path.join(out, 'results.json'), 'w') as f:
         json.dump(results, f, indent=1, sort_keys=True)
-    print(render(results))
+    return publish(results, args.record)
+
+
+def publish(results, record):
+    section = render(results)
+    print(section)
+    if record:
+        with open(os.path.join(HERE, 'grader.md'), 'w') as f:
+            f.write(section + '\n')
     return 0
 
 
@@ -123,24 +145,56 @@ def _spread(values):
 
 
 def render(results):
+    """The "The grader" section of docs/benchmarks.md."""
     alone = results['alone']
     one = [v['seconds'] for v in alone.values()]
-    lines = ['| graded | wall time | per student | all points as alone | rate [Hz] | WARNING after [s] | NORMAL after [s] |',
-             '|---|---|---|---|---|---|---|']
-    lines.append('| each of %d packages alone (JOBS=1) | %.0f s | %.0f-%.0f s | (reference) | %s | %s | %s |' % (
+    rows = ['| graded | wall time | per student | same points as alone | rate [Hz] | WARNING after [s] | '
+            'NORMAL after [s] |', '|---|---|---|---|---|---|---|']
+    rows.append('| each of %d packages alone (JOBS=1) | %.0f s | %.0f-%.0f s | (reference) | %s | %s | %s |' % (
         len(alone), results['alone_wall'], min(one), max(one),
         _spread([v['timing']['hz'] for v in alone.values()]),
         _spread([v['timing']['warning_s'] for k, v in alone.items() if k != 'no_delay']),
         _spread([v['timing']['normal_s'] for v in alone.values()])))
     for klass in results['classes']:
-        rows = klass['rows']
-        lines.append('| class of %d, JOBS=%d | %.0f s | %.0f-%.0f s | %d of %d | %s | %s | %s |' % (
-            klass['students'], klass['jobs'], klass['wall'], min(r['seconds'] for r in rows),
-            max(r['seconds'] for r in rows), len([r for r in rows if r['same_points']]), len(rows),
-            _spread([r['timing']['hz'] for r in rows]),
-            _spread([r['timing']['warning_s'] for r in rows if r['kind'] != 'no_delay']),
-            _spread([r['timing']['normal_s'] for r in rows])))
-    return '\n'.join(lines)
+        graded = klass['rows']
+        rows.append('| class of %d, JOBS=%d | %.0f s | %.0f-%.0f s | %d of %d | %s | %s | %s |' % (
+            klass['students'], klass['jobs'], klass['wall'], min(r['seconds'] for r in graded),
+            max(r['seconds'] for r in graded), len([r for r in graded if r['same_points']]), len(graded),
+            _spread([r['timing']['hz'] for r in graded]),
+            _spread([r['timing']['warning_s'] for r in graded if r['kind'] != 'no_delay']),
+            _spread([r['timing']['normal_s'] for r in graded])))
+    differ = ['%s (JOBS=%d): %s' % (r['student'], k['jobs'], ', '.join(
+        '%s %s instead of %s' % (item, r['points'][item], alone[r['kind']]['points'][item])
+        for item in sorted(r['points']) if r['points'][item] != alone[r['kind']]['points'][item]))
+        for k in results['classes'] for r in k['rows'] if not r['same_points']]
+    kinds = ['| %s | %s | %.0f s |' % (kind, _total(v['points']), v['seconds']) for kind, v in sorted(alone.items())]
+    when = results.get('date', '?')
+    load = ''
+    if results.get('load_start'):
+        load = ' Load average (1, 5, 15 min) at start %s, at end %s: the machine (2 cores) is shared.' % (
+            ['%.2f' % x for x in results['load_start']], ['%.2f' % x for x in results.get('load_end', [])])
+    return '\n'.join([
+        '## The grader', '',
+        '_Measured by `%s --record` on %s (UTC)%s, after `make build` and `source tools/env.sh`; it runs '
+        'standalone and is not part of `make bench`._%s' % (
+            results.get('command', 'python3 lab/bench/grader_bench.py'), when,
+            ' in %.0f s' % results['total_s'] if results.get('total_s') else '', load), '',
+        'What `make grade` costs ([docs/grading.md](grading.md)), and whether grading students side by side '
+        '(`JOBS`, each student on a master of its own) keeps its timing checks fair. The packages are our '
+        'exam node and the student packages of `lab/test/grader/submissions/`; a class of 20 cycles through '
+        'them. "Same points as alone": every item of the student equals that of its package graded alone. '
+        'The timings are those the rubric judges, over every student of the row: the output rate '
+        '(10 Hz +- 10 % passes), the WARNING after the first reading above the threshold (4.7-5.5 s passes; '
+        'the package without delay left out) and the NORMAL after the first reading back (<= 0.5 s).', '']
+        + rows + ['',
+        'Goals: one submission in at most 90 s, a class of 20 in at most 10 minutes. %s' % (
+            'Every student got the points of its package alone.' if not differ else
+            'Points that differed: %s.' % '; '.join(differ)), '',
+        '| package | points alone | wall time alone |', '|---|---|---|'] + kinds)
+
+
+def _total(points):
+    return ('%.1f' % sum(points.values())).rstrip('0').rstrip('.')
 
 
 if __name__ == '__main__':
