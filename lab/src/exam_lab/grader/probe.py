@@ -24,6 +24,7 @@ The main scenario (times are the script's, all recorded as ROS time of the event
 """
 import json
 import math
+import os
 import sys
 import time
 
@@ -303,7 +304,13 @@ class Probe(object):
         return self.result
 
 
+#: Most seconds the probe keeps the drone up after writing its result, waiting to be stopped.
+LINGER_S = 60.0
+
+
 def main(argv):
+    """Measure, write the result (atomically), then keep the fake drone serving until stopped
+    (SIGINT) or LINGER_S: the student's node must not lose its drone before the grader stops it."""
     if len(argv) != 2:
         sys.stderr.write('usage: python3 -m exam_lab.grader.probe PLAN.json RESULT.json\n')
         return 2
@@ -313,11 +320,15 @@ def main(argv):
     probe = Probe(plan)
     try:
         result = probe.run()
+        with open(argv[1] + '.part', 'w') as f:
+            json.dump(result, f, indent=1, sort_keys=True)
+        os.rename(argv[1] + '.part', argv[1])
+        time.sleep(LINGER_S)
+    except KeyboardInterrupt:
+        pass  # the session stopped us, after the student's node
     finally:
         probe.drone.close()
-    with open(argv[1], 'w') as f:
-        json.dump(result, f, indent=1, sort_keys=True)
-    rospy.signal_shutdown('probe done')
+        rospy.signal_shutdown('probe done')
     return 0
 
 

@@ -18,8 +18,10 @@ import json
 import os
 import re
 import sys
+import time
 
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
+from exam_lab.harness.wait import wait_until
 
 #: Terminal colour and title sequences roslaunch writes even into a file.
 _ANSI = re.compile(r'\x1b\[[0-9;]*m|\x1b?\]2;[^\n\x07]*\x07?')
@@ -92,19 +94,25 @@ def run_one(sup, job, run, node_env):
         json.dump(run['plan'], f, indent=1, sort_keys=True)
     probe_env = ros_env(master.env, master.uri, os.path.join(log_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')
     probe_env['ROS_NAMESPACE'] = job.get('namespace', '/')
-    status, _, seconds = sup.run('probe-%s' % tag, [sys.executable, '-m', 'exam_lab.grader.probe',
-                                                    plan_path, result_path],
-                                 timeout=job['run_timeout'], env=probe_env)
-    record = {'tag': tag, 'probe': None, 'probe_status': status, 'seconds': seconds}
-    if status == 0 and os.path.isfile(result_path):
-        with open(result_path) as f:
-            record['probe'] = json.load(f)
-    else:
-        record['probe_error'] = tail(sup.output('probe-%s' % tag), 15)
+    started = time.monotonic()
+    probe = sup.start('probe-%s' % tag, [sys.executable, '-m', 'exam_lab.grader.probe', plan_path, result_path],
+                      probe_env)
+    # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
+    # nothing it does when its drone goes away (a failed service call, a crash) is counted.
+    wait_until(lambda: os.path.isfile(result_path) or probe.poll() is not None, job['run_timeout'], period=0.1)
+    seconds = time.monotonic() - started
+    record = {'tag': tag, 'probe': None, 'seconds': seconds}
     record['launch_running'] = launch.poll() is None
     # Read before stopping: what the nodes print when the grader stops them is not their doing.
     record['launch'] = launch_outcome(sup.output('launch-%s' % tag), job['workspace'])
     sup.stop(launch)
+    if os.path.isfile(result_path):
+        with open(result_path) as f:
+            record['probe'] = json.load(f)
+    else:
+        record['probe_error'] = ('no result within %.0f s; ' % job['run_timeout'] if probe.poll() is None else
+                                 'exit %s; ' % probe.poll()) + tail(sup.output('probe-%s' % tag), 15)
+    record['probe_status'] = sup.stop(probe, grace=5.0)
     sup.stop(master.proc)
     return record
 
