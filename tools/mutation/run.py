@@ -1,0 +1,250 @@
+"""Mutation testing of the answer's code with cosmic-ray, one session per group of mutation.toml.
+
+Run by tools/mutation/run.sh with the interpreter of the virtual environment that holds cosmic-ray,
+from the root of a scratch copy of the repository whose catkin workspace is sourced: cosmic-ray
+writes each mutant into the file on disk, so it must never run in a working tree.
+
+For each group: list its modules, create the cosmic-ray session, mark as skipped the mutants the
+configuration rules out (operators not kept, string formatting, skipped lines, functions the group
+does not target), check
+that the test command passes on the unmutated code, run every remaining mutant against it, and write
+report.md: the score and every surviving mutant with its diff. Mutants listed in equivalents.toml are
+reported apart, with their reason, and left out of the score.
+
+Usage: run.py CONFIG EQUIVALENTS OUTDIR [group name ...]
+"""
+import ast
+import datetime
+import fnmatch
+import os
+import re
+import shlex
+import subprocess
+import sys
+import time
+from importlib.metadata import version
+
+import toml
+from cosmic_ray.work_db import WorkDB, use_db
+from cosmic_ray.work_item import TestOutcome, WorkerOutcome, WorkResult
+
+
+def group_modules(group):
+    """The .py files of a group: its paths (files or directories), less its excludes, sorted."""
+    found = []
+    for path in group['paths']:
+        if path.endswith('.py'):
+            found.append(path)
+            continue
+        for root, _, files in os.walk(path):
+            found.extend(os.path.join(root, name) for name in files if name.endswith('.py'))
+    excludes = group.get('exclude', [])
+    return sorted(p for p in found
+                  if not any(fnmatch.fnmatch(p, pattern) for pattern in excludes)
+                  and os.path.getsize(p) > 0)
+
+
+def session_config(group, modules):
+    """The cosmic-ray configuration of one group, as a dict for toml."""
+    return {'cosmic-ray': {
+        'module-path': modules,
+        'timeout': float(group['timeout']),
+        'excluded-modules': [],
+        # cosmic-ray splits the command without a shell; the group's command may chain with &&.
+        'test-command': 'bash -c %s' % shlex.quote(group['test']),
+        'distributor': {'name': 'local'},
+    }}
+
+
+def string_formatting_spans(path):
+    """Where the % of each ``'literal' % args`` can stand: ((line, col) after the string, (line, col)
+    of the arguments). Such a % formats a string; it is no arithmetic."""
+    with open(path) as source:
+        tree = ast.parse(source.read(), path)
+    return [((node.left.end_lineno, node.left.end_col_offset), (node.right.lineno, node.right.col_offset))
+            for node in ast.walk(tree)
+            if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Mod)
+            and isinstance(node.left, ast.Constant) and isinstance(node.left.value, str)]
+
+
+def skip_reason(mutation, rules, lines, formatting):
+    """Why the configuration rules this mutation out, or None when it runs."""
+    operator = mutation.operator_name
+    if not any(re.match(keep, operator) for keep in rules['keep']):
+        return 'operator not kept'
+    line_no = mutation.start_pos[0]
+    text = lines[line_no - 1].strip()
+    position = tuple(mutation.start_pos)
+    if (rules['skip-string-formatting'] and operator.startswith('core/ReplaceBinaryOperator_Mod_')
+            and any(after <= position < before for after, before in formatting)):
+        return 'string formatting'
+    if any(re.search(pattern, text) for pattern in rules['skip-lines']):
+        return 'skipped line'
+    name = mutation.definition_name or ''
+    if rules['definitions'] and not any(re.search(pattern, name) for pattern in rules['definitions']):
+        return 'function not mutated by this group'
+    return None
+
+
+def apply_filters(session, modules, rules):
+    """Mark the ruled-out mutants of a session as skipped; return {reason: count}."""
+    sources = {m: open(m).read().splitlines() for m in modules}
+    formatting = {m: string_formatting_spans(m) for m in modules}
+    skipped = {}
+    unmatched = set(rules['definitions'])
+    with use_db(session, WorkDB.Mode.open) as db:
+        for item in list(db.pending_work_items):
+            mutation = item.mutations[0]
+            unmatched -= {p for p in unmatched if re.search(p, mutation.definition_name or '')}
+            path = str(mutation.module_path)
+            reason = skip_reason(mutation, rules, sources[path], formatting[path])
+            if reason is not None:
+                skipped[reason] = skipped.get(reason, 0) + 1
+                db.set_result(item.job_id, WorkResult(output='filtered: ' + reason,
+                                                      worker_outcome=WorkerOutcome.SKIPPED))
+    if unmatched:
+        # A function renamed or moved: its mutants would silently drop out of the run.
+        print('mutation: warning: no function matches %s in %s' % (sorted(unmatched), modules), flush=True)
+    return skipped
+
+
+def cosmic_ray(*args, log=None):
+    """Run one cosmic-ray command of the virtual environment; raise when it fails."""
+    command = [os.path.join(os.path.dirname(sys.executable), 'cosmic-ray')] + list(args)
+    subprocess.run(command, check=True, stdout=log, stderr=subprocess.STDOUT)
+
+
+def load_equivalents(path):
+    """The mutants accepted as equivalent or not worth a test: (file, operator, line text) -> reason."""
+    entries = toml.load(path).get('equivalent', [])
+    return {(e['file'], e['operator'], e['line'].strip()): e['reason'] for e in entries}
+
+
+def run_group(group, defaults, outdir):
+    """Run one group's session; return its results as a dict for the report."""
+    slug = re.sub(r'[^a-z0-9]+', '-', group['name'].lower()).strip('-')
+    config_path = os.path.join(outdir, slug + '.toml')
+    session = os.path.join(outdir, slug + '.sqlite')
+    log_path = os.path.join(outdir, slug + '.log')
+    modules = group_modules(group)
+    rules = {
+        'keep': defaults['keep'],
+        'skip-string-formatting': defaults.get('skip-string-formatting', False),
+        'skip-lines': group.get('skip-lines', []),
+        'definitions': group.get('definitions', []),
+    }
+    with open(config_path, 'w') as out:
+        toml.dump(session_config(group, modules), out)
+    if os.path.exists(session):
+        os.remove(session)
+    start = time.monotonic()
+    with open(log_path, 'w') as log:
+        cosmic_ray('init', config_path, session, log=log)
+        skipped = apply_filters(session, modules, rules)
+        print('mutation: %s: %d mutants skipped by the configuration %s; baseline...'
+              % (group['name'], sum(skipped.values()), skipped), flush=True)
+        # The unmutated code must pass, or every mutant would count as killed.
+        cosmic_ray('baseline', config_path, log=log)
+        print('mutation: %s: running the mutants (log: %s)' % (group['name'], log_path), flush=True)
+        cosmic_ray('exec', config_path, session, log=log)
+    elapsed = time.monotonic() - start
+    results = []
+    with use_db(session, WorkDB.Mode.open) as db:
+        for item, result in db.completed_work_items:
+            if result.worker_outcome == WorkerOutcome.SKIPPED:
+                continue
+            results.append((item.mutations[0], result))
+    return {'name': group['name'], 'test': group['test'], 'modules': modules, 'skipped': skipped,
+            'results': results, 'seconds': elapsed}
+
+
+def describe(mutation):
+    return '%s:%d %s (in %s)' % (mutation.module_path, mutation.start_pos[0],
+                                 mutation.operator_name.replace('core/', ''),
+                                 mutation.definition_name or 'module')
+
+
+def classify(run, equivalents):
+    """Split a group's results: killed, accepted (with the reason), surviving, incompetent."""
+    classes = {'killed': [], 'accepted': [], 'surviving': [], 'incompetent': []}
+    for mutation, result in run['results']:
+        line = open(str(mutation.module_path)).read().splitlines()[mutation.start_pos[0] - 1]
+        key = (str(mutation.module_path), mutation.operator_name, line.strip())
+        if result.worker_outcome != WorkerOutcome.NORMAL or result.test_outcome == TestOutcome.INCOMPETENT:
+            classes['incompetent'].append((mutation, result, None))
+        elif result.test_outcome == TestOutcome.KILLED:
+            classes['killed'].append((mutation, result, None))
+        elif key in equivalents:
+            classes['accepted'].append((mutation, result, equivalents[key]))
+        else:
+            classes['surviving'].append((mutation, result, None))
+    return classes
+
+
+def write_report(path, runs, equivalents, tool_version, total_seconds):
+    """report.md: score per group and overall, then every surviving mutant with its diff."""
+    rows = []
+    every = {'killed': [], 'accepted': [], 'surviving': [], 'incompetent': []}
+    for run in runs:
+        classes = classify(run, equivalents)
+        for name, members in classes.items():
+            every[name].extend(members)
+        rows.append('| %s | %d | %d | %d | %d | %d | %d | %s |' % (
+            run['name'], sum(run['skipped'].values()), len(run['results']), len(classes['killed']),
+            len(classes['accepted']), len(classes['surviving']), len(classes['incompetent']),
+            minutes(run['seconds'])))
+    killed, surviving = len(every['killed']), len(every['surviving'])
+    scored = killed + surviving
+    with open(path, 'w') as out:
+        out.write('# Mutation testing report\n\n')
+        out.write('%s, cosmic-ray %s, %s in all. Score: **%d killed of %d non-equivalent mutants (%.1f %%)**; '
+                  '%d accepted as equivalent or not worth a test (tools/mutation/equivalents.toml), '
+                  '%d surviving, %d incompetent.\n\n'
+                  % (datetime.datetime.now().strftime('%Y-%m-%d %H:%M'), tool_version,
+                     minutes(total_seconds), killed, scored, 100.0 * killed / scored if scored else 0.0,
+                     len(every['accepted']), surviving, len(every['incompetent'])))
+        out.write('| group | skipped by the configuration | ran | killed | equivalent | surviving '
+                  '| incompetent | time |\n')
+        out.write('|---|---|---|---|---|---|---|---|\n')
+        out.write('\n'.join(rows) + '\n\n')
+        for run in runs:
+            out.write('- %s: `%s` against %s; skipped: %s\n'
+                      % (run['name'], run['test'], ', '.join(run['modules']), run['skipped'] or 'none'))
+        out.write('\n## Surviving mutants (%d)\n\n' % surviving)
+        if not surviving:
+            out.write('None.\n')
+        for mutation, result, _ in every['surviving']:
+            out.write('### %s\n\n```diff\n%s\n```\n\n' % (describe(mutation), (result.diff or '').strip()))
+        out.write('\n## Accepted as equivalent or not worth a test (%d)\n\n' % len(every['accepted']))
+        for mutation, result, reason in every['accepted']:
+            out.write('- %s: %s\n' % (describe(mutation), reason))
+        if every['incompetent']:
+            out.write('\n## Incompetent: the mutant could not be tested (%d)\n\n' % len(every['incompetent']))
+            for mutation, result, _ in every['incompetent']:
+                out.write('- %s: %s\n' % (describe(mutation), (result.output or '').strip()[-300:]))
+    return killed, len(every['accepted']), surviving
+
+
+def minutes(seconds):
+    return '%d min %02d s' % divmod(int(round(seconds)), 60)
+
+
+def main(argv):
+    config_path, equivalents_path, outdir = argv[:3]
+    wanted = argv[3:]
+    config = toml.load(config_path)
+    groups = [g for g in config['group'] if not wanted or g['name'] in wanted]
+    if wanted and len(groups) != len(wanted):
+        sys.exit('mutation: unknown group in %s; the groups are: %s'
+                 % (wanted, ', '.join(g['name'] for g in config['group'])))
+    start = time.monotonic()
+    runs = [run_group(group, config['operators'], outdir) for group in groups]
+    report = os.path.join(outdir, 'report.md')
+    killed, accepted, surviving = write_report(report, runs, load_equivalents(equivalents_path),
+                                               version('cosmic-ray'), time.monotonic() - start)
+    print('mutation: %d killed, %d accepted as equivalent, %d surviving; report: %s'
+          % (killed, accepted, surviving, report))
+
+
+if __name__ == '__main__':
+    main(sys.argv[1:])
