@@ -44,16 +44,34 @@ def group_modules(group):
                   and os.path.getsize(p) > 0)
 
 
-def session_config(group, modules):
-    """The cosmic-ray configuration of one group, as a dict for toml."""
+def session_config(modules, command, timeout):
+    """The cosmic-ray configuration of one session, as a dict for toml."""
     return {'cosmic-ray': {
         'module-path': modules,
-        'timeout': float(group['timeout']),
+        'timeout': float(timeout),
         'excluded-modules': [],
         # cosmic-ray splits the command without a shell; the group's command may chain with &&.
-        'test-command': 'bash -c %s' % shlex.quote(group['test']),
+        'test-command': 'bash -c %s' % shlex.quote(command),
         'distributor': {'name': 'local'},
     }}
+
+
+def sessions(group):
+    """(modules, test command) of each session of a group.
+
+    A command naming ``{module-tests}`` gets one session per module, with that placeholder replaced by
+    the group's ``module-tests`` path for the module (``{module}`` is its file name without .py) when
+    that file exists: the module's own tests run first, so most mutants die in a fraction of the suite.
+    """
+    modules = group_modules(group)
+    command = group['test']
+    if '{module-tests}' not in command:
+        return [(modules, command)]
+    result = []
+    for module in modules:
+        first = group['module-tests'].format(module=os.path.splitext(os.path.basename(module))[0])
+        result.append(([module], command.replace('{module-tests}', first if os.path.exists(first) else '')))
+    return result
 
 
 def string_formatting_spans(path):
@@ -83,29 +101,32 @@ def skip_reason(mutation, rules, lines, formatting):
     name = mutation.definition_name or ''
     if rules['definitions'] and not any(re.search(pattern, name) for pattern in rules['definitions']):
         return 'function not mutated by this group'
+    if any(re.search(pattern, name) for pattern in rules['skip-definitions']):
+        return 'function not mutated by this group'
     return None
 
 
 def apply_filters(session, modules, rules):
-    """Mark the ruled-out mutants of a session as skipped; return {reason: count}."""
+    """Mark the ruled-out mutants of a session as skipped.
+
+    Return ({reason: count}, the patterns of ``definitions`` and ``skip-definitions`` that matched).
+    """
     sources = {m: open(m).read().splitlines() for m in modules}
     formatting = {m: string_formatting_spans(m) for m in modules}
     skipped = {}
-    unmatched = set(rules['definitions'])
+    patterns = set(rules['definitions']) | set(rules['skip-definitions'])
+    matched = set()
     with use_db(session, WorkDB.Mode.open) as db:
         for item in list(db.pending_work_items):
             mutation = item.mutations[0]
-            unmatched -= {p for p in unmatched if re.search(p, mutation.definition_name or '')}
+            matched |= {p for p in patterns if re.search(p, mutation.definition_name or '')}
             path = str(mutation.module_path)
             reason = skip_reason(mutation, rules, sources[path], formatting[path])
             if reason is not None:
                 skipped[reason] = skipped.get(reason, 0) + 1
                 db.set_result(item.job_id, WorkResult(output='filtered: ' + reason,
                                                       worker_outcome=WorkerOutcome.SKIPPED))
-    if unmatched:
-        # A function renamed or moved: its mutants would silently drop out of the run.
-        print('mutation: warning: no function matches %s in %s' % (sorted(unmatched), modules), flush=True)
-    return skipped
+    return skipped, matched
 
 
 def cosmic_ray(*args, log=None):
@@ -120,42 +141,64 @@ def load_equivalents(path):
     return {(e['file'], e['operator'], e['line'].strip()): e['reason'] for e in entries}
 
 
-def run_group(group, defaults, outdir):
-    """Run one group's session; return its results as a dict for the report."""
-    slug = re.sub(r'[^a-z0-9]+', '-', group['name'].lower()).strip('-')
+def run_session(name, slug, modules, command, timeout, rules, outdir):
+    """Run one cosmic-ray session; return ({skip reason: count}, patterns of functions matched,
+    [(mutation, result)] of the mutants run)."""
     config_path = os.path.join(outdir, slug + '.toml')
     session = os.path.join(outdir, slug + '.sqlite')
     log_path = os.path.join(outdir, slug + '.log')
-    modules = group_modules(group)
+    with open(config_path, 'w') as out:
+        toml.dump(session_config(modules, command, timeout), out)
+    if os.path.exists(session):
+        os.remove(session)
+    with open(log_path, 'w') as log:
+        cosmic_ray('init', config_path, session, log=log)
+        skipped, matched = apply_filters(session, modules, rules)
+        print('mutation: %s: %d mutants skipped by the configuration %s; baseline...'
+              % (name, sum(skipped.values()), skipped), flush=True)
+        # The unmutated code must pass, or every mutant would count as killed.
+        cosmic_ray('baseline', config_path, log=log)
+        print('mutation: %s: running the mutants (log: %s)' % (name, log_path), flush=True)
+        cosmic_ray('exec', config_path, session, log=log)
+    results = []
+    with use_db(session, WorkDB.Mode.open) as db:
+        for item, result in db.completed_work_items:
+            if result.worker_outcome != WorkerOutcome.SKIPPED:
+                results.append((item.mutations[0], result))
+    return skipped, matched, results
+
+
+def run_group(group, defaults, outdir):
+    """Run the sessions of one group; return its results as a dict for the report."""
     rules = {
         'keep': defaults['keep'],
         'skip-string-formatting': defaults.get('skip-string-formatting', False),
         'skip-lines': group.get('skip-lines', []),
         'definitions': group.get('definitions', []),
+        'skip-definitions': group.get('skip-definitions', []),
     }
-    with open(config_path, 'w') as out:
-        toml.dump(session_config(group, modules), out)
-    if os.path.exists(session):
-        os.remove(session)
+    slug = re.sub(r'[^a-z0-9]+', '-', group['name'].lower()).strip('-')
     start = time.monotonic()
-    with open(log_path, 'w') as log:
-        cosmic_ray('init', config_path, session, log=log)
-        skipped = apply_filters(session, modules, rules)
-        print('mutation: %s: %d mutants skipped by the configuration %s; baseline...'
-              % (group['name'], sum(skipped.values()), skipped), flush=True)
-        # The unmutated code must pass, or every mutant would count as killed.
-        cosmic_ray('baseline', config_path, log=log)
-        print('mutation: %s: running the mutants (log: %s)' % (group['name'], log_path), flush=True)
-        cosmic_ray('exec', config_path, session, log=log)
-    elapsed = time.monotonic() - start
-    results = []
-    with use_db(session, WorkDB.Mode.open) as db:
-        for item, result in db.completed_work_items:
-            if result.worker_outcome == WorkerOutcome.SKIPPED:
-                continue
-            results.append((item.mutations[0], result))
+    skipped, results, modules, matched = {}, [], [], set()
+    for modules_of_session, command in sessions(group):
+        modules.extend(modules_of_session)
+        name = group['name']
+        session_slug = slug
+        if len(modules_of_session) == 1 and '{module-tests}' in group['test']:
+            stem = os.path.splitext(os.path.basename(modules_of_session[0]))[0]
+            name, session_slug = '%s: %s' % (name, stem), '%s-%s' % (slug, stem)
+        session_skipped, session_matched, session_results = run_session(
+            name, session_slug, modules_of_session, command, group['timeout'], rules, outdir)
+        matched |= session_matched
+        for reason, count in session_skipped.items():
+            skipped[reason] = skipped.get(reason, 0) + count
+        results.extend(session_results)
+    unmatched = (set(rules['definitions']) | set(rules['skip-definitions'])) - matched
+    if unmatched:
+        # A function renamed or moved: its mutants would silently drop out of the run, or into it.
+        print('mutation: warning: %s: no function matches %s' % (group['name'], sorted(unmatched)), flush=True)
     return {'name': group['name'], 'test': group['test'], 'modules': modules, 'skipped': skipped,
-            'results': results, 'seconds': elapsed}
+            'results': results, 'seconds': time.monotonic() - start}
 
 
 def describe(mutation):
