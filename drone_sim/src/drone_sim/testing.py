@@ -1,10 +1,13 @@
-"""Integration checks shared by the simulators' rostests (imported by test nodes only, never by a node).
+"""Checks shared by the simulators' tests (imported by tests only, never by a node).
 
 Both drones come from the same generic node, so one test case checks both; each package's test node
 subclasses SimulatorNodeCase and fills in its names and expected readings. The rostest file runs the
 node with zero noise and a constant profile, so every reading has an exact expected value.
+:func:`documented_profiles` reads the built-in profiles back from the docstring that describes them,
+so the unit tests can hold each package's table to its documentation.
 """
 
+import re
 import subprocess
 import threading
 import time
@@ -127,3 +130,27 @@ class SimulatorNodeCase(unittest.TestCase):
         # Compared as a whole, so a failure shows every case with the node's output.
         self.assertEqual([o[:4] for o in outcomes], [o[:2] + (True, True) for o in outcomes],
                          '\n'.join(o[4] for o in outcomes))
+
+
+def documented_profiles(docstring):
+    """The waypoints ``[[time_s, value], ...]`` that a profile module's docstring gives, by name.
+
+    Three forms, as mydrone.flights and submarinedrone.dives write them (values in m)::
+
+        ``name`` (loop T s)::           followed by a row "time s ..." and a row "<quantity> m ..."
+        ``name`` (loop T s): v0 m -> v1 m -> ... -> vN m at t0, t1, ..., tN s
+        ``name`` (loop T s): v m all the time
+    """
+    number = r'-?[0-9.]+'
+    profiles = {}
+    table = r'``(\w+)`` \(loop %s s\)::\s*\n\s*time +s +([-0-9. ]+)\n\s*\w+ +m +([-0-9. ]+)' % number
+    for name, times, values in re.findall(table, docstring):
+        profiles[name] = [[float(t), float(v)] for t, v in zip(times.split(), values.split())]
+    chain = r'``(\w+)`` \(loop %s s\): ((?:%s m -> )+%s m) at ([-0-9., ]+) s' % (number, number, number)
+    for name, values, times in re.findall(chain, docstring):
+        values = [float(v) for v in re.findall(number, values)]
+        profiles[name] = [[float(t), v] for t, v in zip(times.split(','), values)]
+    constant = r'``(\w+)`` \(loop (%s) s\): (%s) m all the time' % (number, number)
+    for name, period, value in re.findall(constant, docstring):
+        profiles[name] = [[0.0, float(value)], [float(period), float(value)]]
+    return profiles

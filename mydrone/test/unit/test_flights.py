@@ -3,7 +3,8 @@
 import pytest
 
 from drone_sim.profile import Profile, spans_above
-from mydrone import atmosphere
+from drone_sim.testing import documented_profiles
+from mydrone import atmosphere, flights
 from mydrone.flights import FLIGHTS
 from test_atmosphere import isothermal_altitude
 
@@ -52,3 +53,8 @@ def test_calm_never_crosses_and_high_never_leaves():
     assert max(estimated) < THRESHOLD - 100.0 and max(true) < THRESHOLD - 100.0
     _, times, true, estimated = sampled('high')
     assert min(estimated) > THRESHOLD + 100.0
+
+
+def test_the_docstring_gives_every_flight_exactly():
+    # The docstring is what a user reads to pick a flight: every waypoint must be the one flown.
+    assert documented_profiles(flights.__doc__) == FLIGHTS

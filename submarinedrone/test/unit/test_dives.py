@@ -3,7 +3,8 @@
 import pytest
 
 from drone_sim.profile import Profile, spans_above
-from submarinedrone import hydrostatics
+from drone_sim.testing import documented_profiles
+from submarinedrone import dives, hydrostatics
 from submarinedrone.dives import DIVES
 
 THRESHOLD = 150.0  # m
@@ -45,3 +46,8 @@ def test_default_seen_through_the_exam_formula():
 def test_calm_never_crosses_and_deep_never_leaves():
     assert max(sampled('calm')[1]) < THRESHOLD - 25.0
     assert min(sampled('deep')[1]) > THRESHOLD + 25.0
+
+
+def test_the_docstring_gives_every_dive_exactly():
+    # The docstring is what a user reads to pick a dive: every waypoint must be the one dived.
+    assert documented_profiles(dives.__doc__) == DIVES
