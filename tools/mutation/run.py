@@ -8,10 +8,10 @@ For each group: list its modules, create the cosmic-ray session, mark as skipped
 configuration rules out (operators not kept, string formatting, skipped lines, functions the group
 does not target), check
 that the test command passes on the unmutated code, run every remaining mutant against it, and write
-report.md: the score and every surviving mutant with its diff. Mutants listed in equivalents.toml are
-reported apart, with their reason, and left out of the score.
+report.md: the score and every surviving mutant with its diff. Surviving mutants judged in
+known_mutants.toml are reported apart with their reason; the equivalent ones are left out of the score.
 
-Usage: run.py CONFIG EQUIVALENTS OUTDIR [group name ...]
+Usage: run.py CONFIG KNOWN_MUTANTS OUTDIR [group name ...]
 """
 import ast
 import datetime
@@ -135,10 +135,21 @@ def cosmic_ray(*args, log=None):
     subprocess.run(command, check=True, stdout=log, stderr=subprocess.STDOUT)
 
 
-def load_equivalents(path):
-    """The mutants accepted as equivalent or not worth a test: (file, operator, line text) -> reason."""
-    entries = toml.load(path).get('equivalent', [])
-    return {(e['file'], e['operator'], e['line'].strip()): e['reason'] for e in entries}
+def load_known(path):
+    """The surviving mutants already judged, (file, line, mutated line) -> (kind, reason).
+
+    kind is 'equivalent' (no test can tell the mutant from the code) or 'not worth a test'.
+    """
+    known = {}
+    for entry in toml.load(path).get('mutant', []):
+        if entry['kind'] not in KINDS:
+            sys.exit('mutation: %s: kind %r is none of %s' % (path, entry['kind'], KINDS))
+        reason = ' '.join(entry['reason'].split())
+        known[(entry['file'], entry['line'].strip(), entry['mutant'].strip())] = (entry['kind'], reason)
+    return known
+
+
+KINDS = ('equivalent', 'not worth a test')
 
 
 def run_session(name, slug, modules, command, timeout, rules, outdir):
@@ -207,65 +218,81 @@ def describe(mutation):
                                  mutation.definition_name or 'module')
 
 
-def classify(run, equivalents):
-    """Split a group's results: killed, accepted (with the reason), surviving, incompetent."""
-    classes = {'killed': [], 'accepted': [], 'surviving': [], 'incompetent': []}
-    for mutation, result in run['results']:
-        line = open(str(mutation.module_path)).read().splitlines()[mutation.start_pos[0] - 1]
-        key = (str(mutation.module_path), mutation.operator_name, line.strip())
+def mutated_lines(diff):
+    """(original lines, mutated lines) of a cosmic-ray diff, each stripped and joined by newlines."""
+    lines = (diff or '').splitlines()
+    old = [l[1:].strip() for l in lines if l.startswith('-') and not l.startswith('---')]
+    new = [l[1:].strip() for l in lines if l.startswith('+') and not l.startswith('+++')]
+    return '\n'.join(old), '\n'.join(new)
+
+
+def classify(results, known):
+    """Split results: killed, equivalent, not worth a test (with their reasons), surviving, incompetent."""
+    classes = {name: [] for name in ('killed', 'surviving', 'incompetent') + KINDS}
+    for mutation, result in results:
         if result.worker_outcome != WorkerOutcome.NORMAL or result.test_outcome == TestOutcome.INCOMPETENT:
             classes['incompetent'].append((mutation, result, None))
         elif result.test_outcome == TestOutcome.KILLED:
             classes['killed'].append((mutation, result, None))
-        elif key in equivalents:
-            classes['accepted'].append((mutation, result, equivalents[key]))
         else:
-            classes['surviving'].append((mutation, result, None))
+            kind, reason = known.get((str(mutation.module_path),) + mutated_lines(result.diff), (None, None))
+            classes[kind or 'surviving'].append((mutation, result, reason))
     return classes
 
 
-def write_report(path, runs, equivalents, tool_version, total_seconds):
-    """report.md: score per group and overall, then every surviving mutant with its diff."""
+def score(classes):
+    """(killed, non-equivalent mutants that ran): the equivalent ones cannot be killed, so they do not count."""
+    killed = len(classes['killed'])
+    return killed, killed + len(classes['surviving']) + len(classes['not worth a test'])
+
+
+def write_report(path, runs, known, tool_version, total_seconds):
+    """report.md: score per group and overall, every surviving mutant with its diff, the judged ones."""
     rows = []
-    every = {'killed': [], 'accepted': [], 'surviving': [], 'incompetent': []}
+    every = {}
     for run in runs:
-        classes = classify(run, equivalents)
+        classes = classify(run['results'], known)
         for name, members in classes.items():
-            every[name].extend(members)
-        rows.append('| %s | %d | %d | %d | %d | %d | %d | %s |' % (
-            run['name'], sum(run['skipped'].values()), len(run['results']), len(classes['killed']),
-            len(classes['accepted']), len(classes['surviving']), len(classes['incompetent']),
-            minutes(run['seconds'])))
-    killed, surviving = len(every['killed']), len(every['surviving'])
-    scored = killed + surviving
+            every.setdefault(name, []).extend(members)
+        killed, scored = score(classes)
+        rows.append('| %s | %d | %d | %d | %d | %d | %d | %s | %s |' % (
+            run['name'], sum(run['skipped'].values()), len(run['results']), killed,
+            len(classes['equivalent']), len(classes['not worth a test']), len(classes['surviving']),
+            percent(killed, scored), minutes(run['seconds'])))
+    killed, scored = score(every)
     with open(path, 'w') as out:
         out.write('# Mutation testing report\n\n')
-        out.write('%s, cosmic-ray %s, %s in all. Score: **%d killed of %d non-equivalent mutants (%.1f %%)**; '
-                  '%d accepted as equivalent or not worth a test (tools/mutation/equivalents.toml), '
-                  '%d surviving, %d incompetent.\n\n'
-                  % (datetime.datetime.now().strftime('%Y-%m-%d %H:%M'), tool_version,
-                     minutes(total_seconds), killed, scored, 100.0 * killed / scored if scored else 0.0,
-                     len(every['accepted']), surviving, len(every['incompetent'])))
-        out.write('| group | skipped by the configuration | ran | killed | equivalent | surviving '
-                  '| incompetent | time |\n')
-        out.write('|---|---|---|---|---|---|---|---|\n')
+        out.write('%s, cosmic-ray %s, %s in all. Score: **%d killed of %d non-equivalent mutants (%s)**; '
+                  '%d equivalent and %d not worth a test (tools/mutation/known_mutants.toml); %d surviving '
+                  'not yet judged; %d incompetent.\n\n'
+                  % (datetime.datetime.now().strftime('%Y-%m-%d %H:%M'), tool_version, minutes(total_seconds),
+                     killed, scored, percent(killed, scored), len(every['equivalent']),
+                     len(every['not worth a test']), len(every['surviving']), len(every['incompetent'])))
+        out.write('| group | skipped by the configuration | ran | killed | equivalent | not worth a test '
+                  '| surviving | score | time |\n')
+        out.write('|---|---|---|---|---|---|---|---|---|\n')
         out.write('\n'.join(rows) + '\n\n')
         for run in runs:
             out.write('- %s: `%s` against %s; skipped: %s\n'
                       % (run['name'], run['test'], ', '.join(run['modules']), run['skipped'] or 'none'))
-        out.write('\n## Surviving mutants (%d)\n\n' % surviving)
-        if not surviving:
-            out.write('None.\n')
+        out.write('\n## Surviving mutants not yet judged (%d)\n\n' % len(every['surviving']))
+        out.write('Kill each with a sharper test, or judge it in tools/mutation/known_mutants.toml.\n\n'
+                  if every['surviving'] else 'None.\n')
         for mutation, result, _ in every['surviving']:
             out.write('### %s\n\n```diff\n%s\n```\n\n' % (describe(mutation), (result.diff or '').strip()))
-        out.write('\n## Accepted as equivalent or not worth a test (%d)\n\n' % len(every['accepted']))
-        for mutation, result, reason in every['accepted']:
-            out.write('- %s: %s\n' % (describe(mutation), reason))
+        for kind in KINDS:
+            out.write('\n## Surviving, %s (%d)\n\n' % (kind, len(every[kind])))
+            for mutation, result, reason in every[kind]:
+                out.write('- %s: `%s`: %s\n' % (describe(mutation), mutated_lines(result.diff)[1], reason))
         if every['incompetent']:
             out.write('\n## Incompetent: the mutant could not be tested (%d)\n\n' % len(every['incompetent']))
             for mutation, result, _ in every['incompetent']:
                 out.write('- %s: %s\n' % (describe(mutation), (result.output or '').strip()[-300:]))
-    return killed, len(every['accepted']), surviving
+    return killed, scored, len(every['surviving'])
+
+
+def percent(part, whole):
+    return '%.1f %%' % (100.0 * part / whole) if whole else 'n/a'
 
 
 def minutes(seconds):
@@ -273,7 +300,7 @@ def minutes(seconds):
 
 
 def main(argv):
-    config_path, equivalents_path, outdir = argv[:3]
+    config_path, known_path, outdir = argv[:3]
     wanted = argv[3:]
     config = toml.load(config_path)
     groups = [g for g in config['group'] if not wanted or g['name'] in wanted]
@@ -283,10 +310,10 @@ def main(argv):
     start = time.monotonic()
     runs = [run_group(group, config['operators'], outdir) for group in groups]
     report = os.path.join(outdir, 'report.md')
-    killed, accepted, surviving = write_report(report, runs, load_equivalents(equivalents_path),
-                                               version('cosmic-ray'), time.monotonic() - start)
-    print('mutation: %d killed, %d accepted as equivalent, %d surviving; report: %s'
-          % (killed, accepted, surviving, report))
+    killed, scored, surviving = write_report(report, runs, load_known(known_path), version('cosmic-ray'),
+                                             time.monotonic() - start)
+    print('mutation: %d killed of %d non-equivalent mutants (%s), %d surviving not yet judged; report: %s'
+          % (killed, scored, percent(killed, scored), surviving, report))
 
 
 if __name__ == '__main__':

@@ -35,5 +35,5 @@ export ROS_HOME="$out/ros_home" PYTHONDONTWRITEBYTECODE=1
 cd "$out/tree"
 start=$(date +%s)
 "$venv/bin/python" "$repo/tools/mutation/run.py" "$repo/tools/mutation/mutation.toml" \
-  "$repo/tools/mutation/equivalents.toml" "$out" "$@"
+  "$repo/tools/mutation/known_mutants.toml" "$out" "$@"
 echo "mutation: $(( ($(date +%s) - start) / 60 )) min $(( ($(date +%s) - start) % 60 )) s"
