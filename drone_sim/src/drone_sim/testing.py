@@ -4,7 +4,8 @@ Both drones come from the same generic node, so one test case checks both; each 
 subclasses SimulatorNodeCase and fills in its names and expected readings. The rostest file runs the
 node with zero noise and a constant profile, so every reading has an exact expected value.
 :func:`documented_profiles` reads the built-in profiles back from the docstring that describes them,
-so the unit tests can hold each package's table to its documentation.
+so the unit tests can hold each package's table to its documentation; :func:`accepts_profile_at` tells
+whether a drone takes a profile at a given value.
 """
 
 import re
@@ -16,6 +17,8 @@ import unittest
 import rospy
 import rosservice
 from std_msgs.msg import Float32, String
+
+from drone_sim.profile import parse_profile
 
 DEADLINE = 30.0  # s; generous, the test machine is shared
 
@@ -154,3 +157,12 @@ def documented_profiles(docstring):
     for name, period, value in re.findall(constant, docstring):
         profiles[name] = [[0.0, float(value)], [float(period), float(value)]]
     return profiles
+
+
+def accepts_profile_at(spec, value):
+    """Whether the drone of DroneSpec ``spec`` takes, as its ~profile, a constant profile at ``value``."""
+    try:
+        parse_profile([[0.0, value], [10.0, value]], spec.profiles, spec.lower, spec.upper)
+    except ValueError:
+        return False
+    return True

@@ -150,7 +150,7 @@ def test_refused_call_counts_as_failure():
                 break
             threading.Event().wait(0.01)
         snap = link.snapshot()
-        assert snap['failing'] and snap['failures'] >= 1
+        assert snap['failing'] and snap['failures'] == 1  # once per attempt; the next is 10 s away
         assert 'unknown status' in snap['last_error']
         assert snap['shown'] == NORMAL
     finally:
@@ -171,21 +171,6 @@ def test_a_failing_service_is_retried_once_per_period_not_hammered(service, make
     # 0.5 s at one attempt per 0.2 s: three attempts at most, where a loop without the pause makes
     # thousands.
     assert 1 <= link.snapshot()['failures'] <= 4
-
-
-def test_each_failed_attempt_counts_once():
-    link = WarningLink(lambda state: (False, 'unknown status'), lambda state, reason: None,
-                       lambda state: None, retry_period=10.0)
-    link.start()
-    try:
-        link.request(WARNING)
-        for _ in range(int(WAIT_S / 0.01)):
-            if link.snapshot()['failures']:
-                break
-            threading.Event().wait(0.01)
-        assert link.snapshot()['failures'] == 1  # the next attempt is 10 s away
-    finally:
-        link.stop(timeout=WAIT_S)
 
 
 def test_a_link_never_stopped_does_not_keep_the_process_alive():

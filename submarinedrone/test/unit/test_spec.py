@@ -2,7 +2,7 @@
 
 import pytest
 
-from drone_sim.profile import parse_profile
+from drone_sim.testing import accepts_profile_at
 from submarinedrone import hydrostatics
 from submarinedrone.simulator import SPEC
 
@@ -33,12 +33,6 @@ def test_default_rates_and_noises_are_the_documented_ones():
     assert (sensors['pressure_remote'].default_rate, sensors['pressure_remote'].default_noise) == (1.0, 3.0)
 
 
-@pytest.mark.parametrize('depth, accepted', [(0.0, True), (-0.5, False), (11000.0, True), (11000.5, False)])
-def test_profiles_stay_within_the_documented_depths(depth, accepted):
+def test_profiles_stay_within_the_documented_depths():
     # The ~profile parameter takes depths within [0, 11000] m (submarinedrone.simulator's docstring).
-    waypoints = [[0.0, depth], [10.0, depth]]
-    if accepted:
-        assert parse_profile(waypoints, SPEC.profiles, SPEC.lower, SPEC.upper).value_at(5.0) == depth
-    else:
-        with pytest.raises(ValueError, match='outside'):
-            parse_profile(waypoints, SPEC.profiles, SPEC.lower, SPEC.upper)
+    assert [accepts_profile_at(SPEC, v) for v in (0.0, -0.5, 11000.0, 11000.5)] == [True, False, True, False]
