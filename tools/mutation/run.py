@@ -207,7 +207,8 @@ def run_group(group, defaults, outdir):
     unmatched = (set(rules['definitions']) | set(rules['skip-definitions'])) - matched
     if unmatched:
         # A function renamed or moved: its mutants would silently drop out of the run, or into it.
-        print('mutation: warning: %s: no function matches %s' % (group['name'], sorted(unmatched)), flush=True)
+        print('mutation: warning: %s: no function matches %s' % (group['name'], sorted(unmatched)),
+              flush=True)
     return {'name': group['name'], 'test': group['test'], 'modules': modules, 'skipped': skipped,
             'results': results, 'seconds': time.monotonic() - start}
 
@@ -241,7 +242,7 @@ def classify(results, known):
 
 
 def score(classes):
-    """(killed, non-equivalent mutants that ran): the equivalent ones cannot be killed, so they do not count."""
+    """(killed, non-equivalent mutants that ran); an equivalent mutant cannot be killed: it does not count."""
     killed = len(classes['killed'])
     return killed, killed + len(classes['surviving']) + len(classes['not worth a test'])
 

@@ -4,7 +4,8 @@
 # repository with a catkin workspace of its own, under $EXAM_WS/mutation/; the working tree is never
 # touched, and a crash leaves a mutant only in the scratch copy, which the next run makes anew.
 # cosmic-ray lives in a virtual environment that sees Debian's rospy (--system-site-packages).
-# Usage: tools/mutation/run.sh [group name ...]   (default: every group; report in $EXAM_WS/mutation/report.md)
+# Usage: tools/mutation/run.sh [group name ...]   (default: every group)
+# Report: $EXAM_WS/mutation/report.md.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/../.." && pwd)"
 source "$repo/tools/env.sh"
@@ -16,13 +17,15 @@ if [ "$("$venv/bin/cosmic-ray" --version 2>/dev/null)" != "cosmic-ray, version $
   echo "mutation: installing cosmic-ray $COSMIC_RAY_VERSION into $venv"
   /usr/bin/python3 -m venv --system-site-packages "$venv"
   "$venv/bin/python" -m pip install -q "cosmic-ray==$COSMIC_RAY_VERSION" > "$EXAM_WS/mutation-venv.log" 2>&1 \
-    || { tail -n 20 "$EXAM_WS/mutation-venv.log"; echo "mutation: pip failed, log in $EXAM_WS/mutation-venv.log" >&2; exit 1; }
+    || { tail -n 20 "$EXAM_WS/mutation-venv.log"; echo "mutation: pip failed: $EXAM_WS/mutation-venv.log" >&2
+         exit 1; }
 fi
 
 # The scratch copy: the files git tracks or would track (new files included, .ws/ and caches not).
 rm -rf "$out"
 mkdir -p "$out/tree" "$out/ros_home"
-(cd "$repo" && git ls-files -z --cached --others --exclude-standard | tar -cf - --null -T -) | tar -xf - -C "$out/tree"
+(cd "$repo" && git ls-files -z --cached --others --exclude-standard | tar -cf - --null -T -) \
+  | tar -xf - -C "$out/tree"
 # Its own workspace, so every import and every rosrun of the tests resolves to the scratch copy; the
 # caller's workspace must not leak in.
 unset PYTHONPATH ROS_PACKAGE_PATH CMAKE_PREFIX_PATH

@@ -35,4 +35,5 @@ def test_default_rates_and_noises_are_the_documented_ones():
 
 def test_profiles_stay_within_the_documented_depths():
     # The ~profile parameter takes depths within [0, 11000] m (submarinedrone.simulator's docstring).
-    assert [accepts_profile_at(SPEC, v) for v in (0.0, -0.5, 11000.0, 11000.5)] == [True, False, True, False]
+    accepted = [accepts_profile_at(SPEC, v) for v in (0.0, -0.5, 11000.0, 11000.5)]
+    assert accepted == [True, False, True, False]
