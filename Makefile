@@ -8,7 +8,7 @@ ENV := source tools/env.sh
 # `make test TESTS=run_tests_exam` runs one catkin test target instead of all of them.
 TESTS ?= run_tests
 
-.PHONY: help deps build run run-submarine test report bench soak clean
+.PHONY: help deps build run run-submarine test report bench soak mutation clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
@@ -17,6 +17,7 @@ help:
 	@echo "make report         regenerate docs/ (command outputs, figures, PDF) from a live run"
 	@echo "make bench          benchmarks of the exam node against the naive baseline"
 	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
+	@echo "make mutation       mutation testing of the nodes' code against its tests (about 30 min)"
 	@echo "make clean          remove the build workspace .ws/"
 
 deps:
@@ -43,6 +44,9 @@ bench: build
 
 soak: build
 	@lab/soak/soak.sh
+
+mutation: build
+	@lab/mutation/run.sh
 
 clean:
 	rm -rf .ws
