@@ -112,9 +112,11 @@ def catkin_make(run):
     for manifest in sorted(glob.glob(os.path.join(repo, '*', 'package.xml'))):
         package = os.path.dirname(manifest)
         os.symlink(package, os.path.join(workspace, 'src', os.path.basename(package)))
-    # Our build workspace stays out of it: no underlay, as in a student's first build. catkin_make
-    # takes the workspace from PWD, which a shell's cd would set.
-    env = {name: value for name, value in run.supervisor.env.items() if name != 'CMAKE_PREFIX_PATH'}
+    # As in a student's first build from a shell: no workspace of ours as an underlay, and none of the
+    # variables `make report` hands its children (make would print every directory it enters).
+    # catkin_make takes the workspace from PWD, which a shell's cd would set.
+    env = {name: value for name, value in run.supervisor.env.items()
+           if name not in ('CMAKE_PREFIX_PATH', 'MAKEFLAGS', 'MFLAGS', 'MAKELEVEL')}
     env['PWD'] = workspace
     run.run_all(env, [command_list.CATKIN_MAKE], cwd=workspace)
 

@@ -20,9 +20,9 @@ import collections
 #: show_from, show_until: regular expressions that cut a long output (None: the whole output).
 Command = collections.namedtuple('Command', 'key line limit show_from show_until', defaults=(None, None))
 
-#: Topics of a full flight recorded to a bag: sensors, estimate, LED, ground truth and the log.
-FLIGHT_TOPICS = '/temperature /pressure /altitude /alt_warn_led /mydrone/true_altitude /rosout'
-DIVE_TOPICS = '/pressure_robot /pressure_remote /depth /depth_warn_led /submarine_drone/true_depth /rosout'
+#: Topics of a full flight recorded to a bag: sensors, estimate, LED and ground truth.
+FLIGHT_TOPICS = '/temperature /pressure /altitude /alt_warn_led /mydrone/true_altitude'
+DIVE_TOPICS = '/pressure_robot /pressure_remote /depth /depth_warn_led /submarine_drone/true_depth'
 
 # --- both sheets, question 1: catkin_make in a fresh workspace of this repository's packages ---------
 #: Only its end is shown: the compilation of the two service types and "[100%] Built target".

@@ -6,13 +6,14 @@ Usage: render.py --work DIR --repo DIR   (DIR of collect.py: outputs.json and th
 The template is Markdown with placeholders, each replaced by something this run produced:
 
 - ``{{run KEY}}``: a console block with the command line of command_list.py and its real output (cut
-  where command_list.py says so, with the number of lines left out); ``{{run}}`` placeholders separated
-  by blank lines only share one block;
+  where command_list.py says so, with the number of lines left out);
 - ``{{line KEY}}``: the command line alone (a background command: a launch, a recording);
 - ``{{value NAME}}``: a number or short text computed from the run (see :func:`facts`);
 - ``{{block NAME}}``: a preformatted block computed from the run (log excerpts, comparisons);
 - ``{{file PATH}}``: a file of the repository, verbatim;
 - ``{{source MODULE:NAME}}``: the source of one function or class of the code, verbatim.
+
+Placeholders of one kind (run, source, block) separated by blank lines only share one block.
 
 An unknown placeholder or key is an error: the report never shows a hole.
 """
@@ -210,7 +211,6 @@ def facts(work, repo, outputs):
     # The exam node's lines only: its start-up summary, its decisions, and its service calls.
     exam_lines = r'\]: (/exam: |\w+ -?[0-9.]+ m .*: (WARNING|NORMAL)$|/\w+_warning: LED set to|could not set)'
     b['flight.exam_log'] = '\n'.join(console_lines(outputs['flight.launch']['output'], exam_lines))
-    b['custom.exam_log'] = '\n'.join(console_lines(outputs['custom.launch']['output'], exam_lines))
     b['dive.exam_log'] = '\n'.join(console_lines(outputs['dive.launch']['output'], exam_lines))
     b['flight.drone_log'] = '\n'.join(console_lines(outputs['flight.launch']['output'],
                                                     r'altitude_warning: ALT WARN'))
@@ -243,8 +243,9 @@ def fence(text, language=''):
     return '```%s\n%s\n```' % (language, text)
 
 
-#: ``{{run KEY}}`` placeholders separated by blank lines only: one console block, as in one terminal.
-RUN_GROUP = re.compile(r'\{\{run [^ }]+\}\}(?:\n\n\{\{run [^ }]+\}\})+')
+#: Placeholders of one kind separated by blank lines only (``{{run}}``, ``{{source}}``, ``{{block}}``):
+#: one block for them all, as in one terminal or one file.
+GROUP = re.compile(r'\{\{(run|source|block) [^ }]+\}\}(?:\n\n\{\{\1 [^ }]+\}\})+')
 
 
 def render(template, outputs, values, blocks, repo):
@@ -256,8 +257,13 @@ def render(template, outputs, values, blocks, repo):
         return '$ %s\n%s' % (result['line'], shown(command_list.BY_KEY[key], clean(result['output'])))
 
     def replace_group(match):
-        keys = re.findall(r'\{\{run ([^ }]+)\}\}', match.group(0))
-        return fence('\n\n'.join(console(key) for key in keys), 'console')
+        kind = match.group(1)
+        keys = re.findall(r'\{\{%s ([^ }]+)\}\}' % kind, match.group(0))
+        if kind == 'run':
+            return fence('\n\n'.join(console(key) for key in keys), 'console')
+        if kind == 'source':
+            return fence('\n\n\n'.join(source_of(key) for key in keys), 'python')
+        return fence('\n\n'.join(blocks[key] for key in keys), 'text')
 
     def replace(match):
         kind, key = match.groups()
@@ -274,7 +280,7 @@ def render(template, outputs, values, blocks, repo):
                 language = {'.launch': 'xml', '.xml': 'xml', '.py': 'python', '.srv': 'text'}
                 return fence(f.read().rstrip(), language.get(os.path.splitext(key)[1], ''))
         return fence(source_of(key), 'python')
-    return PLACEHOLDER.sub(replace, RUN_GROUP.sub(replace_group, template))
+    return PLACEHOLDER.sub(replace, GROUP.sub(replace_group, template))
 
 
 def main():
