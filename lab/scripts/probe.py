@@ -5,14 +5,16 @@ A node of its own, run as a subprocess by the pytest operations tests: their tes
 several masters (or none in its network namespace), while rospy can join only one per process.
 
 Usage:
-    probe.py [--timeout S] [--value TOPIC]... [--led TOPIC=COLOUR]... [--node NAME]...
+    probe.py [--timeout S] [--echo] [--value TOPIC]... [--led TOPIC=COLOUR]... [--node NAME]...
 
     --value TOPIC   std_msgs/Float32 TOPIC must deliver at least --count messages (default 5)
     --led T=C       std_msgs/String T must read C (e.g. /alt_warn_led=RED)
     --node NAME     NAME must be registered; its XML-RPC URI is reported
+    --echo          also print every message of those topics as it arrives, one JSON object a line:
+                    {"echo": topic, "t": arrival time (s since the epoch), "data": value}
 
-Prints one JSON object: per topic the message count, last value and receive rate [Hz]; per node its URI.
-Exit status 0 when everything was seen before the deadline, 1 otherwise.
+Prints one JSON object last: per topic the message count, last value and receive rate [Hz]; per node
+its URI. Exit status 0 when everything was seen before the deadline, 1 otherwise.
 """
 import argparse
 import json
@@ -25,11 +27,30 @@ import rospy
 from std_msgs.msg import Float32, String
 
 
+class Echo(object):
+    """Prints messages as JSON lines, one writer at a time, until :meth:`stop` (the report comes last)."""
+
+    def __init__(self, enabled):
+        self.lock = threading.Lock()
+        self.enabled = enabled
+
+    def __call__(self, topic, stamp, data):
+        with self.lock:
+            if self.enabled:
+                print(json.dumps({'echo': topic, 't': stamp, 'data': data}), flush=True)
+
+    def stop(self):
+        with self.lock:
+            self.enabled = False
+
+
 class Watch(object):
     """Messages of one topic: count, last value, first and last arrival (monotonic s)."""
 
-    def __init__(self, topic, msg_type):
+    def __init__(self, topic, msg_type, echo):
         self.lock = threading.Lock()
+        self.topic = topic
+        self.echo = echo
         self.count = 0
         self.last = None
         self.first_at = self.last_at = None
@@ -37,6 +58,7 @@ class Watch(object):
 
     def on_msg(self, msg):
         now = time.monotonic()
+        self.echo(self.topic, time.time(), msg.data)
         with self.lock:
             self.count += 1
             self.last = msg.data
@@ -57,14 +79,16 @@ def main(argv):
     parser.add_argument('--value', action='append', default=[])
     parser.add_argument('--led', action='append', default=[])
     parser.add_argument('--node', action='append', default=[])
+    parser.add_argument('--echo', action='store_true')
     args = parser.parse_args(rospy.myargv(argv)[1:])
 
     rospy.init_node('probe', anonymous=True, disable_signals=True)
-    values = {topic: Watch(topic, Float32) for topic in args.value}
+    echo = Echo(args.echo)
+    values = {topic: Watch(topic, Float32, echo) for topic in args.value}
     leds = {}
     for spec in args.led:
         topic, colour = spec.split('=', 1)
-        leds[topic] = (Watch(topic, String), colour)
+        leds[topic] = (Watch(topic, String, echo), colour)
     master = rosgraph.Master(rospy.get_name())
 
     def node_uris():
@@ -85,6 +109,7 @@ def main(argv):
     while not satisfied() and time.monotonic() < deadline:
         time.sleep(0.1)
     ok = satisfied()
+    echo.stop()
     report = {'ok': ok, 'nodes': node_uris()}
     report.update({topic: w.report() for topic, w in values.items()})
     report.update({topic: w.report() for topic, (w, _colour) in leds.items()})

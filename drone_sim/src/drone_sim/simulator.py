@@ -30,6 +30,9 @@ Services
 
 All times are ROS times, so the node follows ``/clock`` under ``use_sim_time``; the profile's time
 counts from the node's start (or from the first clock message under sim time).
+
+A master that restarts finds the node again within about a second, parameters included
+(:mod:`drone_sim.master_link`); the sensors and the service keep working while it is down.
 """
 
 import collections
@@ -40,7 +43,7 @@ import threading
 import rospy
 from std_msgs.msg import Float32, String
 
-from drone_sim import params
+from drone_sim import master_link, params
 from drone_sim.led import WarningLed
 from drone_sim.noise import GaussianNoise
 from drone_sim.profile import parse_profile
@@ -157,4 +160,5 @@ def run(spec):
     except params.ParamError as err:
         rospy.logfatal('%s: %s', rospy.get_name(), err)
         sys.exit(1)
+    master_link.start()
     rospy.spin()

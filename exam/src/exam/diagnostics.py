@@ -10,6 +10,10 @@ Two statuses, named after the node by diagnostic_updater:
 The status functions only format copies the node takes under its locks (:class:`Snapshot`, and
 :meth:`exam.warning_link.WarningLink.snapshot`): they never touch the node's state themselves.
 
+The timer never dies: diagnostic_updater reads ``~diagnostic_period`` from the master on every update,
+which raises while the master is unreachable; the statuses are then published anyway (subscribers
+already connected keep seeing them) and the failure is logged once per outage (:func:`publish`).
+
 Published Topics:
     /diagnostics (diagnostic_msgs/DiagnosticArray): every second. diagnostic_updater also reads its
         own ``~diagnostic_period`` (s, default 1): a longer period publishes less often.
@@ -20,6 +24,7 @@ import diagnostic_updater
 import rospy
 from diagnostic_msgs.msg import DiagnosticStatus
 
+from drone_sim.outage import OncePerOutage
 from exam.warning_link import LED_COLOURS
 
 #: Seconds between two updates of /diagnostics.
@@ -81,6 +86,31 @@ def start(snapshot, link_snapshot, mode, service, timeout):
     updater.setHardwareID(rospy.get_name())
     updater.add('inputs', lambda stat: inputs_status(stat, snapshot(), timeout))
     updater.add('warning', lambda stat: warning_status(stat, snapshot(), link_snapshot(), mode, service))
+    guard = OncePerOutage('/diagnostics: reading the diagnostic_period parameter from the master',
+                          'the master is unreachable; the statuses are published every %.0f s anyway '
+                          '(connected subscribers keep them, a new one finds them once the master is '
+                          'back)' % PERIOD_S)
     # reset=True: the timer survives time jumping backwards (rosbag play --loop under sim time).
-    rospy.Timer(rospy.Duration(PERIOD_S), lambda event: updater.update(), reset=True)
+    rospy.Timer(rospy.Duration(PERIOD_S), lambda event: publish(updater, guard), reset=True)
     return updater
+
+
+def publish(updater, guard):
+    """One update of ``updater`` that never raises: a timer thread that raises is gone for good.
+
+    :param guard: a :class:`drone_sim.outage.OncePerOutage`: the failure is logged once per outage.
+    """
+    try:
+        updater.update()
+    except Exception as err:  # ConnectionRefusedError, timeouts... from the master
+        line = guard.failed('%s: %s' % (type(err).__name__, err))
+        if line is not None:
+            rospy.logwarn(line)
+        try:
+            updater.force_update()  # publishes only: no master involved
+        except Exception as err:
+            rospy.logerr_throttle(60.0, '/diagnostics not published: %s: %s' % (type(err).__name__, err))
+        return
+    line = guard.succeeded()
+    if line is not None:
+        rospy.loginfo(line)

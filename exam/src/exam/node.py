@@ -17,6 +17,9 @@ How one reading travels (each step runs on the thread rospy gives it):
 3. A periodic timer publishes the latest value at ``~rate`` Hz, only while every input is fresh; a stale
    input interrupts a pending excess.
 4. A 1 Hz timer publishes /diagnostics.
+5. A thread of :mod:`drone_sim.master_link` keeps the node registered across a master restart, and the
+   connection to the warning service is opened ahead of the first call and kept, so a state decided
+   while the master is down still reaches the drone.
 
 State shared by these threads (the caches, the value, the debouncer) is guarded by one lock, held only
 for short computations, never across a publish or a service call.
@@ -50,7 +53,7 @@ import threading
 import rospy
 from std_msgs.msg import Float32, String
 
-from drone_sim import params
+from drone_sim import master_link, params
 from exam import diagnostics
 from exam.debounce import WARNING, Debouncer
 from exam.inputs import InputCache
@@ -92,8 +95,9 @@ class ExamNode(object):
         # 2. Outputs and the service link, before any callback can fire.
         self._pub = rospy.Publisher(mode.output, Float32, queue_size=10)
         self._service = rospy.resolve_name(mode.service)
+        self._proxy = None  # the persistent connection to the service, used by the link's thread only
         self._link = WarningLink(self._call_service, self._on_call_failed, self._on_call_delivered,
-                                 retry_period=RETRY_PERIOD_S)
+                                 retry_period=RETRY_PERIOD_S, connect=self._open_service)
         self._link.start()
         rospy.on_shutdown(lambda: self._link.stop(timeout=1.0))
 
@@ -194,10 +198,43 @@ class ExamNode(object):
             return
         self._link.led_reported(state)
 
+    def _open_service(self):
+        """Open the persistent connection to the warning service if none is (link's thread only).
+
+        Called by the link ahead of the first call, and again after a failed one: a connection that
+        is open needs no master, so a state decided while the master is down still reaches the drone.
+        :raises Exception: the service cannot be found or connected to (the link tries again later).
+        """
+        if self._proxy is None:
+            self._proxy, uri = master_link.open_persistent(self._service, self._mode.service_type)
+            rospy.loginfo('%s: connected to %s; the connection is kept for every call'
+                          % (self._service, uri))
+        return True
+
     def _call_service(self, state):
-        """One call of the warning service (runs on the link's thread, may block)."""
-        rospy.wait_for_service(self._service, timeout=RETRY_PERIOD_S)
-        response = rospy.ServiceProxy(self._service, self._mode.service_type)(state)
+        """One call of the warning service (link's thread only, may block).
+
+        On the open connection if there is one; if a call on it raises (the drone restarted, the link
+        broke, the call failed), the connection is closed and the call made once more on a new one,
+        found through the master. A failure on the new one is the link's to retry.
+        """
+        if self._proxy is not None:
+            try:
+                return self._call_on(state)
+            except Exception as err:
+                rospy.loginfo('%s: the call on the open connection failed (%s: %s); calling again on '
+                              'a new connection' % (self._service, type(err).__name__, err))
+        self._open_service()
+        return self._call_on(state)
+
+    def _call_on(self, state):
+        """One call on the open connection; a connection whose call raised is closed and forgotten."""
+        try:
+            response = self._proxy(state)
+        except Exception:
+            self._proxy.close()
+            self._proxy = None
+            raise
         return response.success, response.message
 
     def _on_call_failed(self, state, reason):
@@ -218,7 +255,12 @@ class ExamNode(object):
                 self._debouncer.interrupt()
             value = self._value
         if not stale:
-            self._pub.publish(Float32(value))
+            try:
+                self._pub.publish(Float32(value))
+            except rospy.ROSException:
+                # The publisher closed: rospy is shutting down and this was the timer's last tick.
+                if not rospy.is_shutdown():
+                    raise
             return
         if all(cache.stamp is None for cache in stale):
             rospy.loginfo_throttle(THROTTLE_S, 'waiting for the first reading of %s'
@@ -249,4 +291,5 @@ def main():
     except params.ParamError as err:
         rospy.logfatal(str(err))
         sys.exit(1)
+    master_link.start()
     rospy.spin()

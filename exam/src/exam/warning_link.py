@@ -16,6 +16,10 @@ Rules:
   the worker send the wanted state again.
 - When a call fails (service absent, error, refused), retry every ``retry_period`` seconds with the
   *latest* wanted state: if the state flipped and flipped back meanwhile, there is nothing left to send.
+- With a ``connect`` function, the worker opens the connection to the service ahead of the first call,
+  while it has nothing to deliver: at start, and again after a failed call, every ``retry_period``
+  until it succeeds. A connection that is already open needs no name lookup, so a state decided while
+  the ROS master is down still reaches the drone (issue 13).
 """
 import threading
 
@@ -33,13 +37,16 @@ class WarningLink(object):
     :param on_failure: function(state, reason), told of every failed attempt (the node logs it throttled).
     :param on_delivered: function(state), told of every successful call.
     :param retry_period: seconds between attempts while the service fails.
+    :param connect: optional function() -> bool; opens the connection ``call`` will use, True once it
+        is open (may block about ``retry_period``; an exception counts as False).
     """
 
-    def __init__(self, call, on_failure, on_delivered, retry_period=1.0):
+    def __init__(self, call, on_failure, on_delivered, retry_period=1.0, connect=None):
         self._call = call
         self._on_failure = on_failure
         self._on_delivered = on_delivered
         self._retry_period = retry_period
+        self._connect = connect
         self._cond = threading.Condition()
         self._wanted = None
         # A drone starts with a green LED (mydrone/submarinedrone contract), so no call is needed at start.
@@ -84,16 +91,29 @@ class WarningLink(object):
                 'last_error': self._last_error,
             }
 
+    def _idle(self):
+        """Nothing to deliver (call under the condition's lock)."""
+        return self._wanted is None or self._wanted == self._shown
+
     def _run(self):
+        connected = self._connect is None
         while True:
             with self._cond:
-                while not self._stopped and (self._wanted is None or self._wanted == self._shown):
+                while not self._stopped and self._idle() and connected:
                     self._cond.wait()
                 if self._stopped:
                     return
-                state = self._wanted
+                state = None if self._idle() else self._wanted
+            if state is None:
+                # Nothing to deliver, no connection yet: open one now, not when a state is due.
+                connected = self._try_connect()
+                with self._cond:
+                    if not connected and not self._stopped and self._idle():
+                        self._cond.wait(self._retry_period)
+                continue
             # The lock is released across the call: callbacks keep calling want() while it blocks.
             reason = self._attempt(state)
+            connected = reason is None or self._connect is None
             with self._cond:
                 if reason is None:
                     self._shown = state
@@ -106,6 +126,12 @@ class WarningLink(object):
                 # or stop() ends the pause early.
                 if not self._stopped:
                     self._cond.wait(self._retry_period)
+
+    def _try_connect(self):
+        try:
+            return bool(self._connect())
+        except Exception:  # the service is not there yet: the next attempt or call says more
+            return False
 
     def _attempt(self, state):
         """One service call; returns None on success, else the reason it failed."""

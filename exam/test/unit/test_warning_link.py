@@ -153,3 +153,63 @@ def test_refused_call_counts_as_failure():
         assert snap['shown'] == NORMAL
     finally:
         link.stop(timeout=WAIT_S)
+
+
+class FakeConnection(object):
+    """The node's connect(): fails while ``available`` is False, counts its attempts."""
+
+    def __init__(self):
+        self.available = False
+        self.attempts = 0
+        self.opened = threading.Event()
+
+    def __call__(self):
+        self.attempts += 1
+        if not self.available:
+            raise IOError('no provider for /altitude_warning')
+        self.opened.set()
+        return True
+
+
+def test_the_connection_is_opened_before_any_state_is_due(service):
+    connection = FakeConnection()
+    link = WarningLink(service, lambda state, reason: None, lambda state: None, retry_period=0.01,
+                       connect=connection)
+    link.start()
+    try:
+        # Nothing wanted yet: the worker keeps trying to open the connection, and makes no call.
+        for _ in range(int(WAIT_S / 0.01)):
+            if connection.attempts >= 3:
+                break
+            threading.Event().wait(0.01)
+        assert connection.attempts >= 3 and service.calls == []
+        connection.available = True
+        assert connection.opened.wait(WAIT_S)
+        # Open: no more attempts while idle.
+        attempts = connection.attempts
+        threading.Event().wait(0.1)
+        assert connection.attempts == attempts and service.calls == []
+        link.want(WARNING)
+        assert service.wait_calls(1) == [WARNING]
+    finally:
+        link.stop(timeout=WAIT_S)
+
+
+def test_a_failed_call_has_the_connection_opened_again_while_idle(service):
+    connection = FakeConnection()
+    connection.available = True
+    link = WarningLink(service, lambda state, reason: None, lambda state: None, retry_period=0.01,
+                       connect=connection)
+    link.start()
+    try:
+        assert connection.opened.wait(WAIT_S)
+        service.available = False
+        link.want(WARNING)
+        assert service.entered.wait(WAIT_S)
+        connection.opened.clear()
+        link.want(NORMAL)  # nothing left to deliver: the worker reopens the connection instead
+        assert connection.opened.wait(WAIT_S)
+        settle(link)
+        assert service.calls == []
+    finally:
+        link.stop(timeout=WAIT_S)

@@ -151,6 +151,7 @@ class FakeWarningService(object):
         self._failing = False
         self._refusing = False
         self._service = None
+        self._withdrawn = False
         self._led = None
         self.colour = 'GREEN'
         if led_topic is not None:
@@ -160,6 +161,8 @@ class FakeWarningService(object):
             self.advertise()
 
     def advertise(self):
+        with self._lock:
+            self._withdrawn = False
         self._service = rospy.Service(self._name, self._srv_class, self._handle)
 
     def close(self):
@@ -170,7 +173,10 @@ class FakeWarningService(object):
             self._service = None
 
     def withdraw(self):
-        """Unregister the service: the node's calls fail as if the drone were gone."""
+        """Unregister the service: the node's calls fail as if the drone were gone, also on a
+        persistent connection opened before (rospy keeps serving those after a shutdown)."""
+        with self._lock:
+            self._withdrawn = True
         self._service.shutdown('withdrawn by the test')
         # The master must have forgotten the service, or the caller would still find it.
         resolved = rospy.resolve_name(self._name)
@@ -213,6 +219,8 @@ class FakeWarningService(object):
     def _handle(self, request):
         now = rospy.get_time()
         with self._lock:
+            if self._withdrawn:
+                raise rospy.ServiceException('the fake drone is gone (withdrawn by the test)')
             self._attempts.append((now, request.status))
             delay, failing, refusing = self._delay, self._failing, self._refusing
         if delay > 0.0:

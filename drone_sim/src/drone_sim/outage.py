@@ -1,0 +1,132 @@
+"""What a node does when its master goes away and comes back: the rules, without rospy.
+
+ROS 1 nodes register with the master once, at start-up; a master that is killed and started again on
+the same port knows none of them. :mod:`drone_sim.master_link` polls the master about once a second
+and feeds each answer to :class:`MasterWatch`, which says what to do and what to log: the pure part,
+unit-tested with synthetic answers and times.
+
+An answer is one of:
+
+- ``KNOWN``: the master answers and lists every registration of this node (all is well, or it is back
+  after a network fault);
+- ``UNKNOWN``: the master answers but misses some of them: it was restarted and lost everything
+  (:func:`missing_registrations` says which; asking ``lookupNode`` is not enough: a node that merely
+  read a cached parameter from the new master is known to it, with none of its topics);
+- ``UNREACHABLE``: no answer (connection refused, timeout).
+
+Logging rule: one line when the outage starts, one when it ends, nothing in between, so that a master
+down for an hour does not flood the log. :class:`OncePerOutage` applies the same rule to any periodic
+task that fails while the master is away (the exam node's /diagnostics update).
+"""
+
+KNOWN = 'known'
+UNKNOWN = 'unknown'
+UNREACHABLE = 'unreachable'
+
+#: What :meth:`MasterWatch.observe` asks the caller to do besides logging.
+REREGISTER = 'reregister'
+
+
+def missing_registrations(system_state, node, publications, subscriptions, services):
+    """The registrations of ``node`` that the master does not list, as ``[(kind, name)]``.
+
+    :param system_state: the master's ``getSystemState`` value: ``[publishers, subscribers, services]``,
+        each a list of ``[name, [node, ...]]``.
+    :param publications: names of the topics the node publishes; ``subscriptions`` and ``services``
+        likewise.
+    """
+    listed = [{name for name, nodes in kind if node in nodes} for kind in system_state]
+    ours = (('publication', publications), ('subscription', subscriptions), ('service', services))
+    return [(kind, name) for (kind, names), known in zip(ours, listed) for name in names
+            if name not in known]
+
+
+class MasterWatch(object):
+    """The master's state as one node sees it, from the answers to its polls.
+
+    :param master_uri: for the messages.
+    :param name: the node's resolved name, for the messages.
+
+    Every method returns ``(action, level, message)``; ``action`` is None or :data:`REREGISTER`,
+    ``level`` is None (log nothing), ``'info'`` or ``'warn'``.
+    """
+
+    def __init__(self, master_uri, name):
+        self._uri = master_uri
+        self._name = name
+        self._down_since = None  # time the outage began, None while the master is up
+        self._reregister_failed = False
+
+    @property
+    def up(self):
+        return self._down_since is None
+
+    def observe(self, answer, now, error=''):
+        """One poll's answer at time ``now`` [s]; ``error`` says why the master was unreachable."""
+        if answer == UNREACHABLE:
+            if self._down_since is not None:
+                return None, None, ''
+            self._down_since = now
+            return None, 'warn', (
+                'master at %s unreachable (%s): %s keeps running; topics already connected keep '
+                'flowing and the warning service keeps its connection, but no new connection, '
+                'parameter or name lookup works until the master is back' % (self._uri, error,
+                                                                              self._name))
+        if answer == UNKNOWN:
+            return REREGISTER, None, ''
+        if self._down_since is None:
+            return None, None, ''
+        outage = now - self._down_since
+        self._down_since = None
+        self._reregister_failed = False
+        return None, 'info', ('master at %s reachable again after %.1f s; it still knows %s: '
+                              'nothing to re-register' % (self._uri, outage, self._name))
+
+    def reregistered(self, now, publications, subscriptions, services, parameters):
+        """Re-registration with a restarted master succeeded; the counts are for the message."""
+        outage = None if self._down_since is None else now - self._down_since
+        self._down_since = None
+        self._reregister_failed = False
+        down = 'restarted' if outage is None else 'restarted after %.1f s down' % outage
+        return None, 'info', ('master at %s %s, without %s: re-registered %d publications, '
+                              '%d subscriptions, %d services and %d private parameters'
+                              % (self._uri, down, self._name, publications, subscriptions, services,
+                                 parameters))
+
+    def reregister_failed(self, now, error):
+        """Re-registration was cut short (the master went away again, or refused a registration)."""
+        if self._down_since is None:
+            self._down_since = now
+        if self._reregister_failed:
+            return None, None, ''
+        self._reregister_failed = True
+        return None, 'warn', ('could not re-register %s with the master at %s (%s): retrying every '
+                              'poll' % (self._name, self._uri, error))
+
+
+class OncePerOutage(object):
+    """Logs a periodic task's failures once per run of failures, and its recovery once.
+
+    :param what: what failed, for the messages (e.g. ``"/diagnostics: reading the diagnostic_period
+        parameter from the master"``).
+    :param meaning: what the failure means for the node, for the first message.
+    """
+
+    def __init__(self, what, meaning):
+        self._what = what
+        self._meaning = meaning
+        self._failures = 0
+
+    def failed(self, error):
+        """The task raised ``error`` (a message); returns the line to log, or None (already logged)."""
+        self._failures += 1
+        if self._failures > 1:
+            return None
+        return '%s failed (%s): %s; logged once until it works again' % (self._what, error, self._meaning)
+
+    def succeeded(self):
+        """The task worked; returns the line to log when it had been failing, else None."""
+        failures, self._failures = self._failures, 0
+        if not failures:
+            return None
+        return '%s works again, after %d failed attempts' % (self._what, failures)

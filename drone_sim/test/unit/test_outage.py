@@ -1,0 +1,109 @@
+"""A node's view of its master: what to do and log for each poll's answer (synthetic answers, no ROS)."""
+
+from drone_sim.outage import (KNOWN, REREGISTER, UNKNOWN, UNREACHABLE, MasterWatch, OncePerOutage,
+                              missing_registrations)
+
+URI = 'http://ground:11311/'
+
+
+def watch():
+    return MasterWatch(URI, '/exam')
+
+
+def test_a_master_that_knows_the_node_is_silent():
+    w = watch()
+    assert [w.observe(KNOWN, t) for t in (1.0, 2.0, 3.0)] == [(None, None, '')] * 3
+    assert w.up
+
+
+def test_an_outage_is_logged_once_then_its_end_once():
+    w = watch()
+    action, level, message = w.observe(UNREACHABLE, 10.0, 'ConnectionRefusedError: refused')
+    assert (action, level) == (None, 'warn')
+    assert message == ('master at http://ground:11311/ unreachable (ConnectionRefusedError: refused): '
+                       '/exam keeps running; topics already connected keep flowing and the warning '
+                       'service keeps its connection, but no new connection, parameter or name lookup '
+                       'works until the master is back')
+    assert not w.up
+    # However long the outage, nothing more until it ends.
+    assert [w.observe(UNREACHABLE, 10.0 + t, 'timeout') for t in range(1, 100)] == [(None, None, '')] * 99
+    assert w.observe(KNOWN, 112.5) == (None, 'info', 'master at http://ground:11311/ reachable again '
+                                       'after 102.5 s; it still knows /exam: nothing to re-register')
+    assert w.up
+    assert w.observe(KNOWN, 113.5) == (None, None, '')
+
+
+def test_a_restarted_master_asks_for_re_registration_and_the_outage_is_measured():
+    w = watch()
+    w.observe(UNREACHABLE, 8.0, 'refused')
+    w.observe(UNREACHABLE, 9.0, 'refused')
+    assert w.observe(UNKNOWN, 11.0) == (REREGISTER, None, '')
+    assert w.reregistered(11.2, 3, 3, 2, 3) == (
+        None, 'info', 'master at http://ground:11311/ restarted after 3.2 s down, without /exam: '
+                      're-registered 3 publications, 3 subscriptions, 2 services and 3 private parameters')
+    assert w.up
+    assert w.observe(KNOWN, 12.0) == (None, None, '')
+
+
+def test_a_restart_between_two_polls_is_still_re_registered():
+    w = watch()
+    assert w.observe(UNKNOWN, 5.0) == (REREGISTER, None, '')
+    assert w.reregistered(5.1, 5, 0, 3, 1)[2] == (
+        'master at http://ground:11311/ restarted, without /exam: re-registered 5 publications, '
+        '0 subscriptions, 3 services and 1 private parameters')
+
+
+def test_a_failed_re_registration_is_logged_once_and_retried_every_poll():
+    w = watch()
+    assert w.observe(UNKNOWN, 5.0)[0] == REREGISTER
+    assert w.reregister_failed(5.1, 'ConnectionResetError: reset') == (
+        None, 'warn', 'could not re-register /exam with the master at http://ground:11311/ '
+                      '(ConnectionResetError: reset): retrying every poll')
+    assert not w.up
+    assert w.observe(UNREACHABLE, 6.0, 'refused') == (None, None, '')  # the same outage
+    assert w.observe(UNKNOWN, 7.0)[0] == REREGISTER
+    assert w.reregister_failed(7.1, 'again') == (None, None, '')
+    assert w.observe(UNKNOWN, 8.0)[0] == REREGISTER
+    assert w.reregistered(8.1, 1, 1, 1, 0)[2].startswith(
+        'master at http://ground:11311/ restarted after 3.0 s down, without /exam:')
+    # A new outage is a new story: logged again.
+    assert w.observe(UNREACHABLE, 20.0, 'refused')[1] == 'warn'
+
+
+SYSTEM_STATE = [
+    [['/rosout', ['/exam', '/mydrone']], ['/altitude', ['/exam']]],           # publishers
+    [['/pressure', ['/exam']], ['/rosout', ['/rosout']]],                        # subscribers
+    [['/exam/get_loggers', ['/exam']], ['/altitude_warning', ['/mydrone']]],   # services
+]
+
+
+def test_missing_registrations_lists_what_the_master_lost():
+    assert missing_registrations(SYSTEM_STATE, '/exam', ['/rosout', '/altitude'], ['/pressure'],
+                                 ['/exam/get_loggers']) == []
+    assert missing_registrations(SYSTEM_STATE, '/exam', ['/rosout', '/diagnostics'],
+                                 ['/pressure', '/temperature'], ['/exam/set_logger_level']) == [
+        ('publication', '/diagnostics'), ('subscription', '/temperature'),
+        ('service', '/exam/set_logger_level')]
+    # A topic registered by another node only does not count as ours.
+    assert missing_registrations(SYSTEM_STATE, '/mydrone', ['/altitude'], [], []) == [
+        ('publication', '/altitude')]
+
+
+def test_a_fresh_master_misses_everything_even_if_it_knows_the_name():
+    # After a restart the node may be known to the master through a parameter subscription alone.
+    empty = [[], [], []]
+    assert missing_registrations(empty, '/exam', ['/rosout'], ['/pressure'], ['/exam/get_loggers']) == [
+        ('publication', '/rosout'), ('subscription', '/pressure'), ('service', '/exam/get_loggers')]
+
+
+def test_once_per_outage_logs_the_first_failure_and_the_recovery():
+    guard = OncePerOutage('/diagnostics: reading ~diagnostic_period from the master', 'published anyway')
+    assert guard.succeeded() is None
+    assert guard.failed('ConnectionRefusedError: refused') == (
+        '/diagnostics: reading ~diagnostic_period from the master failed (ConnectionRefusedError: '
+        'refused): published anyway; logged once until it works again')
+    assert [guard.failed('refused') for _ in range(5)] == [None] * 5
+    assert guard.succeeded() == ('/diagnostics: reading ~diagnostic_period from the master works again, '
+                                 'after 6 failed attempts')
+    assert guard.succeeded() is None
+    assert guard.failed('refused') is not None  # the next outage is logged again

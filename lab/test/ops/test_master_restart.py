@@ -1,0 +1,195 @@
+"""The ground station's master is killed mid-flight and restarted on the same port (issue 13).
+
+The scenario of the issue, on a master of its own on a free port: ``exam.launch threshold:=1450``
+(mydrone and the exam node) flies a climb through 1450 m; at 8 s after the launch the master gets
+SIGKILL (and its rosout with it), and 2 s later a new roscore starts on the same port. Asserted:
+
+1. the nodes are back on the new master within a few seconds: ``rosnode list`` names them, a subscriber
+   started after the restart receives ``/altitude``, and ``/diagnostics`` carries the exam node's
+   statuses; the launch's parameters are on the new master again (``/exam/threshold`` is 1450);
+2. the LED turns RED within 1 s of the deadline of the 1450 m threshold (the first published altitude
+   above 1450 m plus the 5 s delay), not at the default threshold's;
+3. nothing died: the same processes run the nodes, roslaunch is still up, no traceback in any log.
+
+Then a second fault: the master is killed again once the LED is RED and stays down while the drone
+descends, so NORMAL is decided with no master at all: the LED must turn GREEN within 1 s of the
+altitude's return below 1450 m, over the connection the exam node opened before; once a new master is
+up, the nodes are back on it again, and a new subscriber reads the LED GREEN.
+
+A watcher connected before the first fault times the whole flight (topics are peer to peer: its
+connections survive the master); every other check is a process started against the new master.
+"""
+import json
+import time
+
+from exam_lab.harness.supervisor import Supervisor
+from exam_lab.harness.wait import wait_until
+
+#: The flight, [time_s, altitude_m] from mydrone's start: 1200 m (estimate 1183.6 m), a climb at
+#: 25 m/s from 12 s to 1600 m (estimate 1567 m), a descent from 34 s. The estimate crosses 1300 m at
+#: about 16.8 s and 1450 m at about 23 s on the way up (WARNING due at about 28 s), and 1450 m again
+#: at about 35.9 s on the way down (NORMAL at once).
+PROFILE = [[0, 1200], [12, 1200], [28, 1600], [34, 1600], [40, 1200], [120, 1200]]
+THRESHOLD = 1450.0
+#: exam.launch's default delay [s].
+DELAY = 5.0
+#: The threshold the node would use had it fallen back to its default [m].
+DEFAULT_THRESHOLD = 1300.0
+#: The issue's schedule: SIGKILL at 8 s (after the launch), a new master 2 s later.
+KILL_AT = 8.0
+DOWN_FOR = 2.0
+#: The issue's bounds: back on the new master "within a few seconds", the LED within 1 s.
+REAPPEAR_BOUND = 5.0
+LED_BOUND = 1.0
+NODES = ('/exam', '/mydrone')
+
+
+def echoed(output):
+    """The probe's --echo lines: [(topic, arrival time s, data)], in arrival order."""
+    return [(s['echo'], s['t'], s['data']) for s in
+            (json.loads(line) for line in output.splitlines() if line.startswith('{"echo"'))]
+
+
+def run_start(samples, above, threshold, until):
+    """Start time of the last uninterrupted run of values ``above`` (or not) ``threshold`` up to
+    ``until``, or None."""
+    start = None
+    for t, value in samples:
+        if t > until:
+            break
+        if (value > threshold) == above:
+            start = t if start is None else start
+        else:
+            start = None
+    return start
+
+
+class Flight(object):
+    """The watcher's view: what it received so far, read from its --echo lines."""
+
+    def __init__(self, procs):
+        self.procs = procs
+
+    def samples(self):
+        return echoed(self.procs.output('watch'))
+
+    def altitudes(self):
+        return [(t, data) for topic, t, data in self.samples() if topic == '/altitude']
+
+    def led_turned(self, colour, after=0.0):
+        """Arrival time of the first LED report ``colour`` after ``after``, or None."""
+        return next((t for topic, t, data in self.samples()
+                     if topic == '/alt_warn_led' and data == colour and t > after), None)
+
+
+def registered(master):
+    """True when ``master`` lists the nodes' topics and service (knowing a node's name is not enough:
+    a node that merely read a parameter from a new master is known to it)."""
+    try:
+        publishers, subscribers, services = (dict(kind) for kind in master.system_state())
+    except OSError:
+        return False
+    return ('/exam' in publishers.get('/altitude', []) and '/exam' in subscribers.get('/pressure', [])
+            and '/mydrone' in publishers.get('/pressure', [])
+            and '/mydrone' in services.get('/altitude_warning', []))
+
+
+def restart(master):
+    """SIGKILL the master, wait the issue's 2 s, start a new one on its port; once it answers, return
+    (time of the kill, time it answered), monotonic s."""
+    master.kill()
+    killed = time.monotonic()
+    time.sleep(DOWN_FOR)
+    master.start()
+    return killed, time.monotonic()
+
+
+def assert_back(procs, master, since, what):
+    """The nodes are registered with the new master within REAPPEAR_BOUND s; returns how long it took."""
+    assert wait_until(lambda: registered(master), REAPPEAR_BOUND), \
+        '%s: not registered with the new master after %.0f s: %s\n%s' % (
+            what, REAPPEAR_BOUND, master.system_state(), procs.output('launch'))
+    assert master.graph.getParam('/exam/threshold') == THRESHOLD
+    assert master.graph.getParam('/mydrone/profile') == PROFILE
+    return time.monotonic() - since
+
+
+def test_master_killed_and_restarted_mid_flight(tmp_path):
+    with Supervisor(tmp_path) as procs:
+        master = procs.start_master()
+        env = master.env
+        launched = time.monotonic()
+        launch = procs.start('launch', ['roslaunch', 'exam', 'exam.launch', 'threshold:=%g' % THRESHOLD,
+                                        'profile:=%s' % json.dumps(PROFILE)], env)
+        # Connected before the fault, it records the whole flight (its conditions are never met: it
+        # runs until it is stopped).
+        watch = procs.start('watch', ['rosrun', 'exam_lab', 'probe.py', '--echo', '--timeout', '120',
+                                      '--count', '100000', '--value', '/altitude',
+                                      '--led', '/alt_warn_led=RED'], env)
+        flight = Flight(procs)
+        assert wait_until(lambda: {topic for topic, _, _ in flight.samples()}
+                          == {'/altitude', '/alt_warn_led'}, 30.0), \
+            procs.output('watch') + procs.output('launch')
+        assert registered(master), procs.output('launch')
+        pids = {name: master.node_pid(name) for name in NODES}
+
+        # The fault, on the issue's schedule (the flight is scripted in time: this is not a wait).
+        time.sleep(max(0.0, launched + KILL_AT - time.monotonic()))
+        killed, back = restart(master)
+        print('master killed at %.1f s after the launch, a new one answering at %.1f s'
+              % (killed - launched, back - launched))
+
+        # 1. Back on the new master, with the launch's parameters.
+        reappeared = assert_back(procs, master, back, 'first restart')
+        status, out, _ = procs.run('rosnode', ['rosnode', 'list'], 20.0, env)
+        assert status == 0 and set(NODES) <= set(out.split()), out
+        status, out, _ = procs.run('fresh', ['rosrun', 'exam_lab', 'probe.py', '--timeout', '15',
+                                             '--value', '/altitude'], 30.0, env)
+        assert status == 0, 'a subscriber started after the restart got no /altitude: ' + out
+        fresh = time.monotonic() - back
+        status, out, _ = procs.run('diagnostics', ['rostopic', 'echo', '-n', '1', '/diagnostics'], 20.0,
+                                   env)
+        assert status == 0 and 'exam: inputs' in out and 'exam: warning' in out, out
+        print('on the new master %.2f s after it answered; a subscriber started then had 5 '
+              '/altitude messages %.2f s after it answered' % (reappeared, fresh))
+
+        # 2. The WARNING of the 1450 m threshold, on time, decided after the restart.
+        red = wait_until(lambda: flight.led_turned('RED'), 40.0)
+        assert red is not None, 'the LED never turned RED:\n' + procs.output('launch')[-4000:]
+        altitudes = flight.altitudes()
+        deadline = run_start(altitudes, True, THRESHOLD, red) + DELAY
+        default_deadline = run_start(altitudes, True, DEFAULT_THRESHOLD, red) + DELAY
+        print('LED RED %+.3f s from the 1450 m deadline (the 1300 m one was %.1f s earlier)'
+              % (red - deadline, deadline - default_deadline))
+        assert abs(red - deadline) <= LED_BOUND, 'RED %+.3f s from the deadline' % (red - deadline)
+
+        # Second fault: no master while the drone descends; NORMAL goes out over the open connection.
+        master.kill()
+        killed = time.time()
+        green = wait_until(lambda: flight.led_turned('GREEN', red), 20.0)
+        assert green is not None, 'the LED never turned GREEN with the master down:\n' \
+            + procs.output('launch')[-4000:]
+        time.sleep(max(0.0, killed + DOWN_FOR - time.time()))
+        master.start()
+        back = time.monotonic()
+        # The node acts on the reading itself; /altitude shows it at the next 10 Hz tick, after GREEN.
+        below = run_start(flight.altitudes(), False, THRESHOLD, green + LED_BOUND)
+        print('master down from %.1f s before to %.1f s after NORMAL; LED GREEN %+.3f s from the '
+              'return below 1450 m' % (green - killed, time.time() - green, green - below))
+        assert killed < below, 'the master was killed after the return below the threshold'
+        assert abs(green - below) <= LED_BOUND, 'GREEN %+.3f s from the return' % (green - below)
+        reappeared = assert_back(procs, master, back, 'second restart')
+        print('on the second new master %.2f s after it answered' % reappeared)
+        # What a subscriber started now reads from the latched LED is what the drone shows.
+        status, out, _ = procs.run('led', ['rosrun', 'exam_lab', 'probe.py', '--timeout', '15',
+                                           '--led', '/alt_warn_led=GREEN'], 30.0, env)
+        assert status == 0, out
+
+        # 3. Nothing died, nothing was respawned.
+        assert launch.poll() is None, procs.output('launch')
+        assert {name: master.node_pid(name) for name in NODES} == pids
+        procs.stop(watch)
+        procs.stop(launch)
+        log = procs.output('launch')
+        assert 'Traceback' not in log, log
+        print('\n'.join(line for line in log.splitlines() if 'master' in line or 'connect' in line))
