@@ -10,7 +10,7 @@ A line is split with shlex and run without a shell, from the report's work folde
 ``limit`` [s] is a safety net only: commands that would run forever (``rostopic hz``) are bounded by a
 visible ``timeout -s INT``, which stops them as Ctrl-C would.
 
-A long output may be shown in part: ``show_from`` shows it from the last line that matches this regular
+A long output may be shown in part: ``show_from`` shows it from the first line that matches this regular
 expression on, ``show_until`` up to the first line that matches; the report says how many lines it
 leaves out.
 """
@@ -25,8 +25,8 @@ FLIGHT_TOPICS = '/temperature /pressure /altitude /alt_warn_led /mydrone/true_al
 DIVE_TOPICS = '/pressure_robot /pressure_remote /depth /depth_warn_led /submarine_drone/true_depth'
 
 # --- both sheets, question 1: catkin_make in a fresh workspace of this repository's packages ---------
-#: Only its end is shown: the compilation of the two service types and "[100%] Built target".
-CATKIN_MAKE = Command('build.catkin_make', 'catkin_make', 300, show_from=r'^#### Running command: "make')
+#: Only its end is shown: from the first "[100%]" line of make on.
+CATKIN_MAKE = Command('build.catkin_make', 'catkin_make', 300, show_from=r'^\[100%\]')
 
 # --- sheet 000, questions 3 to 8: the aerial drone's node alone --------------------------------------
 MYDRONE_NODE = Command('mydrone.run', 'rosrun mydrone mydrone_node.py', None)

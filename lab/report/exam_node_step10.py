@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""Question 10's first step, as a student writes it: subscribe to the drone's two sensor topics and log
-each value received, nothing more. ``~mode``: "altitude" (sheet 000, the default) or "depth" (001)."""
+"""Question 10's first step: log each value the drone's two sensor topics bring, nothing more.
+``~mode``: "altitude" (sheet 000: temperature, pressure; the default) or "depth" (001: two pressures)."""
 import rospy
 from std_msgs.msg import Float32
 
-#: The two input topics of each sheet, with their units.
+# The two input topics of each sheet, with their units.
 INPUTS = {'altitude': [('temperature', 'degC'), ('pressure', 'Pa')],
           'depth': [('pressure_robot', 'Pa'), ('pressure_remote', 'Pa')]}
 

@@ -88,8 +88,8 @@ def shown(command, output):
         starts = [i for i, line in enumerate(lines) if re.search(command.show_from, line)]
         if not starts:
             raise RuntimeError('%s: no line matches %r' % (command.key, command.show_from))
-        if starts[-1] > 0:
-            lines = ['[... %d lines above left out ...]' % starts[-1]] + lines[starts[-1]:]
+        if starts[0] > 0:
+            lines = ['[... %d lines above left out ...]' % starts[0]] + lines[starts[0]:]
     if command.show_until:
         ends = [i for i, line in enumerate(lines) if re.search(command.show_until, line)]
         if not ends:
