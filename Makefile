@@ -8,7 +8,7 @@ ENV := source tools/env.sh
 # `make test TESTS=run_tests_exam` runs one catkin test target instead of all of them.
 TESTS ?= run_tests
 
-.PHONY: help deps build run run-submarine test report bench soak grade clean
+.PHONY: help deps build run run-submarine test report bench soak mutation grade clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
@@ -17,6 +17,7 @@ help:
 	@echo "make report         regenerate docs/ (command outputs, figures, PDF) from a live run"
 	@echo "make bench          benchmarks of the exam node against the naive baseline"
 	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
+	@echo "make mutation       mutation testing of the nodes' code against its tests (about 30 min)"
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
@@ -45,6 +46,9 @@ bench: build
 
 soak: build
 	@lab/soak/soak.sh
+
+mutation: build
+	@lab/mutation/run.sh
 
 # make grade SUBMISSION=<dir or zip> | CLASS=<dir or zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]
 grade: build

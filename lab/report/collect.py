@@ -1,16 +1,20 @@
 #!/usr/bin/env python3
 """Brings the system up and runs every command of docs/report.md; writes outputs.json and the bags.
 
-Usage: collect.py --work DIR --run-dir DIR [--flight-seconds S]
+Usage: collect.py --work DIR --run-dir DIR [--run-seconds S]
 
 The order follows the exam sheets:
 
-1. A master; ``rosrun mydrone mydrone_node.py`` alone; questions 4 to 8 and the warning service by hand.
-2. ``catkin_create_pkg`` in a scratch folder (question 9).
-3. The full default flight: ``rosbag record`` then ``roslaunch exam exam.launch`` for one profile loop;
+1. ``catkin_make`` in a scratch workspace whose src/ links to this repository's packages (question 1),
+   with no workspace of ours on CMAKE_PREFIX_PATH, as on a student's machine.
+2. A master; ``rosrun mydrone mydrone_node.py`` alone; questions 4 to 8, the warning service by hand,
+   and question 10's first step (a node that only logs what it receives).
+3. ``catkin_create_pkg`` in a scratch folder (question 9); a launch with a bad threshold (question 12).
+4. The full default flight: ``rosbag record`` then ``roslaunch exam exam.launch`` for one profile loop;
    meanwhile the commands of questions 10 to 14. At the same time, on a second master, the same flight
-   with ``threshold:=1500`` (question 14a), recorded too.
-4. The same for the underwater drone on a fresh master: questions 4 to 8, then one full dive.
+   with ``threshold:=1200 delay:=3`` (question 14), recorded too.
+5. The same for the underwater drone on a fresh master: questions 4 to 8 and 10's first step, then one
+   full dive.
 
 Everything is bounded in time, and every process started is ended on the way out: the harness's
 supervisor runs them all, with their consoles in ``--run-dir`` (report.sh's trap ends them by that
@@ -18,6 +22,7 @@ folder should this process die). The outputs (with PIDs and ports of this run) g
 ``<work>/outputs.json``; render.py fills the report.
 """
 import argparse
+import glob
 import json
 import os
 import shlex
@@ -48,12 +53,11 @@ class Run(object):
         #: {'line', 'console', 'output' once it stopped, 'started' for a launch}.
         self.results = {}
 
-    def run_all(self, master, commands, cwd=None):
-        """Run each command to completion (bounded by its limit) and keep its output."""
+    def run_all(self, env, commands, cwd=None):
+        """Run each command to completion (bounded by its limit) in ``env`` and keep its output."""
         for command in commands:
             status, output, seconds = self.supervisor.run(command.key, shlex.split(command.line),
-                                                          command.limit, master.env,
-                                                          cwd or self.work_dir)
+                                                          command.limit, env, cwd or self.work_dir)
             if status is None:
                 status = 'killed after %d s' % command.limit
             self.results[command.key] = {'line': command.line, 'output': output.rstrip(),
@@ -84,7 +88,7 @@ def node_alone(run, master, node_command, sensor_topic, commands):
     """Questions 3 to 8: one drone node on its own, explored with the command-line tools."""
     node = run.background(master, node_command)
     wait_for(sensor_topic + ' published', lambda: master.publishers(sensor_topic), node)
-    run.run_all(master, commands)
+    run.run_all(master.env, commands)
     run.stop([node], [node_command])
 
 
@@ -100,6 +104,23 @@ def recorded_run(run, master, record, launch, output_topic, bag_topic):
     return bag, proc, started
 
 
+def catkin_make(run):
+    """Question 1: build this repository's packages in a fresh workspace, as a student builds theirs."""
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    workspace = os.path.join(run.supervisor.log_dir, 'catkin_ws')
+    os.makedirs(os.path.join(workspace, 'src'))
+    for manifest in sorted(glob.glob(os.path.join(repo, '*', 'package.xml'))):
+        package = os.path.dirname(manifest)
+        os.symlink(package, os.path.join(workspace, 'src', os.path.basename(package)))
+    # As in a student's first build from a shell: no workspace of ours as an underlay, and none of the
+    # variables `make report` hands its children (make would print every directory it enters).
+    # catkin_make takes the workspace from PWD, which a shell's cd would set.
+    env = {name: value for name, value in run.supervisor.env.items()
+           if name not in ('CMAKE_PREFIX_PATH', 'MAKEFLAGS', 'MFLAGS', 'MAKELEVEL')}
+    env['PWD'] = workspace
+    run.run_all(env, [command_list.CATKIN_MAKE], cwd=workspace)
+
+
 def flight(run, run_seconds):
     master = run.supervisor.start_master('flight.master')
     log('mydrone alone on %s' % master.uri)
@@ -108,24 +129,27 @@ def flight(run, run_seconds):
     scratch = os.path.join(run.supervisor.log_dir, 'create_pkg')
     os.makedirs(scratch)
     create_pkg = command_list.CREATE_PKG
-    run.run_all(master, [create_pkg], cwd=scratch)
+    run.run_all(master.env, [create_pkg], cwd=scratch)
     with open(os.path.join(scratch, 'exam', 'package.xml')) as f:
         run.results[create_pkg.key]['package_xml'] = f.read()
+    # No drone runs on this master now: the bad launch starts both nodes, and roslaunch ends it.
+    run.run_all(master.env, [command_list.BAD_LAUNCH])
 
-    high = run.supervisor.start_master('high.master')
-    log('default flight on %s, threshold 1500 on %s, %.0f s' % (master.uri, high.uri, run_seconds))
+    custom = run.supervisor.start_master('custom.master')
+    log('default flight on %s, threshold 1200 and delay 3 on %s, %.0f s'
+        % (master.uri, custom.uri, run_seconds))
     bag, launch, started = recorded_run(run, master, command_list.FLIGHT_RECORD,
                                         command_list.FLIGHT_LAUNCH, '/altitude', '/alt_warn_led')
-    high_bag, high_launch, _ = recorded_run(run, high, command_list.HIGH_RECORD,
-                                            command_list.HIGH_LAUNCH, '/altitude', '/alt_warn_led')
-    run.run_all(master, command_list.FLIGHT_LIVE)
-    run.run_all(high, command_list.HIGH_LIVE)
+    custom_bag, custom_launch, _ = recorded_run(run, custom, command_list.CUSTOM_RECORD,
+                                                command_list.CUSTOM_LAUNCH, '/altitude', '/alt_warn_led')
+    run.run_all(master.env, command_list.FLIGHT_LIVE)
+    run.run_all(custom.env, command_list.CUSTOM_LIVE)
     time.sleep(max(0.0, started + run_seconds - time.time()))
     # The bags first, so they end on the running system rather than on its shutdown.
-    run.stop([bag, high_bag, launch, high_launch],
-             [command_list.FLIGHT_RECORD, command_list.FLIGHT_LAUNCH, command_list.HIGH_RECORD,
-              command_list.HIGH_LAUNCH])
-    run.supervisor.stop(high.proc)
+    run.stop([bag, custom_bag, launch, custom_launch],
+             [command_list.FLIGHT_RECORD, command_list.FLIGHT_LAUNCH, command_list.CUSTOM_RECORD,
+              command_list.CUSTOM_LAUNCH])
+    run.supervisor.stop(custom.proc)
     run.supervisor.stop(master.proc)
 
 
@@ -137,7 +161,7 @@ def dive(run, run_seconds):
     log('default dive on %s, %.0f s' % (master.uri, run_seconds))
     bag, launch, started = recorded_run(run, master, command_list.DIVE_RECORD,
                                         command_list.DIVE_LAUNCH, '/depth', '/depth_warn_led')
-    run.run_all(master, command_list.DIVE_LIVE)
+    run.run_all(master.env, command_list.DIVE_LIVE)
     time.sleep(max(0.0, started + run_seconds - time.time()))
     run.stop([bag, launch], [command_list.DIVE_RECORD, command_list.DIVE_LAUNCH])
     run.supervisor.stop(master.proc)
@@ -151,11 +175,12 @@ def main():
                         help='length of each recorded flight and dive [s]')
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
-    for name in ('flight.bag', 'flight_1500.bag', 'dive.bag'):
+    for name in ('flight.bag', 'flight_1200.bag', 'dive.bag'):
         if os.path.exists(os.path.join(args.work, name)):
             os.remove(os.path.join(args.work, name))
     with Supervisor(args.run_dir) as supervisor:
         run = Run(supervisor, args.work)
+        catkin_make(run)
         flight(run, args.run_seconds)
         dive(run, args.run_seconds)
     missing = [c.key for c in command_list.ALL if c.key not in run.results]

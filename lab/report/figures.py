@@ -19,7 +19,7 @@ def _led_band(ax, changes, end):
 def run_figure(path, facts, title, quantity, unit, threshold, delay, service, invert=False):
     """True value, published estimate, threshold, LED state and service-call instants of one run."""
     end = max(t for t, _ in facts['published'])
-    fig, (ax, led) = plt.subplots(2, 1, sharex=True, figsize=(11, 4.6),
+    fig, (ax, led) = plt.subplots(2, 1, sharex=True, figsize=(11, 4.0),
                                   gridspec_kw={'height_ratios': [6, 1], 'hspace': 0.08})
     for start, stop, _ in facts['episodes']:
         ax.axvspan(start, end if stop is None else stop, color='#ffcc80', alpha=0.35, lw=0)

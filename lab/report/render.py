@@ -5,12 +5,15 @@ Usage: render.py --work DIR --repo DIR   (DIR of collect.py: outputs.json and th
 
 The template is Markdown with placeholders, each replaced by something this run produced:
 
-- ``{{run KEY}}``: a console block with the command line of command_list.py and its real output;
+- ``{{run KEY}}``: a console block with the command line of command_list.py and its real output (cut
+  where command_list.py says so, with the number of lines left out);
 - ``{{line KEY}}``: the command line alone (a background command: a launch, a recording);
 - ``{{value NAME}}``: a number or short text computed from the run (see :func:`facts`);
 - ``{{block NAME}}``: a preformatted block computed from the run (log excerpts, comparisons);
 - ``{{file PATH}}``: a file of the repository, verbatim;
 - ``{{source MODULE:NAME}}``: the source of one function or class of the code, verbatim.
+
+Placeholders of one kind (run, source, block) separated by blank lines only share one block.
 
 An unknown placeholder or key is an error: the report never shows a hole.
 """
@@ -73,7 +76,27 @@ def depends(package_xml_text):
 
 
 def fmt(value, digits=1):
-    return '%.*f' % (digits, value)
+    """``value`` with ``digits`` decimals; a value that rounds to zero prints as 0, never as -0.0."""
+    text = '%.*f' % (digits, value)
+    return text[1:] if text.startswith('-') and float(text) == 0.0 else text
+
+
+def shown(command, output):
+    """The part of ``output`` the report shows (see command_list.Command), with what was left out."""
+    lines = output.splitlines()
+    if command.show_from:
+        starts = [i for i, line in enumerate(lines) if re.search(command.show_from, line)]
+        if not starts:
+            raise RuntimeError('%s: no line matches %r' % (command.key, command.show_from))
+        if starts[0] > 0:
+            lines = ['[... %d lines above left out ...]' % starts[0]] + lines[starts[0]:]
+    if command.show_until:
+        ends = [i for i, line in enumerate(lines) if re.search(command.show_until, line)]
+        if not ends:
+            raise RuntimeError('%s: no line matches %r' % (command.key, command.show_until))
+        if ends[0] + 1 < len(lines):
+            lines = lines[:ends[0] + 1] + ['[... %d more lines until Ctrl-C ...]' % (len(lines) - ends[0] - 1)]
+    return '\n'.join(lines)
 
 
 def run_facts(work, outputs, name, bag, inputs, compute, output, truth, led, threshold_key, delay):
@@ -93,9 +116,9 @@ def facts(work, repo, outputs):
     flight = run_facts(work, outputs, 'flight.launch', 'flight.bag', ['/temperature', '/pressure'],
                        formulas.altitude, '/altitude', '/mydrone/true_altitude', '/alt_warn_led',
                        'flight.param_threshold', delay)
-    high = run_facts(work, outputs, 'high.launch', 'flight_1500.bag', ['/temperature', '/pressure'],
-                     formulas.altitude, '/altitude', '/mydrone/true_altitude', '/alt_warn_led',
-                     'high.param_threshold', delay)
+    custom = run_facts(work, outputs, 'custom.launch', 'flight_1200.bag', ['/temperature', '/pressure'],
+                       formulas.altitude, '/altitude', '/mydrone/true_altitude', '/alt_warn_led',
+                       'custom.param_threshold', param_value(outputs, 'custom.param_delay'))
     dive = run_facts(work, outputs, 'dive.launch', 'dive.bag', ['/pressure_robot', '/pressure_remote'],
                      formulas.depth, '/depth', '/submarine_drone/true_depth', '/depth_warn_led',
                      'dive.param_threshold', delay)
@@ -126,6 +149,11 @@ def facts(work, repo, outputs):
         v[prefix + '.threshold'] = '%g' % run['threshold']
         v[prefix + '.short_start'] = fmt(short[0][0])
         v[prefix + '.short_duration'] = fmt(short[0][2])
+        # The same excursions of the ground truth (sampled with each reading of the truth's sensor).
+        true = [(end - start) for start, end in analysis.excess_episodes(run['truth'], run['threshold'])
+                if end is not None]
+        v[prefix + '.true_short_duration'] = fmt(min(true))
+        v[prefix + '.true_long_duration'] = fmt(max(true))
         v[prefix + '.long_start'] = fmt(long_[0][0])
         v[prefix + '.long_end'] = fmt(long_[0][1])
         v[prefix + '.long_duration'] = fmt(long_[0][2])
@@ -143,10 +171,15 @@ def facts(work, repo, outputs):
     versions = re.findall(r'/rosversion: (\S+)', outputs['flight.launch']['output'])
     v['run.rosversion'] = versions[0] if versions else 'unknown'
     v['flight.delay'] = '%g' % delay
-    v['high.threshold'] = '%g' % high['threshold']
-    v['high.calls'] = str(len(high['changes']))
-    v['high.max'] = fmt(max(value for _, value in high['published']))
-    v['high.seconds'] = '%.0f' % high['published'][-1][0]
+    v['flight.bad_launch_seconds'] = '%.0f' % outputs['flight.bad_launch']['seconds']
+    v['custom.threshold'] = '%g' % custom['threshold']
+    v['custom.delay'] = '%g' % param_value(outputs, 'custom.param_delay')
+    v['custom.calls'] = str(len(custom['changes']))
+    v['custom.changes'] = ', '.join('%s at %.1f s' % (c, t) for t, c in custom['changes'])
+    v['custom.seconds'] = '%.0f' % custom['published'][-1][0]
+    custom_episodes = [e for e in custom['episodes'] if e[2] is not None]
+    v['custom.short_start'] = fmt(custom_episodes[0][0])
+    v['custom.short_duration'] = fmt(custom_episodes[0][2])
     v['flight.max'] = fmt(max(value for _, value in flight['published']))
     v['flight.true_max'] = fmt(max(value for _, value in flight['truth']))
 
@@ -164,7 +197,7 @@ def facts(work, repo, outputs):
         errs = [e for h, e in measured if abs(h - level) < 0.5]
         v['model.measured_%d' % level] = fmt(analysis.mean(errs))
         v['model.measured_%d_n' % level] = str(len(errs))
-    v['dive.err_mean_mm'] = '%.1f' % (1000 * analysis.mean(e for _, e in dive_errors))
+    v['dive.err_mean_mm'] = fmt(1000 * analysis.mean(e for _, e in dive_errors))
     v['dive.err_max_mm'] = '%.0f' % (1000 * max(abs(e) for _, e in dive_errors))
     v['dive.err_n'] = str(len(dive_errors))
     v['mydrone.temperature_rate'] = fmt(last_rate(outputs['mydrone.hz_temperature']['output']), 3)
@@ -178,7 +211,6 @@ def facts(work, repo, outputs):
     # The exam node's lines only: its start-up summary, its decisions, and its service calls.
     exam_lines = r'\]: (/exam: |\w+ -?[0-9.]+ m .*: (WARNING|NORMAL)$|/\w+_warning: LED set to|could not set)'
     b['flight.exam_log'] = '\n'.join(console_lines(outputs['flight.launch']['output'], exam_lines))
-    b['high.exam_log'] = '\n'.join(console_lines(outputs['high.launch']['output'], exam_lines))
     b['dive.exam_log'] = '\n'.join(console_lines(outputs['dive.launch']['output'], exam_lines))
     b['flight.drone_log'] = '\n'.join(console_lines(outputs['flight.launch']['output'],
                                                     r'altitude_warning: ALT WARN'))
@@ -211,15 +243,32 @@ def fence(text, language=''):
     return '```%s\n%s\n```' % (language, text)
 
 
+#: Placeholders of one kind separated by blank lines only (``{{run}}``, ``{{source}}``, ``{{block}}``):
+#: one block for them all, as in one terminal or one file.
+GROUP = re.compile(r'\{\{(run|source|block) [^ }]+\}\}(?:\n\n\{\{\1 [^ }]+\}\})+')
+
+
 def render(template, outputs, values, blocks, repo):
     """The template with every placeholder replaced; raises KeyError on an unknown one."""
+    def console(key):
+        result = outputs[key]
+        if command_list.BY_KEY[key].line != result['line']:
+            raise KeyError('%s: outputs.json is older than command_list.py, run make report' % key)
+        return '$ %s\n%s' % (result['line'], shown(command_list.BY_KEY[key], clean(result['output'])))
+
+    def replace_group(match):
+        kind = match.group(1)
+        keys = re.findall(r'\{\{%s ([^ }]+)\}\}' % kind, match.group(0))
+        if kind == 'run':
+            return fence('\n\n'.join(console(key) for key in keys), 'console')
+        if kind == 'source':
+            return fence('\n\n\n'.join(source_of(key) for key in keys), 'python')
+        return fence('\n\n'.join(blocks[key] for key in keys), 'text')
+
     def replace(match):
         kind, key = match.groups()
         if kind == 'run':
-            result = outputs[key]
-            if command_list.BY_KEY[key].line != result['line']:
-                raise KeyError('%s: outputs.json is older than command_list.py, run make report' % key)
-            return fence('$ %s\n%s' % (result['line'], clean(result['output'])), 'console')
+            return fence(console(key), 'console')
         if kind == 'line':
             return '`%s`' % command_list.BY_KEY[key].line
         if kind == 'value':
@@ -231,7 +280,7 @@ def render(template, outputs, values, blocks, repo):
                 language = {'.launch': 'xml', '.xml': 'xml', '.py': 'python', '.srv': 'text'}
                 return fence(f.read().rstrip(), language.get(os.path.splitext(key)[1], ''))
         return fence(source_of(key), 'python')
-    return PLACEHOLDER.sub(replace, template)
+    return PLACEHOLDER.sub(replace, GROUP.sub(replace_group, template))
 
 
 def main():

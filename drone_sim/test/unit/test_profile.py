@@ -50,6 +50,11 @@ def test_value_stays_within_the_waypoint_range(t):
     ([[0, 0], [5, 1], [5, 0]], 'increase strictly: waypoint 2 at 5.0 s follows 5.0 s'),
     ([[0, 0], [5, 1], [3, 0]], 'increase strictly'),
     ([[0, 0], [5, 1]], 'last value 1.0 must equal the first 0.0'),
+    # Each message names the offending values themselves, not their neighbours.
+    ([[1, 0], [9, 0]], 'at time 0, got 1.0'),
+    ([[0, 3], [5, 1], [9, 2]], 'last value 2.0 must equal the first 3.0'),
+    ([[0, 0], [0, 1], [9, 0]], 'waypoint 1 at 0.0 s follows 0.0 s'),
+    ([[0, 0], [5, 1], [3, 0]], 'waypoint 2 at 3.0 s follows 5.0 s'),
 ])
 def test_validation_names_the_problem(waypoints, words):
     with pytest.raises(ValueError, match='.*' + words.replace('[', r'\[').replace(']', r'\]')

@@ -39,3 +39,38 @@ def test_rate_counts_arrivals_within_the_window():
     assert cache.rate(10.0) == pytest.approx(2.0)
     # 30 s later every arrival has left the window.
     assert cache.rate(40.0) == 0.0
+
+
+def test_rate_is_measured_from_the_first_to_the_last_arrival_kept():
+    cache = InputCache('pressure', why_unusable_pressure, rate_window=10.0)
+    for t in (100.0, 101.0, 104.0):
+        cache.offer(90000.0, t)
+    # Two intervals in 4 s; an arrival exactly one window old still counts.
+    assert cache.rate(104.0) == pytest.approx(0.5)
+    assert cache.rate(110.0) == pytest.approx(0.5)
+    assert cache.rate(110.01) == pytest.approx(1.0 / 3.0)  # 100.0 has left: one interval in 3 s
+    assert cache.rate(111.01) == 0.0  # only 104.0 is left
+
+
+def test_rate_of_arrivals_with_one_timestamp_is_zero():
+    # Two readings stamped alike (a bag replayed, a coarse clock) give no interval to divide by.
+    cache = InputCache('pressure', why_unusable_pressure)
+    cache.offer(90000.0, 5.0)
+    cache.offer(90001.0, 5.0)
+    assert cache.rate(5.0) == 0.0
+
+
+def test_the_default_rate_window_is_10_s():
+    cache = InputCache('pressure', why_unusable_pressure)
+    for t in (0.0, 1.0, 3.0):
+        cache.offer(90000.0, t)
+    assert cache.rate(10.0) == pytest.approx(2.0 / 3.0)
+    assert cache.rate(10.5) == pytest.approx(0.5)  # 0.0 has left the window: one interval in 2 s
+    assert cache.rate(11.5) == 0.0
+
+
+def test_rate_of_readings_less_than_a_second_apart():
+    cache = InputCache('pressure', why_unusable_pressure)
+    cache.offer(90000.0, 5.0)
+    cache.offer(90000.0, 5.5)
+    assert cache.rate(5.5) == pytest.approx(2.0)

@@ -1,4 +1,6 @@
 """Delivery rules of the warning link, against a fake service driven by events (no sleeps)."""
+import subprocess
+import sys
 import threading
 
 import pytest
@@ -148,7 +150,7 @@ def test_refused_call_counts_as_failure():
                 break
             threading.Event().wait(0.01)
         snap = link.snapshot()
-        assert snap['failing'] and snap['failures'] >= 1
+        assert snap['failing'] and snap['failures'] == 1  # once per attempt; the next is 10 s away
         assert 'unknown status' in snap['last_error']
         assert snap['shown'] == NORMAL
     finally:
@@ -213,3 +215,28 @@ def test_a_failed_call_has_the_connection_opened_again_while_idle(service):
         assert service.calls == []
     finally:
         link.stop(timeout=WAIT_S)
+
+
+def test_a_new_link_reports_nothing_wanted_and_no_failure(make_link):
+    assert make_link().snapshot() == {'wanted': None, 'shown': NORMAL, 'failing': False, 'failures': 0,
+                                      'last_error': ''}
+
+
+def test_a_failing_service_is_retried_once_per_period_not_hammered(service, make_link):
+    service.available = False
+    link = make_link(retry_period=0.2)
+    link.want(WARNING)
+    assert service.entered.wait(WAIT_S)
+    threading.Event().wait(0.5)
+    # 0.5 s at one attempt per 0.2 s: three attempts at most, where a loop without the pause makes
+    # thousands.
+    assert 1 <= link.snapshot()['failures'] <= 4
+
+
+def test_a_link_never_stopped_does_not_keep_the_process_alive():
+    # The worker is a daemon thread: a node that dies before its shutdown hook still exits.
+    code = ('from exam.warning_link import WarningLink\n'
+            'link = WarningLink(lambda s: (True, ""), lambda s, r: None, lambda s: None)\n'
+            'link.start()\n')
+    done = subprocess.run([sys.executable, '-c', code], timeout=WAIT_S * 2)
+    assert done.returncode == 0

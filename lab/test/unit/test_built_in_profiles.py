@@ -1,10 +1,13 @@
-"""The simulators' built-in flights and dives seen through the exam's threshold and delay: each default
-profile has a short excursion (no warning) and a long stay (a warning), located with the oracle's
-spans_above; and the oracle's own helpers. No master needed.
+"""The simulators' built-in flights and dives: exactly the waypoints their docstrings give, and seen
+through the exam's threshold and delay, each default profile has a short excursion (no warning) and a
+long stay (a warning), located with the oracle's spans_above; and the oracle's own helpers. No master
+needed.
 
 What the exam node estimates is computed with exam.formulas itself: these tests are about the profiles,
 not the formula (the formula is checked against the oracle in exam's unit tests and the lab's rostests).
 """
+
+import re
 
 import pytest
 from hypothesis import given, strategies as st
@@ -12,9 +15,9 @@ from hypothesis import given, strategies as st
 from drone_sim.profile import Profile
 from exam import formulas
 from exam_lab.harness.oracle import depth_of, spans_above
-from mydrone import atmosphere
+from mydrone import atmosphere, flights
 from mydrone.flights import FLIGHTS
-from submarinedrone import hydrostatics
+from submarinedrone import dives, hydrostatics
 from submarinedrone.dives import DIVES
 
 STEP = 0.01  # s, sampling step of a profile
@@ -97,3 +100,33 @@ def test_default_dive_seen_through_the_exam_formula():
         surface = hydrostatics.surface_pressure_pa(t)
         robot = hydrostatics.pressure_at_depth_pa(surface, depth)
         assert formulas.depth(robot, surface) == pytest.approx(depth, abs=1e-6)
+
+
+def documented_profiles(docstring):
+    """The waypoints ``[[time_s, value], ...]`` that a profile module's docstring gives, by name.
+
+    Three forms, as mydrone.flights and submarinedrone.dives write them (values in m)::
+
+        ``name`` (loop T s)::           followed by a row "time s ..." and a row "<quantity> m ..."
+        ``name`` (loop T s): v0 m -> v1 m -> ... -> vN m at t0, t1, ..., tN s
+        ``name`` (loop T s): v m all the time
+    """
+    number = r'-?[0-9.]+'
+    profiles = {}
+    table = r'``(\w+)`` \(loop %s s\)::\s*\n\s*time +s +([-0-9. ]+)\n\s*\w+ +m +([-0-9. ]+)' % number
+    for name, times, values in re.findall(table, docstring):
+        profiles[name] = [[float(t), float(v)] for t, v in zip(times.split(), values.split())]
+    chain = r'``(\w+)`` \(loop %s s\): ((?:%s m -> )+%s m) at ([-0-9., ]+) s' % (number, number, number)
+    for name, values, times in re.findall(chain, docstring):
+        values = [float(v) for v in re.findall(number, values)]
+        profiles[name] = [[float(t), v] for t, v in zip(times.split(','), values)]
+    constant = r'``(\w+)`` \(loop (%s) s\): (%s) m all the time' % (number, number)
+    for name, period, value in re.findall(constant, docstring):
+        profiles[name] = [[0.0, float(value)], [float(period), float(value)]]
+    return profiles
+
+
+def test_the_docstrings_give_every_flight_and_dive_exactly():
+    # The docstring is what a user reads to pick a flight or a dive: every waypoint must be the one flown.
+    assert documented_profiles(flights.__doc__) == FLIGHTS
+    assert documented_profiles(dives.__doc__) == DIVES
