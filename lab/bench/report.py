@@ -169,7 +169,7 @@ def _method(r):
             '- Fleet: N pairs of the real simulator (`mydrone/scripts/mydrone_node.py`) and a node, '
             'each pair in its own namespace on one master, %d s window after all pairs publish. The '
             'bench starts the nodes itself, in namespaces never reused, instead of through '
-            '`exam/scripts/fleet_launch.py`, whose names repeat from one fleet to the next: see '
+            '`lab/scripts/fleet_launch.py`, whose names repeat from one fleet to the next: see '
             '`fleet()` in lab/bench/stages.py for the rospy hazard that made a reused name kill a node '
             'of the next fleet.' % c['fleet_window'], '']
 

@@ -161,7 +161,7 @@ def fleet(lab, kind, count, window):
     """``count`` drone + exam pairs: each pair's /altitude rate, total CPU and RSS by role.
 
     Every pair gets a namespace never used before on this master, and the bench starts each node
-    itself rather than through exam/scripts/fleet_launch.py, whose names drone1..droneN repeat from
+    itself rather than through lab/scripts/fleet_launch.py, whose names drone1..droneN repeat from
     one fleet to the next. A rospy node never withdraws its param subscriptions (rosout's
     /rosout_disable_topics_generation, diagnostic_updater's ~diagnostic_period), so the master keeps
     every stopped node's XML-RPC address; when a node of the same name registers again, the master

@@ -247,3 +247,49 @@ def test_code_scan_finds_the_parameters_of_both_nodes():
     for expected in ('mode', 'threshold', 'delay', 'rate', 'timeout', 'profile', 'seed',
                      'temperature_rate', 'pressure_noise', 'pressure_robot_rate', 'true_depth'):
         assert expected in names
+
+
+# --- commands and paths named in the docs -----------------------------------------------------------
+
+#: `rosrun PKG SCRIPT`, `roslaunch PKG FILE`, `rostest PKG FILE` as a user types them.
+ROS_COMMAND = re.compile(r'\b(rosrun|roslaunch|rostest)\s+(?:--\S+\s+)*([a-z_]+)\s+([\w.-]+\.(?:py|launch|test))\b')
+#: `$(find PKG)/path` in a launch file quoted by the docs.
+FIND = re.compile(r'\$\(find (\w+)\)/([\w/.-]+)')
+#: A path inside this repository, in backticks or a Markdown link: `lab/test/ops/replay.test`.
+REPO_PATH = re.compile(r'[`(]((?:exam|mydrone|submarinedrone|drone_sim|lab|tools|docs)/[\w./-]*)[`)#]')
+
+
+def named_things(text):
+    """(what, exists) for each ROS command, $(find) path and repository path the text names."""
+    found = []
+    for program, package, name in ROS_COMMAND.findall(text):
+        folder = package_dir(package)
+        if program == 'roslaunch':
+            ok = folder is not None and os.path.isfile(os.path.join(folder, 'launch', name))
+        else:  # rosrun and rostest find the file anywhere in the package
+            ok = folder is not None and bool(glob.glob(os.path.join(folder, '**', name), recursive=True))
+        found.append(('%s %s %s' % (program, package, name), ok))
+    for package, path in FIND.findall(text):
+        folder = package_dir(package)
+        found.append(('$(find %s)/%s' % (package, path),
+                      folder is not None and os.path.exists(os.path.join(folder, path))))
+    for path in REPO_PATH.findall(text):
+        path = path.rstrip('.')
+        if path.count('/') == 1 and path.split('/')[0] not in ('docs', 'tools', 'lab'):
+            continue  # `mydrone/AltitudeWarning`, `exam/exam_node.py`: ROS's package/resource names
+        found.append((path, os.path.exists(os.path.join(REPO, path))))
+    return found
+
+
+@pytest.mark.parametrize('path', doc_files(), ids=lambda p: os.path.relpath(p, REPO))
+def test_every_command_and_path_named_in_the_docs_exists(path):
+    assert [what for what, ok in named_things(read(path)) if not ok] == []
+
+
+def test_the_check_catches_a_command_or_path_that_moved():
+    text = ('`roslaunch exam drone_pair.launch ns:=d1`, `rosrun exam fleet_launch.py 2`, '
+            '`exam/test/ops/replay.test`, `$(find exam)/launch/drone_pair.launch`; fine: '
+            '`roslaunch exam exam.launch`, `lab/test/ops/replay.test`.')
+    assert [what for what, ok in named_things(text) if not ok] == [
+        'roslaunch exam drone_pair.launch', 'rosrun exam fleet_launch.py',
+        '$(find exam)/launch/drone_pair.launch', 'exam/test/ops/replay.test']
