@@ -4,8 +4,9 @@
     python3 lab/bench/grader_bench.py [--students 20] [--jobs 2,3] [--out DIR] [--record]
     python3 lab/bench/grader_bench.py --from-results DIR/results.json [--record]
 
-(from the repository, after ``make build`` and ``source tools/env.sh``; runs standalone, about 20
-minutes, and is not part of ``make bench``). Phases:
+(from the repository, after ``make build`` and ``source tools/env.sh``; about 20 minutes). A full
+``make bench`` runs it last and records it; ``BENCH_STAGES=grader make bench`` runs a class of 4 into
+``$EXAM_WS/bench-quick/grader``. Phases:
 
 1. *alone*: each distinct package (the flawed and good student packages of lab/test/grader, and our
    exam node) graded one at a time (JOBS=1): the reference points and timings, and one submission's
@@ -176,8 +177,8 @@ def render(results):
             ', '.join('%.2f' % x for x in results.get('load_end', [])))
     return '\n'.join([
         '## The grader', '',
-        '_Measured by `%s --record` on %s (UTC)%s, after `make build` and `source tools/env.sh`; it runs '
-        'standalone and is not part of `make bench`._%s' % (
+        '_Measured by `%s --record` on %s (UTC)%s, after `make build` and `source tools/env.sh`; the '
+        'last stage of a full `make bench`, or alone._%s' % (
             results.get('command', 'python3 lab/bench/grader_bench.py'), when,
             ' in %.0f s' % results['total_s'] if results.get('total_s') else '', load), '',
         'What `make grade` costs ([docs/grading.md](grading.md)), and whether grading students side by side '

@@ -2,7 +2,9 @@
 # `make bench`: measures the exam node against lab/bench/baseline_exam_node.py and writes
 # docs/benchmarks.md and docs/figures/bench_fleet.png (about 10 minutes, 15 with BENCH_PROFILE=1).
 #   BENCH_QUICK=1    a few seconds per stage; results go to $EXAM_WS/bench-quick/, docs/ is untouched
-#   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet), also to $EXAM_WS/bench-quick/
+#   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet grader), also to $EXAM_WS/bench-quick/
+# A full run ends with the grader's speed (lab/bench/grader_bench.py: a class of 20 at JOBS 2 and 3,
+# about 20 minutes more), recorded in lab/bench/grader.md and rendered into docs/benchmarks.md.
 #   BENCH_PROFILE=1  also profile ours with py-spy (installed from PyPI into a throwaway directory)
 #   BENCH_RENDER_ONLY=1  measure nothing: render the docs again from the last results
 # Every process it starts carries the run's log folder in its environment (exam_lab's supervisor); the
@@ -40,8 +42,18 @@ command="$({ env | grep -E '^BENCH_(QUICK|PROFILE|STAGES)=' || true; } | sort | 
 if [ "$EXAM_WS" != "$repo/.ws" ]; then
   command="EXAM_WS=$EXAM_WS $command"
 fi
-if [ -n "${BENCH_STAGES:-}" ]; then
-  args+=(--stages "$BENCH_STAGES")
+# The grader's stage is grader_bench.py, run after bench.py: a full run records it; BENCH_STAGES=grader
+# runs it alone into bench-quick/; BENCH_QUICK skips it (its reference pass alone takes minutes).
+grader=""
+stages="${BENCH_STAGES:-}"
+if [ -z "$stages" ] && [ "${BENCH_QUICK:-0}" != 1 ]; then
+  grader=record
+elif [[ ",$stages," == *,grader,* ]]; then
+  grader=quick
+  stages="$(echo ",$stages," | sed 's/,grader,/,/g; s/^,//; s/,$//')"
+fi
+if [ -n "$stages" ]; then
+  args+=(--stages "$stages")
 fi
 if [ "${BENCH_QUICK:-0}" = 1 ] || [ -n "${BENCH_STAGES:-}" ]; then
   out="$EXAM_WS/bench-quick"
@@ -68,6 +80,22 @@ if [ "${BENCH_PROFILE:-0}" = 1 ]; then
 fi
 
 # In the background so the trap runs at once on Ctrl-C instead of after the stage in progress.
-/usr/bin/python3 "$repo/lab/bench/bench.py" "${args[@]}" &
-bench_pid=$!
-wait "$bench_pid"
+if [ -n "${BENCH_STAGES:-}" ] && [ -z "$stages" ]; then
+  : # only the grader's stage was asked for
+else
+  /usr/bin/python3 "$repo/lab/bench/bench.py" "${args[@]}" &
+  bench_pid=$!
+  wait "$bench_pid"
+fi
+if [ "$grader" = record ]; then
+  echo "bench: the grader's speed (lab/bench/grader_bench.py, about 20 minutes)"
+  /usr/bin/python3 "$repo/lab/bench/grader_bench.py" --out "$scratch/grader" --record &
+  bench_pid=$!
+  wait "$bench_pid"
+  # docs/benchmarks.md again, now with the new lab/bench/grader.md appended.
+  /usr/bin/python3 "$repo/lab/bench/bench.py" "${args[@]}" --render-only
+elif [ "$grader" = quick ]; then
+  /usr/bin/python3 "$repo/lab/bench/grader_bench.py" --students 4 --jobs 2 --out "$out/grader" &
+  bench_pid=$!
+  wait "$bench_pid"
+fi
