@@ -39,6 +39,13 @@ def test_inputs_stale_or_missing_is_a_warning_naming_them():
     assert values(stat)['temperature age [s]'] == 'never received'
 
 
+def test_an_input_exactly_as_old_as_the_timeout_is_still_fresh():
+    # The node's own rule (inputs.is_fresh): stale only when older than ~timeout.
+    rows = [InputRow('temperature', 0.78, 5.0, 0), InputRow('pressure', 2.0, 0.4, 0)]
+    stat = inputs_status(diagnostic_updater.DiagnosticStatusWrapper(), snapshot(rows), timeout=5.0)
+    assert stat.level == DiagnosticStatus.OK
+
+
 def test_warning_before_the_first_reading():
     link = dict(LINK_OK, wanted=None, shown=NORMAL)
     stat = warning_status(diagnostic_updater.DiagnosticStatusWrapper(), snapshot(), link, ALTITUDE,

@@ -240,3 +240,34 @@ def test_a_link_never_stopped_does_not_keep_the_process_alive():
             'link.start()\n')
     done = subprocess.run([sys.executable, '-c', code], timeout=WAIT_S * 2)
     assert done.returncode == 0
+
+
+def test_a_delivered_call_keeps_the_connection_it_used(service):
+    connection = FakeConnection()
+    connection.available = True
+    link = WarningLink(service, lambda state, reason: None, lambda state: None, retry_period=0.01,
+                       connect=connection)
+    link.start()
+    try:
+        assert connection.opened.wait(WAIT_S)
+        link.want(WARNING)
+        assert service.wait_calls(1) == [WARNING]
+        attempts = connection.attempts
+        threading.Event().wait(0.2)  # twenty retry periods: an idle link opens nothing more
+        assert connection.attempts == attempts
+    finally:
+        link.stop(timeout=WAIT_S)
+
+
+def test_a_connection_that_cannot_be_opened_is_tried_once_per_period_not_hammered(service):
+    connection = FakeConnection()  # never available
+    link = WarningLink(service, lambda state, reason: None, lambda state: None, retry_period=0.2,
+                       connect=connection)
+    link.start()
+    try:
+        threading.Event().wait(0.5)
+        # 0.5 s at one attempt per 0.2 s: three attempts at most, where a loop without the pause makes
+        # thousands.
+        assert 1 <= connection.attempts <= 4
+    finally:
+        link.stop(timeout=WAIT_S)
