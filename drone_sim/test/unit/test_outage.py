@@ -66,8 +66,19 @@ def test_a_failed_re_registration_is_logged_once_and_retried_every_poll():
     assert w.observe(UNKNOWN, 8.0)[0] == REREGISTER
     assert w.reregistered(8.1, 1, 1, 1, 0)[2].startswith(
         'master at http://ground:11311/ restarted after 3.0 s down, without /exam:')
-    # A new outage is a new story: logged again.
+    # A new outage is a new story: logged again, and so is its first failed re-registration.
     assert w.observe(UNREACHABLE, 20.0, 'refused')[1] == 'warn'
+    assert w.observe(UNKNOWN, 21.0)[0] == REREGISTER
+    assert w.reregister_failed(21.1, 'reset')[1] == 'warn'
+
+
+def test_after_an_outage_that_needed_nothing_a_failed_re_registration_is_logged_again():
+    w = watch()
+    assert w.observe(UNKNOWN, 5.0)[0] == REREGISTER
+    assert w.reregister_failed(5.1, 'reset')[1] == 'warn'
+    assert w.observe(KNOWN, 6.0)[1] == 'info'  # the master came back knowing the node after all
+    assert w.observe(UNKNOWN, 30.0)[0] == REREGISTER
+    assert w.reregister_failed(30.1, 'reset')[1] == 'warn'
 
 
 SYSTEM_STATE = [

@@ -250,10 +250,10 @@ def test_a_delivered_call_keeps_the_connection_it_used(service):
     link.start()
     try:
         assert connection.opened.wait(WAIT_S)
+        attempts = connection.attempts
         link.want(WARNING)
         assert service.wait_calls(1) == [WARNING]
-        attempts = connection.attempts
-        threading.Event().wait(0.2)  # twenty retry periods: an idle link opens nothing more
+        threading.Event().wait(0.2)  # twenty retry periods: the link opens nothing more
         assert connection.attempts == attempts
     finally:
         link.stop(timeout=WAIT_S)
