@@ -197,24 +197,29 @@ def test_the_connection_is_opened_before_any_state_is_due(service):
         link.stop(timeout=WAIT_S)
 
 
-def test_a_failed_call_has_the_connection_opened_again_while_idle(service):
+@pytest.fixture
+def open_link(service):
+    """A started link whose connection is open, and that connection; stopped after the test."""
     connection = FakeConnection()
     connection.available = True
     link = WarningLink(service, lambda state, reason: None, lambda state: None, retry_period=0.01,
                        connect=connection)
     link.start()
-    try:
-        assert connection.opened.wait(WAIT_S)
-        service.available = False
-        link.want(WARNING)
-        assert service.entered.wait(WAIT_S)
-        connection.opened.clear()
-        link.want(NORMAL)  # nothing left to deliver: the worker reopens the connection instead
-        assert connection.opened.wait(WAIT_S)
-        settle(link)
-        assert service.calls == []
-    finally:
-        link.stop(timeout=WAIT_S)
+    assert connection.opened.wait(WAIT_S)
+    yield link, connection
+    link.stop(timeout=WAIT_S)
+
+
+def test_a_failed_call_has_the_connection_opened_again_while_idle(service, open_link):
+    link, connection = open_link
+    service.available = False
+    link.want(WARNING)
+    assert service.entered.wait(WAIT_S)
+    connection.opened.clear()
+    link.want(NORMAL)  # nothing left to deliver: the worker reopens the connection instead
+    assert connection.opened.wait(WAIT_S)
+    settle(link)
+    assert service.calls == []
 
 
 def test_a_new_link_reports_nothing_wanted_and_no_failure(make_link):
@@ -242,21 +247,13 @@ def test_a_link_never_stopped_does_not_keep_the_process_alive():
     assert done.returncode == 0
 
 
-def test_a_delivered_call_keeps_the_connection_it_used(service):
-    connection = FakeConnection()
-    connection.available = True
-    link = WarningLink(service, lambda state, reason: None, lambda state: None, retry_period=0.01,
-                       connect=connection)
-    link.start()
-    try:
-        assert connection.opened.wait(WAIT_S)
-        attempts = connection.attempts
-        link.want(WARNING)
-        assert service.wait_calls(1) == [WARNING]
-        threading.Event().wait(0.2)  # twenty retry periods: the link opens nothing more
-        assert connection.attempts == attempts
-    finally:
-        link.stop(timeout=WAIT_S)
+def test_a_delivered_call_keeps_the_connection_it_used(service, open_link):
+    link, connection = open_link
+    attempts = connection.attempts
+    link.want(WARNING)
+    assert service.wait_calls(1) == [WARNING]
+    threading.Event().wait(0.2)  # twenty retry periods: the link opens nothing more
+    assert connection.attempts == attempts
 
 
 def test_a_connection_that_cannot_be_opened_is_tried_once_per_period_not_hammered(service):
