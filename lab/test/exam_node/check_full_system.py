@@ -18,7 +18,6 @@ Subscribed Topics:
     ``alt_warn_led`` or ``depth_warn_led`` (std_msgs/String, latched): the simulated drone's LED.
 """
 import sys
-import threading
 import unittest
 
 import rospy
@@ -29,24 +28,6 @@ from exam_lab.harness.fake_drone import TopicRecorder
 from exam_lab.harness.wait import wait_until
 
 TOPICS = {'altitude': ('altitude', 'alt_warn_led'), 'depth': ('depth', 'depth_warn_led')}
-
-
-class LedRecorder(object):
-    """Every colour the LED topic shows, with its arrival time (ROS time, s)."""
-
-    def __init__(self, topic):
-        self._lock = threading.Lock()
-        self._colours = []
-        self._sub = rospy.Subscriber(topic, String, self._callback)
-
-    def colours(self):
-        with self._lock:
-            return list(self._colours)
-
-    def _callback(self, msg):
-        now = rospy.get_time()
-        with self._lock:
-            self._colours.append((now, msg.data))
 
 
 def run_above(samples, index, threshold):
@@ -65,13 +46,13 @@ class FullSystem(unittest.TestCase):
         duration = float(rospy.get_param('~duration'))
         output_topic, led_topic = TOPICS[mode]
         output = TopicRecorder(output_topic)
-        led = LedRecorder(led_topic)
+        led = TopicRecorder(led_topic, String)
         start = rospy.get_time()
 
-        wait_until(lambda: len(led.colours()) >= 3, duration)
+        wait_until(lambda: len(led.samples()) >= 3, duration)
         # A repeated or extra colour would show up within a few more readings.
-        wait_until(lambda: len(led.colours()) >= 4, 2.0)
-        colours = led.colours()
+        wait_until(lambda: len(led.samples()) >= 4, 2.0)
+        colours = led.samples()
         names = [c for _, c in colours]
         for first, second in zip(names, names[1:]):
             self.assertNotEqual(first, second, 'the LED repeated a colour: %s' % names)
