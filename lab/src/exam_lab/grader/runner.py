@@ -1,11 +1,13 @@
-"""Grading a submission or a class: prepare, run the session (isolated), score, write.
+"""Grading a submission or a class: prepare, run the session (sandboxed), score, write.
 
 The runner itself never runs a student's code: it unpacks and reads (:mod:`~exam_lab.grader.unpack`,
-:mod:`~exam_lab.grader.launch`, :mod:`~exam_lab.grader.source`), writes the derived launch files and
-the job, and starts :mod:`exam_lab.grader.session` for one submission, as root inside ``unshare
---net`` (only loopback), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an overall
-time limit. Whatever the session leaves behind is ended by its marker. Then
-:mod:`~exam_lab.grader.rubric` scores and :mod:`~exam_lab.grader.report` writes.
+:mod:`~exam_lab.grader.launch`, :mod:`~exam_lab.grader.source`) a copy of the package that no
+student code can write, writes the derived launch files and the job, opens the submission's
+:class:`~exam_lab.grader.sandbox.Box`, and starts :mod:`exam_lab.grader.session` as root inside
+``unshare --net`` (only loopback), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an
+overall time limit. Then :mod:`~exam_lab.grader.rubric` scores and :mod:`~exam_lab.grader.report`
+writes; what reaches the results from the session's folder is copied as data (regular files only,
+each capped: :func:`~exam_lab.grader.sandbox.copy_results`).
 
 The simulators (``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
 workspace (cached under ``$EXAM_WS/grader/underlay``, rebuilt when their sources change); each student's
@@ -26,7 +28,7 @@ import threading
 import time
 import traceback
 
-from exam_lab.grader import launch, report, rubric, source, unpack
+from exam_lab.grader import launch, report, rubric, sandbox, source, unpack
 from exam_lab.grader.sheets import DELAY, PACKAGE, SHEETS
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
@@ -43,11 +45,17 @@ SIMULATORS = ('drone_sim', 'mydrone', 'submarinedrone')
 _ODD = re.compile(r'\[(WARN|ERROR|FATAL)\]|Traceback|Error\b|Exception\b')
 
 _isolation = {}
+_isolation_lock = threading.Lock()
 _underlay_lock = threading.Lock()
 
 
 def can_isolate():
     """True when this process may run a session in a network namespace of its own (root, unshare)."""
+    with _isolation_lock:
+        return _can_isolate()
+
+
+def _can_isolate():
     if 'ok' not in _isolation:
         try:
             _isolation['ok'] = os.geteuid() == 0 and shutil.which('unshare') is not None and \
@@ -57,28 +65,15 @@ def can_isolate():
     return _isolation['ok']
 
 
-def unprivileged_user(underlay):
-    """``(uid, gid)`` of ``nobody`` when this root process can run the session as that user (it can
-    read the grader's code and the underlay); None otherwise (then the session runs as this user)."""
-    if 'user' not in _isolation:
-        _isolation['user'] = None
-        try:
-            entry = pwd.getpwnam('nobody')
-            if os.geteuid() == 0 and shutil.which('setpriv'):
-                check = subprocess.run(
-                    _as_user((entry.pw_uid, entry.pw_gid)) + [
-                        sys.executable, '-c', 'import os, sys, exam_lab.grader.session; '
-                        'sys.exit(0 if os.access(sys.argv[1], os.R_OK) else 1)', underlay],
-                    timeout=30, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-                if check.returncode == 0:
-                    _isolation['user'] = (entry.pw_uid, entry.pw_gid)
-        except (KeyError, OSError, subprocess.SubprocessError):
-            pass
-    return _isolation['user']
-
-
-def _as_user(user):
-    return ['setpriv', '--reuid=%d' % user[0], '--regid=%d' % user[1], '--clear-groups', '--']
+def sandbox_refusal(unsandboxed=False):
+    """None when student code may run here: boxes can be made, or the teacher passed the flag that
+    names the risk (``unsandboxed``); otherwise the refusal, for the teacher."""
+    why = sandbox.check()
+    if why is None or unsandboxed:
+        return None
+    return ('refusing to run student code without its sandbox: %s. Run the grader as root on a machine '
+            'with bubblewrap and unprivileged user namespaces (docs/grading.md, "Isolation"), or pass '
+            '--unsandboxed-student-code-can-read-and-damage-my-files to accept that risk' % why)
 
 
 def _package_path(name):
@@ -222,44 +217,57 @@ def _executable_in(pkg, name):
     return False
 
 
-def run_session(job, work, underlay, isolate, user=None):
-    """Run the session of one submission; return what it measured (or why it could not).
+def run_session(job, work, underlay, isolate, box):
+    """Run the session of one submission, its student steps in ``box``; return what it measured (or
+    why it could not).
 
     :param isolate: in a network namespace of its own with only loopback (needs root).
-    :param user: ``(uid, gid)`` to run it as (root only): the work folder is handed to that user.
     """
     log_dir = os.path.join(work, 'logs')
-    os.makedirs(log_dir, exist_ok=True)
-    job = dict(job, underlay=underlay, log_dir=log_dir)
+    judge_home = os.path.join(work, 'judge')
+    for folder in (log_dir, judge_home):
+        os.makedirs(folder, mode=0o700, exist_ok=True)
+    ws = os.path.join(work, 'ws')
+    runs = [dict(run, launch=os.path.join(box.workspace, os.path.relpath(run['launch'], ws)))
+            for run in job['runs']]
+    job = dict(job, workspace=box.workspace, runs=runs, underlay=underlay, log_dir=log_dir,
+               judge_home=judge_home, box=box.describe())
     job_path = os.path.join(work, 'job.json')
     with open(job_path, 'w') as f:
         json.dump(job, f, indent=1, sort_keys=True)
     argv = [sys.executable, '-m', 'exam_lab.grader.session', job_path]
-    env = dict(os.environ, HOME=work)
-    if user is not None:
-        for dirpath, dirnames, filenames in os.walk(work):
-            for name in [dirpath] + [os.path.join(dirpath, n) for n in dirnames + filenames]:
-                os.lchown(name, user[0], user[1])
-        argv = _as_user(user) + argv
     if isolate:
         argv = ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + argv
     with Supervisor(os.path.join(work, 'outer')) as sup:
-        status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT, env=env)
+        status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT, env=dict(os.environ, HOME=judge_home))
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
+    survivors = box.end()  # the box's uid: nothing may be left once its PID namespaces are gone
     path = os.path.join(log_dir, 'session.json')
     if status == 0 and os.path.isfile(path):
         with open(path) as f:
-            return json.load(f)
+            result = json.load(f)
+        result['survivors'] = result.get('survivors', 0) + survivors
+        return result
     why = 'the session did not finish within %.0f s' % SESSION_TIMEOUT if status is None else \
         'the session failed (exit %s): %s' % (status, session_tail(output))
-    return {'build': None, 'runs': [], 'error': why}
+    return {'build': None, 'runs': [], 'error': why, 'survivors': survivors}
+
+
+def _share_read_only(folder):
+    """Make the pristine package readable (never writable) by the box's user, which sees it read-only."""
+    for dirpath, dirnames, filenames in os.walk(folder):
+        os.chmod(dirpath, 0o755)
+        for name in filenames:
+            full = os.path.join(dirpath, name)
+            if os.path.isfile(full) and not os.path.islink(full):
+                os.chmod(full, 0o755 if os.stat(full).st_mode & 0o100 else 0o644)
 
 
 def session_tail(output):
     return '\n'.join(output.strip().splitlines()[-10:])
 
 
-def hints(static, session, notes, pkg, isolate, user=None):
+def hints(static, session, notes, pkg, isolate, how_run=None):
     """The for_the_teacher list: what the machine saw but does not score."""
     out = list(notes)
     scripts = source.student_code(pkg) if pkg and os.path.isdir(pkg) else []
@@ -286,23 +294,73 @@ def hints(static, session, notes, pkg, isolate, user=None):
         out.append('launch file graded: %s (of %s)' % (static['launch']['file'], ', '.join(static['launch_files'])))
     out.append('ran in a network namespace with only loopback' if isolate else
                'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
-    out.append('ran as user %s' % pwd.getpwuid(user[0]).pw_name if user is not None else
-               'ran as the grading user %s (as root the grader runs it as nobody)' % pwd.getpwuid(os.geteuid()).pw_name)
+    out.append(how_run or 'not run')
+    if (session or {}).get('survivors'):
+        out.append('%d processes of the student were still alive after its steps ended: killed'
+                   % session['survivors'])
     out.append('not scored by the machine: %s' % report.NOT_SCORED)
     return out
 
 
-def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False):
-    """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record."""
+def _how_run(box):
+    if box.bwrap:
+        return ('ran in a bubblewrap sandbox as uid %d: its own user, PID, mount, IPC and UTS namespaces, '
+                'a clean environment, only its workspace writable; limited in memory, processes, CPU time '
+                'and file size' % box.uid)
+    if box.slot is not None:
+        return 'ran WITHOUT its sandbox (the teacher\'s flag) as uid %d, with resource limits only' % box.uid
+    return ('ran WITHOUT its sandbox (the teacher\'s flag) as the grading user %s: it could read and change '
+            'that user\'s files' % pwd.getpwuid(os.geteuid()).pw_name)
+
+
+def _box_binds(underlay):
+    """What the box sees of the grader (read-only): the underlay and the simulators' sources it links."""
+    cache = os.path.dirname(os.path.dirname(underlay))
+    sources = os.path.join(cache, 'src')
+    return [cache] + [os.path.realpath(os.path.join(sources, name)) for name in sorted(os.listdir(sources))
+                      if os.path.islink(os.path.join(sources, name))]
+
+
+def _prepare_workspace(work):
+    """The pristine workspace the box sees read-only: catkin's top-level CMakeLists.txt linked (catkin_make
+    cannot write src/ in the box), everything readable by the box's user, nothing writable by it."""
+    src = os.path.join(work, 'ws', 'src')
+    top = os.path.join(src, 'CMakeLists.txt')
+    if not os.path.lexists(top):
+        os.symlink(os.path.join(_package_path('catkin'), 'cmake', 'toplevel.cmake'), top)
+    _share_read_only(os.path.join(work, 'ws'))
+    if os.path.isdir(os.path.join(work, 'unpacked')):
+        os.chmod(os.path.join(work, 'unpacked'), 0o700)
+
+
+def could_not_grade(student, sheet, why, notes=()):
+    """The record of a submission the grader could not grade: every item 0, and why."""
+    sheet = sheet or 'altitude'
+    session = {'build': None, 'runs': [], 'error': why}
+    return report.grade_record(student, sheet, rubric.score(sheet, {}, session),
+                               list(notes) + ['could not grade: %s' % why], {'seconds': 0.0})
+
+
+def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False,
+                     unsandboxed=False):
+    """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
+
+    :param unsandboxed: run it even where no sandbox can be made (the teacher's flag that names the
+        risk); otherwise :class:`~exam_lab.grader.sandbox.SandboxUnavailable` is raised there.
+    """
     start = time.monotonic()
     student = student or unpack.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
+    refusal = sandbox_refusal(unsandboxed)
+    if refusal:
+        raise sandbox.SandboxUnavailable(refusal)
     isolate = can_isolate() if isolate is None else isolate
     underlay = underlay or ensure_underlay(default_underlay())  # raises: the grader cannot run
     os.makedirs(out_dir, exist_ok=True)
-    # In the system's temp folder (any user can reach it), not under OUT (which may be private).
+    # In the system's temp folder, not under OUT (which may be private): the box's user must reach
+    # <work>/ws and <work>/box, and may not list <work>.
     work = tempfile.mkdtemp(prefix='exam-grade-')
-    user = unprivileged_user(underlay)
-    notes, static, session, chosen_sheet, pkg = [], {}, None, sheet, None
+    os.chmod(work, 0o711)
+    notes, static, session, chosen_sheet, pkg, how_run = [], {}, None, sheet, None, None
     try:
         try:
             chosen_sheet, static, job = prepare(submission, work, sheet, notes)
@@ -310,7 +368,11 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             if job is None:
                 session = {'build': None, 'runs': [], 'error': 'no script of the package starts a ROS node'}
             else:
-                session = run_session(job, work, underlay, isolate, user)
+                _prepare_workspace(work)
+                with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None) as box:
+                    notes.extend(box.notes)
+                    how_run = _how_run(box)
+                    session = run_session(job, work, underlay, isolate, box)
         except unpack.UnpackError as err:
             session = {'build': None, 'runs': [], 'error': 'submission refused: %s' % err}
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
@@ -318,13 +380,14 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
         chosen_sheet = chosen_sheet or 'altitude'
         items = rubric.score(chosen_sheet, static, session)
-        record = report.grade_record(student, chosen_sheet, items, hints(static, session, notes, pkg, isolate, user),
-                                     {'seconds': round(time.monotonic() - start, 1)})
         logs = os.path.join(out_dir, 'logs')
         shutil.rmtree(logs, ignore_errors=True)
         if os.path.isdir(os.path.join(work, 'logs')):
-            shutil.copytree(os.path.join(work, 'logs'), logs,
-                            ignore=shutil.ignore_patterns('ros_home', 'ros_log', 'ros-*'))
+            skipped = sandbox.copy_results(os.path.join(work, 'logs'), logs)
+            if skipped:
+                notes.append('not copied to logs/ (not a regular file): %s' % ', '.join(skipped))
+        record = report.grade_record(student, chosen_sheet, items, hints(static, session, notes, pkg, isolate, how_run),
+                                     {'seconds': round(time.monotonic() - start, 1)})
         report.write_grade(out_dir, record)
         return record
     finally:
@@ -341,8 +404,12 @@ def default_underlay():
     return os.path.join(workspace(), 'grader', 'underlay')
 
 
-def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=None):
-    """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv."""
+def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=None, unsandboxed=False):
+    """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv.
+    One student the grader cannot grade is that student's row ("could not grade"), never the class's."""
+    refusal = sandbox_refusal(unsandboxed)
+    if refusal:
+        raise sandbox.SandboxUnavailable(refusal)
     os.makedirs(out_dir, exist_ok=True)
     scratch = tempfile.mkdtemp(prefix='class-', dir=out_dir)
     try:
@@ -360,7 +427,17 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
 
         def one(index):
             name, folder = names[index], students[index][1]
-            record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate)
+            try:
+                record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
+                                          unsandboxed=unsandboxed)
+            except Exception as err:  # anything: this student's row says so, the class goes on
+                record = could_not_grade(name, sheet, '%r' % err,
+                                         ['grader error, please report: %s'
+                                          % traceback.format_exc().replace('\n', ' | ')])
+                try:
+                    report.write_grade(os.path.join(out_dir, name), record)
+                except OSError:
+                    pass
             if progress:
                 progress(record)
             return record

@@ -1,18 +1,24 @@
 """One submission's session: build the student's workspace, run its node against the probe.
 
-Everything the student's code runs happens here, under one :class:`~exam_lab.harness.supervisor.
-Supervisor` (its own log folder; every process it started, and every process that inherited its
-marker, is ended on exit). The runner starts this module inside a network namespace that has only
-loopback when the machine allows it::
+The runner starts this module as root, alone in a network namespace that has only loopback::
 
     python3 -m exam_lab.grader.session JOB.json
 
-Job (JSON, written by :mod:`exam_lab.grader.runner`): ``workspace`` (a catkin workspace whose src/
-holds the student's package), ``underlay`` (setup.bash of the simulators' workspace), ``log_dir``,
-``namespace`` (the drone's), ``build_timeout`` / ``run_timeout`` (s), ``runs``: the main run and,
-when the launch file has a threshold the grader can change, the threshold run: each ``{"tag",
-"launch" (derived launch file), "plan" (for the probe)}``. Writes ``<log_dir>/session.json``:
-``{"build": {...}, "runs": [{"tag", "probe" (the probe's result or None), "launch": {...}}]}``.
+Here the grader's side (a master per run, the probe with its fake drone) runs as the grader, under a
+:class:`~exam_lab.harness.supervisor.Supervisor` whose log folder the student's code cannot see; every
+step that runs the student's code (``catkin_make``, ``roslaunch`` and the nodes) runs in the
+submission's :class:`~exam_lab.grader.sandbox.Box`, another user in namespaces of its own that shares
+only this network namespace. The box's environment starts empty: the underlay's, ROS's, a fresh HOME;
+the student's own ``devel/setup.bash`` is sourced inside the box, never here. After each step, the box's
+uid must have no process left (they die with its PID namespace); any found is killed and reported.
+
+Job (JSON, written by :mod:`exam_lab.grader.runner`): ``workspace`` (the student's catkin workspace as
+the box sees it), ``box`` (:meth:`~exam_lab.grader.sandbox.Box.describe`), ``underlay`` (setup.bash of
+the simulators' workspace), ``log_dir``, ``namespace`` (the drone's), ``build_timeout`` /
+``run_timeout`` (s), ``runs``: the main run and, when the launch file has a threshold the grader can
+change, the threshold run: each ``{"tag", "launch" (derived launch file, as the box sees it), "plan"
+(for the probe)}``. Writes ``<log_dir>/session.json``: ``{"build": {...}, "runs": [{"tag", "probe"
+(the probe's result or None), "launch": {...}}], "survivors": n}``.
 """
 import json
 import os
@@ -20,6 +26,7 @@ import re
 import sys
 import time
 
+from exam_lab.grader.sandbox import Box
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
 from exam_lab.harness.wait import wait_until
 
@@ -80,21 +87,40 @@ def warned_in_long_excursion(probe):
                for t, status in probe.get('calls', []))
 
 
-def run_one(sup, job, run, node_env):
-    """Start a master, the student's launch and the probe; return the run's record."""
+def probe_problem(result, plan, started, finished):
+    """Why the probe's ``result`` cannot be this run's measurement, or None: every time it records
+    (wall clock: ROS time without sim time) must lie between the probe's start and the result's
+    arrival, and the flight must have lasted its schedule (the long excursion at least the delay)."""
+    schedule = result.get('schedule') or {}
+    times = [t for t in [result.get('t0')] + list(schedule.values()) if isinstance(t, (int, float))]
+    if not times:
+        return 'the probe\'s result has no times'
+    if min(times) < started - 1.0 or max(times) > finished + 1.0:
+        return 'the probe\'s times (%.1f to %.1f) are not within its run (%.1f to %.1f)' % (
+            min(times), max(times), started, finished)
+    if plan.get('kind') == 'main' and 'long_up' in schedule and 'long_down' in schedule \
+            and schedule['long_down'] - schedule['long_up'] < plan['delay']:
+        return 'the long excursion lasted %.1f s, less than the %.1f s delay' % (
+            schedule['long_down'] - schedule['long_up'], plan['delay'])
+    return None
+
+
+def run_one(sup, job, run, base_env, box):
+    """Start a master, the student's launch (in the box) and the probe; return the run's record."""
     tag = run['tag']
     log_dir = sup.log_dir
     master = sup.start_master(name='master-%s' % tag)
-    launch_env = ros_env(node_env, master.uri, os.path.join(log_dir, 'ros-%s' % tag), ip='127.0.0.1')
-    launch = sup.start('launch-%s' % tag, ['roslaunch', '--screen', run['launch']], launch_env,
-                       cwd=job['workspace'])
+    launch_env = ros_env(base_env, master.uri, os.path.join(box.home, 'ros-%s' % tag), ip='127.0.0.1')
+    launch = sup.start('launch-%s' % tag, box.argv(
+        ['bash', '-c', 'source "$1/devel/setup.bash" && exec roslaunch --screen "$2"', 'bash',
+         job['workspace'], run['launch']], launch_env))
     plan_path = os.path.join(log_dir, 'plan-%s.json' % tag)
     result_path = os.path.join(log_dir, 'probe-%s.json' % tag)
     with open(plan_path, 'w') as f:
         json.dump(run['plan'], f, indent=1, sort_keys=True)
     probe_env = ros_env(master.env, master.uri, os.path.join(log_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')
     probe_env['ROS_NAMESPACE'] = job.get('namespace', '/')
-    started = time.monotonic()
+    started, started_wall = time.monotonic(), time.time()
     probe = sup.start('probe-%s' % tag, [sys.executable, '-m', 'exam_lab.grader.probe', plan_path, result_path],
                       probe_env)
     # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
@@ -106,9 +132,13 @@ def run_one(sup, job, run, node_env):
     # Read before stopping: what the nodes print when the grader stops them is not their doing.
     record['launch'] = launch_outcome(sup.output('launch-%s' % tag), job['workspace'])
     sup.stop(launch)
+    record['survivors'] = box.end()
     if os.path.isfile(result_path):
         with open(result_path) as f:
             record['probe'] = json.load(f)
+        problem = probe_problem(record['probe'], run['plan'], started_wall, time.time())
+        if problem:
+            record['probe'], record['probe_error'] = None, 'result refused: %s' % problem
     else:
         record['probe_error'] = ('no result within %.0f s; ' % job['run_timeout'] if probe.poll() is None else
                                  'exit %s; ' % probe.poll()) + tail(sup.output('probe-%s' % tag), 15)
@@ -118,18 +148,23 @@ def run_one(sup, job, run, node_env):
 
 
 def session(job):
-    result = {'build': None, 'runs': []}
-    with Supervisor(job['log_dir'], env=dict(os.environ, ROS_IP='127.0.0.1')) as sup:
-        build_env = workspace_env(job['underlay'], sup.env)
+    result = {'build': None, 'runs': [], 'survivors': 0}
+    box = Box.attached(job['box'])
+    # The grader's side keeps the grader's environment, with a HOME of its own the box cannot see.
+    judge_env = dict(os.environ, ROS_IP='127.0.0.1', HOME=job['judge_home'], PYTHONNOUSERSITE='1')
+    with Supervisor(job['log_dir'], env=judge_env) as sup:
+        base_env = workspace_env(job['underlay'], {'PATH': os.environ.get('PATH', '/usr/bin:/bin'),
+                                                   'LANG': 'C.UTF-8'})
         status, output, seconds = sup.run(
-            'build', ['catkin_make', '--directory', job['workspace'], '-DPYTHON_EXECUTABLE=/usr/bin/python3',
-                      '-DCATKIN_ENABLE_TESTING=OFF'],
-            timeout=job['build_timeout'], env=build_env, cwd=job['workspace'])
+            'build', box.argv(['catkin_make', '--directory', job['workspace'],
+                               '-DPYTHON_EXECUTABLE=/usr/bin/python3', '-DCATKIN_ENABLE_TESTING=OFF'],
+                              dict(base_env, ROS_HOME=os.path.join(box.home, 'ros'))),
+            timeout=job['build_timeout'])
+        result['survivors'] += box.end()
         result['build'] = {'status': status, 'seconds': seconds, 'tail': tail(output),
                            'timeout': job['build_timeout']}
         if status != 0:
             return result
-        node_env = workspace_env(os.path.join(job['workspace'], 'devel', 'setup.bash'), sup.env)
         for run in job['runs']:
             if run['tag'] == 'threshold':
                 main = result['runs'][0]['probe'] if result['runs'] else None
@@ -137,7 +172,8 @@ def session(job):
                     result['threshold_skipped'] = 'the node never warned in the main run'
                     break
                 run = dict(run, plan=dict(run['plan'], fit=main['calibration'].get('fit')))
-            result['runs'].append(run_one(sup, job, run, node_env))
+            result['runs'].append(run_one(sup, job, run, base_env, box))
+            result['survivors'] += result['runs'][-1]['survivors']
     return result
 
 

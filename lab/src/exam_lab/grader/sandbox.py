@@ -1,0 +1,435 @@
+"""The box a submission's code runs in: bubblewrap, as a user of its own, with resource limits.
+
+Every step that runs a student's code (``catkin_make``: CMake runs code; ``roslaunch`` and the nodes)
+runs through :meth:`Box.argv`::
+
+    sh -c 'join the box's cgroups'  prlimit ...  setpriv --reuid=U ... --no-new-privs  bwrap ...  CMD
+
+- **A user of its own.** Each box holds a slot (an exclusive ``flock`` on
+  ``/run/lock/exam-grader/box-N``, so concurrent gradings on one machine, even of two graders, never
+  share one) and runs as uid ``BOX_UID_BASE + N``, a uid no account and no process uses. bubblewrap
+  started by root with ``--unshare-user`` would keep root's rights over every file it can see;
+  started from the box's own uid, it has exactly that uid's rights: other users' 0600 files are not
+  readable, another box's processes cannot be signalled, and ``RLIMIT_NPROC`` (counted per uid)
+  bounds this box's processes alone.
+- **Namespaces** (bubblewrap): user, PID, IPC, UTS and cgroup namespaces of its own; the network
+  namespace is the session's (only loopback, made by the runner), shared with the grader's master
+  and probe, which run outside the box. When the box's first process ends, its PID namespace ends
+  and the kernel kills every process in it, double-forked and ``setsid`` ones included.
+- **Files**: an empty root (read-only once set up) with read-only binds of ``/usr`` (``/bin``,
+  ``/lib``... are its links on Debian 12), the few ``/etc`` files a ROS process reads, the simulators'
+  underlay and their sources; the student's package read-only; only the box's own work folder
+  (``build/``, ``devel/``) writable. Fresh ``/proc``, ``/dev``, and private ``/tmp``, ``/var/tmp``,
+  ``/dev/shm`` and HOME (size-capped tmpfs). No /root, /home, other students, grader output.
+- **Environment**: empty (``--clearenv``) but for the variables :func:`box_env` lets through.
+- **Limits**: memory and processes by a cgroup of the box's own where the machine lets root make one
+  (cgroup v1 ``memory`` + ``pids``, or v2), always ``prlimit`` (address space, processes, CPU time,
+  file size, open files, no core files). The box's work folder is a tmpfs of ``WORK_BYTES``.
+
+:func:`check` says whether boxes can be made here at all; the runner refuses to grade when they
+cannot unless the teacher accepts the risk by name.
+"""
+import errno
+import fcntl
+import os
+import pwd
+import shutil
+import signal
+import stat
+import subprocess
+import threading
+import time
+
+#: First uid of the boxes (isolate uses 60000+); slot N runs as BOX_UID_BASE + N.
+BOX_UID_BASE = 61000
+SLOTS = 64
+LOCK_DIR = '/run/lock/exam-grader'
+#: Where the box sees its workspace, and its private HOME.
+BOX_WS = '/box/ws'
+BOX_HOME = '/box/home'
+#: Limits of one box.
+MEMORY_BYTES = 2 << 30           # cgroup: the whole box
+ADDRESS_SPACE_BYTES = 4 << 30    # prlimit: each process (rospy reserves 64 MB malloc arenas per thread)
+PROCESSES = 512                  # threads count: a rospy node has ~15, roslaunch ~10
+CPU_SECONDS = 300                # each process
+FILE_BYTES = 64 << 20            # each file written, logs included
+OPEN_FILES = 1024
+WORK_BYTES = 512 << 20           # build/ + devel/
+TMP_BYTES = 64 << 20             # each of /tmp, /var/tmp, /dev/shm, HOME
+#: /etc files a ROS process reads (name resolution of localhost, the dynamic linker, alternatives).
+ETC = ('alternatives', 'catkin', 'ld.so.cache', 'ld.so.conf', 'ld.so.conf.d', 'hosts', 'host.conf', 'nsswitch.conf',
+       'localtime', 'ros', 'python3', 'python3.11', 'mime.types', 'ssl')
+#: Variables of a box's environment, besides those a sourced workspace sets (ROS_*, paths).
+PASSED = ('PATH', 'LANG', 'LC_ALL', 'PYTHONUNBUFFERED', 'PYTHONDONTWRITEBYTECODE')
+
+_check_lock = threading.Lock()
+_checked = {}
+
+
+class SandboxUnavailable(RuntimeError):
+    """The machine cannot make a box: the grader refuses to run student code (unless told to)."""
+
+
+def box_env(env, home=BOX_HOME):
+    """Only what ROS and the build need from ``env`` (ROS_*, the workspace's paths, PATH, locale), with
+    a fresh HOME and a user name of the box: nothing else of the grading user reaches student code."""
+    from exam_lab.harness.supervisor import WORKSPACE_VARS
+    kept = {k: v for k, v in env.items() if k.startswith('ROS') or k in WORKSPACE_VARS or k in PASSED}
+    kept.update(HOME=home, USER='student', LOGNAME='student', PYTHONNOUSERSITE='1')
+    kept.setdefault('LANG', 'C.UTF-8')
+    return kept
+
+
+def _own_cgroups():
+    """``{controller: (hierarchy root, this process's path)}``; v2 as controller ``''``."""
+    found = {}
+    try:
+        with open('/proc/self/cgroup') as f:
+            for line in f:
+                _, controllers, path = line.rstrip('\n').split(':', 2)
+                for name in controllers.split(','):
+                    if name in ('memory', 'pids') and os.path.isdir('/sys/fs/cgroup/%s' % name):
+                        found[name] = ('/sys/fs/cgroup/%s' % name, path)
+                    elif controllers == '' and os.path.isfile('/sys/fs/cgroup/cgroup.controllers'):
+                        found[''] = ('/sys/fs/cgroup', path)
+    except OSError:
+        pass
+    return found
+
+
+def _make_cgroups(name):
+    """Folders of new cgroups for one box with their limits set; [] when the machine does not let us."""
+    own = _own_cgroups()
+    made = []
+    try:
+        if 'memory' in own and 'pids' in own:
+            for controller, limit_file, value in (('memory', 'memory.limit_in_bytes', MEMORY_BYTES),
+                                                  ('pids', 'pids.max', PROCESSES)):
+                root, path = own[controller]
+                folder = os.path.join(root, path.lstrip('/'), name)
+                os.mkdir(folder)
+                made.append(folder)
+                with open(os.path.join(folder, limit_file), 'w') as f:
+                    f.write(str(value))
+        elif '' in own:
+            root, path = own['']
+            folder = os.path.join(root, path.lstrip('/'), name)
+            os.mkdir(folder)
+            made.append(folder)
+            for limit_file, value in (('memory.max', MEMORY_BYTES), ('pids.max', PROCESSES)):
+                with open(os.path.join(folder, limit_file), 'w') as f:
+                    f.write(str(value))
+        return made
+    except OSError:
+        _remove_cgroups(made)
+        return []
+
+
+def _remove_cgroups(folders):
+    for folder in reversed(folders):
+        try:
+            os.rmdir(folder)
+        except OSError:
+            pass
+
+
+def _uid_in_use(uid):
+    try:
+        pwd.getpwuid(uid)
+        return True
+    except KeyError:
+        return bool(pids_of_uid(uid))
+
+
+def pids_of_uid(uid):
+    """Living processes whose real or effective uid is ``uid`` (zombies left out: they are dead)."""
+    found = []
+    for entry in os.listdir('/proc'):
+        if not entry.isdigit():
+            continue
+        try:
+            with open('/proc/%s/status' % entry) as f:
+                status = dict(line.split(':', 1) for line in f if ':' in line)
+        except (OSError, ValueError):
+            continue
+        uids = status.get('Uid', '').split()
+        if status.get('State', '').strip().startswith('Z') or len(uids) < 2:
+            continue
+        if str(uid) in uids[:2]:
+            found.append(int(entry))
+    return found
+
+
+def _tmpfs(path, size, uid):
+    """Mount a tmpfs of ``size`` bytes owned by ``uid`` on ``path``; False where root cannot mount."""
+    done = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=%d,mode=0700,uid=%d,gid=%d,nosuid,nodev'
+                           % (size, uid, uid), 'exam-box', path],
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=30)
+    return done.returncode == 0
+
+
+class Box(object):
+    """One submission's box: a uid of its own, its work folder ``<work>/box``, its cgroups.
+
+    :param work: the submission's work folder (root's); the box gets ``<work>/box`` (build/ and devel/
+        of its workspace) and sees ``<work>/ws/src`` read-only.
+    :param binds: host folders the box sees read-only at the same path (the underlay, the simulators'
+        sources).
+    :param bwrap: False for the unsandboxed mode the teacher asked for by name: same user and limits,
+        no namespaces.
+    """
+
+    def __init__(self, work, binds=(), bwrap=True):
+        self.work = work
+        self.binds = [os.path.realpath(b) for b in binds]
+        self.bwrap = bwrap
+        self.slot = None
+        self._lock = None
+        self.cgroups = []
+        self.mounted = False
+        self.folder = os.path.join(work, 'box')
+        self.notes = []
+
+    def describe(self):
+        """What the session needs to make this box's command lines (JSON): see :meth:`attached`."""
+        return {'work': self.work, 'binds': self.binds, 'bwrap': self.bwrap, 'slot': self.slot,
+                'cgroups': self.cgroups}
+
+    @classmethod
+    def attached(cls, described):
+        """The box :meth:`describe` described, opened by another process (the runner holds it)."""
+        box = cls(described['work'], described['binds'], described['bwrap'])
+        box.slot, box.cgroups = described['slot'], described['cgroups']
+        return box
+
+    @property
+    def home(self):
+        """The box's HOME as its processes see it."""
+        return BOX_HOME if self.bwrap else os.path.join(self.folder, 'home')
+
+    @property
+    def uid(self):
+        return BOX_UID_BASE + self.slot
+
+    @property
+    def workspace(self):
+        """The student's workspace as the box's processes see it."""
+        return BOX_WS if self.bwrap else os.path.join(self.folder, 'ws')
+
+    def open(self):
+        if os.geteuid() != 0:  # unsandboxed and not root: the grading user's own rights, limits only
+            if self.bwrap:
+                raise SandboxUnavailable('a box needs root (a user of its own per submission)')
+            os.makedirs(os.path.join(self.folder, 'ws', 'build'))
+            os.makedirs(os.path.join(self.folder, 'ws', 'devel'))
+            shutil.copytree(os.path.join(self.work, 'ws', 'src'), os.path.join(self.folder, 'ws', 'src'),
+                            symlinks=True)
+            return self
+        os.makedirs(LOCK_DIR, mode=0o700, exist_ok=True)
+        for slot in range(SLOTS):
+            lock = open(os.path.join(LOCK_DIR, 'box-%d' % slot), 'w')
+            try:
+                fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                lock.close()
+                continue
+            if _uid_in_use(BOX_UID_BASE + slot):
+                lock.close()
+                continue
+            self.slot, self._lock = slot, lock
+            break
+        else:
+            raise SandboxUnavailable('no free box among %d (uids %d-%d taken)'
+                                     % (SLOTS, BOX_UID_BASE, BOX_UID_BASE + SLOTS - 1))
+        os.makedirs(self.folder)
+        self.mounted = _tmpfs(self.folder, WORK_BYTES, self.uid)
+        if not self.mounted:
+            os.chown(self.folder, self.uid, self.uid)
+            os.chmod(self.folder, 0o700)
+            self.notes.append('the box\'s work folder has no size limit (no tmpfs): files are limited '
+                              'to %d MB each' % (FILE_BYTES >> 20))
+        # The workspace: src is a mount point for the read-only package (or, unsandboxed, a copy).
+        for sub in ('ws', 'ws/src', 'ws/build', 'ws/devel'):
+            os.mkdir(os.path.join(self.folder, sub))
+        src = os.path.join(self.work, 'ws', 'src')
+        if not self.bwrap:
+            os.rmdir(os.path.join(self.folder, 'ws', 'src'))
+            shutil.copytree(src, os.path.join(self.folder, 'ws', 'src'), symlinks=True)
+        for dirpath, dirnames, filenames in os.walk(self.folder):
+            for name in [dirpath] + [os.path.join(dirpath, n) for n in dirnames + filenames]:
+                os.lchown(name, self.uid, self.uid)
+        self.cgroups = _make_cgroups('exam-box-%d' % self.slot)
+        if not self.cgroups:
+            self.notes.append('no cgroup could be made: memory limited per process (%d GB of address '
+                              'space), processes per uid (%d)' % (ADDRESS_SPACE_BYTES >> 30, PROCESSES))
+        return self
+
+    def __enter__(self):
+        return self.open()
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def argv(self, command, env, cwd=None):
+        """The command line that runs ``command`` in the box with ``env`` (filtered by :func:`box_env`)
+        and ``cwd`` (a path as the box sees it; default its workspace)."""
+        env = box_env(env, self.home)
+        cwd = cwd or self.workspace
+        limits = ['prlimit', '--as=%d' % ADDRESS_SPACE_BYTES, '--nproc=%d' % PROCESSES,
+                  '--cpu=%d' % CPU_SECONDS, '--fsize=%d' % FILE_BYTES, '--nofile=%d' % OPEN_FILES,
+                  '--core=0', '--']
+        user = ['setpriv', '--reuid=%d' % self.uid, '--regid=%d' % self.uid, '--clear-groups',
+                '--no-new-privs', '--inh-caps=-all', '--'] if self.slot is not None else []
+        join = []
+        if self.cgroups:
+            join = ['sh', '-c', 'for g in "$@"; do case "$g" in --) shift; break;; esac; '
+                    'echo $$ > "$g/cgroup.procs" || exit 125; shift; done; exec "$@"', 'sh'] + \
+                self.cgroups + ['--']
+        if not self.bwrap:
+            os.makedirs(env['HOME'], exist_ok=True)
+            if self.slot is not None:
+                os.chown(env['HOME'], self.uid, self.uid)
+            return join + limits + user + ['env', '-i', '-C', cwd] + \
+                ['%s=%s' % item for item in sorted(env.items())] + list(command)
+        box = ['bwrap', '--unshare-user', '--unshare-pid', '--unshare-ipc', '--unshare-uts',
+               '--unshare-cgroup-try', '--hostname', 'exam-box', '--die-with-parent', '--new-session',
+               '--clearenv', '--ro-bind', '/usr', '/usr']
+        for link in ('bin', 'sbin', 'lib', 'lib32', 'lib64', 'libx32'):
+            if os.path.islink('/' + link):
+                box += ['--symlink', os.readlink('/' + link), '/' + link]
+            elif os.path.isdir('/' + link):
+                box += ['--ro-bind', '/' + link, '/' + link]
+        for name in ETC:
+            if os.path.exists('/etc/' + name):
+                box += ['--ro-bind', '/etc/' + name, '/etc/' + name]
+        if os.path.isdir('/opt/ros'):
+            box += ['--ro-bind', '/opt/ros', '/opt/ros']
+        for path in self.binds:
+            box += ['--ro-bind', path, path]
+        box += ['--proc', '/proc', '--dev', '/dev']
+        for path in ('/tmp', '/var/tmp', '/dev/shm', BOX_HOME):
+            box += ['--size', str(TMP_BYTES), '--tmpfs', path]
+        box += ['--bind', os.path.join(self.folder, 'ws'), BOX_WS,
+                '--ro-bind', os.path.join(self.work, 'ws', 'src'), BOX_WS + '/src',
+                '--remount-ro', '/', '--chdir', cwd]
+        for name, value in sorted(env.items()):
+            box += ['--setenv', name, value]
+        return join + limits + user + box + ['--'] + list(command)
+
+    def leftovers(self):
+        """Pids of the box's uid still alive (there should be none once its command ended)."""
+        return pids_of_uid(self.uid) if self.slot is not None else []
+
+    def end(self):
+        """Kill whatever still runs as the box's uid; returns how many there were (0 expected)."""
+        left = self.leftovers()
+        for _ in range(3 if left else 0):
+            for pid in left:
+                try:
+                    os.kill(pid, signal.SIGKILL)
+                except OSError:
+                    pass
+            deadline = time.monotonic() + 5.0
+            while time.monotonic() < deadline and self.leftovers():
+                time.sleep(0.05)
+            if not self.leftovers():
+                break
+        return len(left)
+
+    def close(self):
+        if self.slot is None:
+            shutil.rmtree(self.folder, ignore_errors=True)
+            return
+        self.end()
+        _remove_cgroups(self.cgroups)
+        if self.mounted:
+            subprocess.run(['umount', '-l', self.folder], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                           timeout=30)
+        shutil.rmtree(self.folder, ignore_errors=True)
+        self._lock.close()
+        self.slot = None
+
+
+def check():
+    """None when boxes can be made here; else why not. Tried once per process (a real box runs
+    ``true``), under a lock so that concurrent gradings wait for the answer rather than guess it."""
+    with _check_lock:
+        if 'why' not in _checked:
+            _checked['why'] = _try_a_box()
+        return _checked['why']
+
+
+def _try_a_box():
+    if os.geteuid() != 0:
+        return 'the grader is not root: it needs root to give each submission a user of its own'
+    missing = [tool for tool in ('bwrap', 'setpriv', 'prlimit', 'unshare', 'ip') if shutil.which(tool) is None]
+    if missing:
+        return 'missing %s (Debian: apt-get install bubblewrap util-linux iproute2)' % ', '.join(missing)
+    import tempfile
+    work = tempfile.mkdtemp(prefix='exam-box-check-')
+    try:
+        os.chmod(work, 0o711)
+        os.makedirs(os.path.join(work, 'ws', 'src'))
+        with Box(work) as box:
+            done = subprocess.run(box.argv(['sh', '-c', 'test "$(id -u)" != 0 && test ! -e /root'], {}),
+                                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=30)
+        if done.returncode != 0:
+            return 'bubblewrap could not make a box (exit %d): %s' % (
+                done.returncode, done.stdout.decode('utf-8', 'replace').strip()[-500:])
+        return None
+    except (OSError, subprocess.SubprocessError, SandboxUnavailable) as err:
+        return 'a box could not be made: %s' % err
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+#: What of a log reaches the results: its first and last LOG_PART bytes.
+LOG_PART = 256 << 10
+#: Most bytes of a file other than a log (JSON) copied to the results.
+FILE_CAP = 4 << 20
+
+
+def read_capped(path, part=LOG_PART):
+    """A file's text, its middle cut when longer than ``2 * part`` bytes (saying so); None when
+    ``path`` is not a regular file (a link, FIFO or device is never followed or opened for reading:
+    opened with O_NOFOLLOW | O_NONBLOCK and checked with fstat)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError as err:
+        if err.errno in (errno.ELOOP, errno.ENXIO, errno.ENOENT, errno.EACCES):
+            return None
+        raise
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            return None
+        with os.fdopen(os.dup(fd), 'rb') as f:
+            if info.st_size <= 2 * part:
+                data = f.read(2 * part)
+            else:
+                head = f.read(part)
+                f.seek(info.st_size - part)
+                cut = info.st_size - 2 * part
+                data = head + ('\n[... %d bytes cut by the grader: this log keeps its first and last %d KB '
+                               'of %d bytes ...]\n' % (cut, part >> 10, info.st_size)).encode() + f.read(part)
+        return data.decode('utf-8', 'replace')
+    finally:
+        os.close(fd)
+
+
+def copy_results(source, target, suffixes=('.log', '.json', '.md'), part=LOG_PART):
+    """Copy the regular files of ``source`` (not its sub-folders) ending in ``suffixes`` to ``target``,
+    each capped by :func:`read_capped`; a link, FIFO or device is skipped. Returns the names skipped."""
+    os.makedirs(target, exist_ok=True)
+    skipped = []
+    for name in sorted(os.listdir(source)):
+        if not name.endswith(suffixes) or '\n' in name:
+            continue
+        text = read_capped(os.path.join(source, name), part if name.endswith('.log') else FILE_CAP)
+        if text is None:
+            skipped.append(name)
+            continue
+        with open(os.path.join(target, name), 'w') as f:
+            f.write(text)
+    return skipped
