@@ -15,7 +15,7 @@ packages=(
   python3-rosnode python3-roslaunch python3-rosbag rosbash
   python3-diagnostic-updater python3-diagnostic-msgs
   python3-pytest python3-hypothesis python3-matplotlib
-  iproute2
+  iproute2 bubblewrap
   "$@"
 )
 

@@ -62,6 +62,9 @@ ETC = ('alternatives', 'catkin', 'ld.so.cache', 'ld.so.conf', 'ld.so.conf.d', 'h
 #: Variables of a box's environment, besides those a sourced workspace sets (ROS_*, paths).
 PASSED = ('PATH', 'LANG', 'LC_ALL', 'PYTHONUNBUFFERED', 'PYTHONDONTWRITEBYTECODE')
 
+#: PATH entries a box keeps (the system's, ROS's, the workspace's): none of the grading user's own.
+SYSTEM_PATH = ('/usr/', '/bin', '/sbin', '/opt/ros/', BOX_WS)
+
 _check_lock = threading.Lock()
 _checked = {}
 
@@ -75,6 +78,8 @@ def box_env(env, home=BOX_HOME):
     a fresh HOME and a user name of the box: nothing else of the grading user reaches student code."""
     from exam_lab.harness.supervisor import WORKSPACE_VARS
     kept = {k: v for k, v in env.items() if k.startswith('ROS') or k in WORKSPACE_VARS or k in PASSED}
+    kept['PATH'] = ':'.join(p for p in kept.get('PATH', '').split(':') if p.startswith(SYSTEM_PATH)) or \
+        '/usr/bin:/bin'
     kept.update(HOME=home, USER='student', LOGNAME='student', PYTHONNOUSERSITE='1')
     kept.setdefault('LANG', 'C.UTF-8')
     return kept
@@ -292,7 +297,8 @@ class Box(object):
                 os.chown(env['HOME'], self.uid, self.uid)
             return join + limits + user + ['env', '-i', '-C', cwd] + \
                 ['%s=%s' % item for item in sorted(env.items())] + list(command)
-        box = ['bwrap', '--unshare-user', '--unshare-pid', '--unshare-ipc', '--unshare-uts',
+        # bwrap itself (the box's pid 1, whose /proc/1/environ the box can read) starts with nothing.
+        box = ['env', '-i', 'bwrap', '--unshare-user', '--unshare-pid', '--unshare-ipc', '--unshare-uts',
                '--unshare-cgroup-try', '--hostname', 'exam-box', '--die-with-parent', '--new-session',
                '--clearenv', '--ro-bind', '/usr', '/usr']
         for link in ('bin', 'sbin', 'lib', 'lib32', 'lib64', 'libx32'):
