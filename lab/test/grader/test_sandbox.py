@@ -104,6 +104,16 @@ def test_links_and_fifos_do_not_stop_the_class(hostile_class):
     assert sorted(row.split(',')[0] for row in rows) == [name for name, _ in CLASS]
 
 
+def test_every_student_runs_in_a_box_of_its_own(hostile_class):
+    boxes = []
+    for name, record in sorted(hostile_class['records'].items()):
+        ran = [hint for hint in record['for_the_teacher'] if hint.startswith('ran ') and ' as ' in hint]
+        assert len(ran) == 1 and ran[0].startswith('ran in a bubblewrap sandbox as uid '), (name, ran)
+        boxes.append(int(ran[0].split('as uid ')[1].split(':')[0]))
+    assert boxes[0] != boxes[1], 'the saboteur and its classmate, graded side by side, share a uid'
+    assert all(uid >= sandbox.BOX_UID_BASE for uid in boxes)
+
+
 def test_the_classmate_of_a_saboteur_keeps_its_points(hostile_class):
     record = hostile_class['records']['b_victim']
     got = {i['id']: i['points'] for i in record['items']}
@@ -197,7 +207,9 @@ def test_a_box_is_another_user_and_sees_only_its_own():
         f.write('host')
     script = ('id -u; test -e /root && echo ROOT_VISIBLE; test -e %s && echo HOST_TMP_VISIBLE; '
               'touch /box/ws/src/exam/x 2>/dev/null && echo PACKAGE_WRITABLE; touch /box/ws/devel/x && echo OK; '
-              'env; tr "\\0" "\\n" < /proc/1/environ; (setsid sh -c "sleep 77; true" &) ; true' % host_file)
+              'env; tr "\\0" "\\n" < /proc/1/environ; (setsid sh -c "sleep 77; true" &) ; '
+              'cat /proc/self/limits; head -c %d /dev/zero > /box/ws/devel/big; echo "BIG $(wc -c < /box/ws/devel/big)"'
+              % (host_file, sandbox.FILE_BYTES + 4096))
     try:
         with sandbox.Box(work) as box:
             grader_env = dict(os.environ, GRADER_SECRET='leak')
@@ -210,5 +222,10 @@ def test_a_box_is_another_user_and_sees_only_its_own():
     lines = output.splitlines()
     assert lines[0] == str(uid) and uid != 0
     assert 'OK' in lines
+    assert 'BIG %d' % sandbox.FILE_BYTES in lines, 'a file stops growing at the limit'
+    limits = dict((line[:26].strip(), line[26:].split()) for line in lines if line.startswith('Max '))
+    assert limits['Max processes'][0] == str(sandbox.PROCESSES)
+    assert limits['Max cpu time'][0] == str(sandbox.CPU_SECONDS)
+    assert limits['Max address space'][0] == str(sandbox.ADDRESS_SPACE_BYTES)
     for bad in ('ROOT_VISIBLE', 'HOST_TMP_VISIBLE', 'PACKAGE_WRITABLE', 'GRADER_SECRET', 'EXAM_LAB'):
         assert bad not in output
