@@ -112,14 +112,14 @@ def _make_cgroups(name):
                                                   ('pids', 'pids.max', PROCESSES)):
                 root, path = own[controller]
                 folder = os.path.join(root, path.lstrip('/'), name)
-                os.mkdir(folder)
+                _fresh_folder(folder)
                 made.append(folder)
                 with open(os.path.join(folder, limit_file), 'w') as f:
                     f.write(str(value))
         elif '' in own:
             root, path = own['']
             folder = os.path.join(root, path.lstrip('/'), name)
-            os.mkdir(folder)
+            _fresh_folder(folder)
             made.append(folder)
             for limit_file, value in (('memory.max', MEMORY_BYTES), ('pids.max', PROCESSES)):
                 with open(os.path.join(folder, limit_file), 'w') as f:
@@ -128,6 +128,15 @@ def _make_cgroups(name):
     except OSError:
         _remove_cgroups(made)
         return []
+
+
+def _fresh_folder(folder):
+    """mkdir, after removing an empty one a crashed grader left (its slot's lock was released)."""
+    try:
+        os.mkdir(folder)
+    except FileExistsError:
+        os.rmdir(folder)
+        os.mkdir(folder)
 
 
 def _remove_cgroups(folders):
