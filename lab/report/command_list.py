@@ -101,17 +101,31 @@ SUBMARINE_ALONE = [
 DIVE_RECORD = Command('dive.record', 'rosbag record -O dive.bag ' + DIVE_TOPICS, None)
 DIVE_LAUNCH = Command('dive.launch', 'roslaunch exam exam_submarine.launch', None)
 DIVE_LIVE = [
-    Command('dive.rosnode_info_exam', 'rosnode info /exam', 15),
     Command('dive.echo_depth', 'rostopic echo -n 3 /depth', 15),
     Command('dive.hz_depth', 'timeout -s INT 3 rostopic hz /depth', 15),
     Command('dive.param_threshold', 'rosparam get /exam/threshold', 15),
 ]
 
+# --- both sheets, questions 10 to 14: the simple answer (docs/simple_answer/exam), built in question
+# 1's workspace and run beside ours, each sheet on a master of its own, recorded for its LED changes ---
+SIMPLE_RECORD = Command('simple.record', 'rosbag record -O simple.bag /temperature /pressure /altitude /alt_warn_led',
+                        None)
+SIMPLE_LAUNCH = Command('simple.launch', 'roslaunch exam exam.launch', None)
+SIMPLE_LIVE = [
+    Command('simple.hz_altitude', 'timeout -s INT 3 rostopic hz /altitude', 15),
+    Command('simple.param_threshold', 'rosparam get /exam/threshold', 15),
+]
+SIMPLE_DIVE_RECORD = Command('simple_dive.record', 'rosbag record -O simple_dive.bag /pressure_robot '
+                             '/pressure_remote /depth /depth_warn_led', None)
+SIMPLE_DIVE_LAUNCH = Command('simple_dive.launch', 'roslaunch exam exam_submarine.launch', None)
+SIMPLE_DIVE_LIVE = [Command('simple_dive.param_threshold', 'rosparam get /exam/threshold', 15)]
+
 #: Processes started in the background (their console is kept; they are stopped with SIGINT).
 BACKGROUND = [MYDRONE_NODE, FLIGHT_RECORD, FLIGHT_LAUNCH, CUSTOM_RECORD, CUSTOM_LAUNCH,
-              SUBMARINE_NODE, DIVE_RECORD, DIVE_LAUNCH]
+              SUBMARINE_NODE, DIVE_RECORD, DIVE_LAUNCH, SIMPLE_RECORD, SIMPLE_LAUNCH, SIMPLE_DIVE_RECORD,
+              SIMPLE_DIVE_LAUNCH]
 #: Commands run to completion, output captured.
 FOREGROUND = ([CATKIN_MAKE] + MYDRONE_ALONE + [CREATE_PKG, BAD_LAUNCH] + FLIGHT_LIVE + CUSTOM_LIVE
-              + SUBMARINE_ALONE + DIVE_LIVE)
+              + SIMPLE_LIVE + SUBMARINE_ALONE + DIVE_LIVE + SIMPLE_DIVE_LIVE)
 ALL = BACKGROUND + FOREGROUND
 BY_KEY = {command.key: command for command in ALL}
