@@ -183,7 +183,6 @@ def dive(run, run_seconds, student_env):
     simple_bag, simple_launch, _ = recorded_run(run, simple, command_list.SIMPLE_DIVE_RECORD,
                                                 command_list.SIMPLE_DIVE_LAUNCH, '/depth', '/depth_warn_led')
     run.run_all(master.env, command_list.DIVE_LIVE)
-    run.run_all(simple.env, command_list.SIMPLE_DIVE_LIVE)
     time.sleep(max(0.0, started + run_seconds - time.time()))
     run.stop([bag, simple_bag, launch, simple_launch],
              [command_list.DIVE_RECORD, command_list.SIMPLE_DIVE_RECORD, command_list.DIVE_LAUNCH,

@@ -59,9 +59,10 @@ BAD_LAUNCH = Command('flight.bad_launch', 'roslaunch exam exam.launch threshold:
 
 # --- sheet 000, questions 10 to 14: the exam node with the drone, one full default flight -----------
 FLIGHT_RECORD = Command('flight.record', 'rosbag record -O flight.bag ' + FLIGHT_TOPICS, None)
-#: Shown up to the exam node's first decision: roslaunch's summary, the processes, the nodes' start.
+#: Shown from roslaunch's server to the exam node's first decision: the summary, the processes, the
+#: nodes' start (the log folder and disk check before it are left out).
 FLIGHT_LAUNCH = Command('flight.launch', 'roslaunch exam exam.launch', None,
-                        show_until=r'\]: altitude -?[0-9.]+ m at or below')
+                        show_from=r'^started roslaunch server', show_until=r'\]: altitude -?[0-9.]+ m at or below')
 FLIGHT_LIVE = [
     Command('flight.rosnode_list', 'rosnode list', 15),
     Command('flight.rosnode_info_exam', 'rosnode info /exam', 15),
@@ -118,7 +119,6 @@ SIMPLE_LIVE = [
 SIMPLE_DIVE_RECORD = Command('simple_dive.record', 'rosbag record -O simple_dive.bag /pressure_robot '
                              '/pressure_remote /depth /depth_warn_led', None)
 SIMPLE_DIVE_LAUNCH = Command('simple_dive.launch', 'roslaunch exam exam_submarine.launch', None)
-SIMPLE_DIVE_LIVE = [Command('simple_dive.param_threshold', 'rosparam get /exam/threshold', 15)]
 
 #: Processes started in the background (their console is kept; they are stopped with SIGINT).
 BACKGROUND = [MYDRONE_NODE, FLIGHT_RECORD, FLIGHT_LAUNCH, CUSTOM_RECORD, CUSTOM_LAUNCH,
@@ -126,6 +126,6 @@ BACKGROUND = [MYDRONE_NODE, FLIGHT_RECORD, FLIGHT_LAUNCH, CUSTOM_RECORD, CUSTOM_
               SIMPLE_DIVE_LAUNCH]
 #: Commands run to completion, output captured.
 FOREGROUND = ([CATKIN_MAKE] + MYDRONE_ALONE + [CREATE_PKG, BAD_LAUNCH] + FLIGHT_LIVE + CUSTOM_LIVE
-              + SIMPLE_LIVE + SUBMARINE_ALONE + DIVE_LIVE + SIMPLE_DIVE_LIVE)
+              + SIMPLE_LIVE + SUBMARINE_ALONE + DIVE_LIVE)
 ALL = BACKGROUND + FOREGROUND
 BY_KEY = {command.key: command for command in ALL}

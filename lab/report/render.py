@@ -60,6 +60,14 @@ def console_lines(text, pattern):
     return [line for line in clean(text).splitlines() if re.search(pattern, line)]
 
 
+def logged_threshold(console):
+    """The threshold the simple answer logs at start (``threshold 150.0 m``)."""
+    found = re.search(r'\]: threshold (-?[0-9.]+) m$', clean(console), re.M)
+    if not found:
+        raise RuntimeError('the simple answer logged no threshold:\n' + console[-2000:])
+    return float(found.group(1))
+
+
 def param_value(outputs, key):
     """The number ``rosparam get`` printed."""
     return float(outputs[key]['output'].strip())
@@ -99,10 +107,14 @@ def shown(command, output):
     return '\n'.join(lines)
 
 
-def run_facts(work, outputs, name, bag, inputs, compute, output, truth, led, threshold_key, delay):
-    """analysis.summarise of one recorded run, with its origin at the roslaunch start."""
+def run_facts(work, outputs, name, bag, inputs, compute, output, truth, led, threshold, delay):
+    """analysis.summarise of one recorded run, with its origin at the roslaunch start.
+
+    :param threshold: the run's threshold, or the key of the ``rosparam get`` that read it.
+    """
     series = analysis.read_bag(os.path.join(work, bag))
-    threshold = param_value(outputs, threshold_key)
+    if isinstance(threshold, str):
+        threshold = param_value(outputs, threshold)
     origin = outputs[name]['started']
     summary = analysis.summarise(series, inputs, compute, output, truth, led, threshold, delay, origin)
     summary['threshold'] = threshold
@@ -127,8 +139,8 @@ def facts(work, repo, outputs):
                        'simple.param_threshold', delay)
     simple_dive = run_facts(work, outputs, 'simple_dive.launch', 'simple_dive.bag',
                             ['/pressure_robot', '/pressure_remote'], formulas.depth, '/depth',
-                            '/submarine_drone/true_depth', '/depth_warn_led', 'simple_dive.param_threshold',
-                            delay)
+                            '/submarine_drone/true_depth', '/depth_warn_led',
+                            logged_threshold(outputs['simple_dive.launch']['output']), delay)
     out = os.path.join(repo, 'docs', 'figures')
     os.makedirs(out, exist_ok=True)
     figures.run_figure(os.path.join(out, 'flight.png'), flight, 'mydrone, default flight, exam.launch',
