@@ -34,16 +34,24 @@ def main(argv=None):
         if args.submission:
             record = runner.grade_submission(args.submission, out, args.sheet)
             print(report.table([record]))
+            if record.get('status_reason'):
+                print('%s: %s' % (record['status'], record['status_reason']))
             for line in report.evidence_lines(record):
                 print('  ' + line)
             print('grade.json and grade.md in %s' % out)
         else:
             def progress(record):
-                sys.stdout.write('graded %s: %s/%s (%.0f s)\n' % (record['student'], record['total'],
-                                                                   record['max'], record['seconds']))
+                sys.stdout.write('graded %s: %s/%s, %s (%.0f s)\n' % (record['student'], record['total'],
+                                                                       record['max'], record['status'],
+                                                                       record['seconds']))
                 sys.stdout.flush()
             records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=progress)
             print(report.table(records))
+            waiting = report.needing_the_teacher(records)
+            if waiting:
+                print('\n%d student(s) need the teacher (their points are not a grade yet):' % len(waiting))
+                for line in waiting:
+                    print('  ' + line)
             print('grades.csv and one folder per student in %s' % out)
     except RuntimeError as err:
         sys.stderr.write('grade: %s\n' % err)
