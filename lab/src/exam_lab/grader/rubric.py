@@ -367,8 +367,11 @@ def score_q14b(sheet, session):
     if not short_judged:
         notes.append('short excursion: %s (0/1)' % _leg_words(probe, 'short_up'))
     else:
-        notes.append('%.1f s excursion%s: %s (%s/1)' % (
+        back = _reached(probe, 'short_down') - schedule['short_down']
+        notes.append('%.1f s excursion%s%s: %s (%s/1)' % (
             schedule['short_down'] - schedule['short_up'], _lag(probe, 'short_up'),
+            ' (the node\'s own value stayed above %.1f s longer: it did not follow its inputs)' % back
+            if back > LAG_S else '',
             'no WARNING' if short_ok else 'WARNING %.2f s after it began' % (short[0][0] - schedule['short_up']),
             1 if short_ok else 0))
     if not normal_judged:
