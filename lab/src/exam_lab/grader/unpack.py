@@ -408,6 +408,9 @@ def open_submission(path, scratch, notes, fixes=None, budget=None):
         root = path
     found = _search(root, scratch, notes, fixes, budget, counter, 0, seen)
     if not found:
+        refused = [s for s in seen if '(refused: ' in s or 'cannot be opened' in s]
+        if refused:  # the reason is the archive that could not be opened, not a missing package
+            raise UnpackError(_listed(refused))
         raise UnpackError('no catkin package (package.xml) in %s%s' % (
             os.path.basename(path), '; found: %s' % _listed(seen) if seen else ' (it is empty)'))
     chosen = found[0]
@@ -443,13 +446,13 @@ def _search(root, scratch, notes, fixes, budget, counter, depth, seen):
             words = what_it_is(archive)
             notes.append('%s cannot be opened: it is %s; the grader opens zip and tar archives'
                          % (shown_name(rel), words or 'not a readable archive'))
-            seen.append('%s (%s)' % (shown_name(rel), words or 'unreadable'))
+            seen.append('%s cannot be opened: it is %s' % (shown_name(rel), words or 'not a readable archive'))
             continue
         try:
             inner = _unpack_one(archive, scratch, notes, fixes, budget, counter)
         except UnpackError as err:
             notes.append('%s refused: %s' % (shown_name(rel), err))
-            seen.append('%s (refused: %s)' % (shown_name(rel), err))
+            seen.append('%s (refused: %s)' % (rel, err))
             continue
         got = _search(inner, scratch, notes, fixes, budget, counter, depth + 1, seen)
         if not got:
