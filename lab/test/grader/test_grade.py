@@ -178,7 +178,8 @@ def test_what_the_teacher_reads_of_each_status(graded):
     with open(os.path.join(str(out), 'refused_upload', 'grade.md')) as f:
         text = f.read()
     assert '**Status: not graded**' in text and 'Graded by running the package' not in text
-    assert 'launch files: none' not in text
+    assert 'launch files: none' not in text and 'no threshold parameter' not in text
+    assert 'ran as' not in text, 'nothing of the student ran'
     with open(os.path.join(str(out), 'python2_prints', 'grade.md')) as f:
         assert '**Status: needs a hand grade** - Python 2 code' in f.read()
     late = [i for i in records['late_warning']['items'] if i['id'] == 'Q13'][0]['evidence']

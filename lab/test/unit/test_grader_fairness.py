@@ -178,6 +178,8 @@ def test_reports_say_the_status():
     text = report.markdown(record)
     assert '**Status: not graded** - refused: x' in text
     assert 'Graded by running the package' not in text and 'launch files: none' not in text
+    assert 'no threshold parameter' not in text and 'did not build' not in text
+    assert text.count('the upload was refused') == 4 and text.count('the package was not read') == 2
     assert report.needing_the_teacher([record, dict(record, student='Bob', status='graded')]) == [
         'Ann: not graded - refused: x']
     assert record['status'] == 'not graded' and record['status_reason'] == 'refused: x'

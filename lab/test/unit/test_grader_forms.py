@@ -102,6 +102,23 @@ def test_a_whole_workspace_gives_its_package(tmp_path):
                      "followed; the grader makes its own workspace)"]
 
 
+def test_a_whole_workspace_zipped_on_linux_keeps_its_package(tmp_path):
+    """zip -r catkin_ws.zip catkin_ws: catkin's link is a Unix symlink entry; dropped, not refused."""
+    with zipfile.ZipFile(str(tmp_path / 'ws.zip'), 'w') as zf:
+        zf.writestr('catkin_ws/src/exam/package.xml', PACKAGE_XML % 'exam')
+        zf.writestr('catkin_ws/devel/setup.sh', 'x')
+        info = zipfile.ZipInfo('catkin_ws/src/CMakeLists.txt')
+        info.create_system = 3
+        info.external_attr = (stat.S_IFLNK | 0o777) << 16
+        zf.writestr(info, '/opt/ros/noetic/share/catkin/cmake/toplevel.cmake')
+    notes, fixes = [], []
+    found = unpack.open_submission(str(tmp_path / 'ws.zip'), str(tmp_path / 'scratch'), notes, fixes)
+    assert found.endswith(os.path.join('catkin_ws', 'src', 'exam'))
+    assert not os.path.lexists(os.path.join(os.path.dirname(found), 'CMakeLists.txt'))
+    assert len(fixes) == 1 and "catkin's link 'catkin_ws/src/CMakeLists.txt' dropped" in fixes[0]
+    assert 'a whole catkin workspace was uploaded: graded its package catkin_ws/src/exam' in notes
+
+
 def test_a_package_however_named(tmp_path):
     archive = windows_zip(tmp_path / 'a.zip', [('catkin_ws/src/mydrone/package.xml', PACKAGE_XML % 'mydrone'),
                                                ('catkin_ws/src/exam_pkg/package.xml', PACKAGE_XML % 'exam_pkg')])

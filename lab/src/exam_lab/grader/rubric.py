@@ -69,7 +69,12 @@ def stayed_up(session):
 
 
 def _not_run(session):
-    build = (session or {}).get('build') or {}
+    session = session or {}
+    build = session.get('build')
+    if session.get('refused'):
+        return 'not measured: the upload was refused (see runs)'
+    if build is None:
+        return 'not measured: nothing was run (see runs)'
     if build.get('status') != 0:
         return 'not measured: the package did not build (see runs)'
     return 'not measured: the node did not run (see runs)'
@@ -302,6 +307,8 @@ def score_q13(sheet, session):
 
 def score_q14a(sheet, static, session):
     threshold = static.get('threshold')
+    if static.get('launch_files') is None:
+        return item('Q14a', 0, 'not judged: the package was not read (see runs)')
     if threshold is None:
         return item('Q14a', 0, static.get('threshold_reason', 'no threshold parameter in the launch file'))
     name = threshold['name']

@@ -292,10 +292,11 @@ def hints(static, session, notes, pkg, isolate, user=None):
             out.append('%s run, odd lines in the log: %s' % (run['tag'], ' | '.join(odd[:4])))
     if static and static.get('launch') and static['launch']['file'] and len(static.get('launch_files', [])) > 1:
         out.append('launch file graded: %s (of %s)' % (static['launch']['file'], ', '.join(static['launch_files'])))
-    out.append('ran in a network namespace with only loopback' if isolate else
-               'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
-    out.append('ran as user %s' % pwd.getpwuid(user[0]).pw_name if user is not None else
-               'ran as the grading user %s (as root the grader runs it as nobody)' % pwd.getpwuid(os.geteuid()).pw_name)
+    if (session or {}).get('build') is not None:  # something of the student's ran
+        out.append('ran in a network namespace with only loopback' if isolate else
+                   'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
+        out.append('ran as user %s' % pwd.getpwuid(user[0]).pw_name if user is not None else
+                   'ran as the grading user %s (as root the grader runs it as nobody)' % pwd.getpwuid(os.geteuid()).pw_name)
     out.append('not scored by the machine: %s' % report.NOT_SCORED)
     return out
 

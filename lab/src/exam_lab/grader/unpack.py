@@ -419,8 +419,7 @@ def open_submission(path, scratch, notes, fixes=None, budget=None):
         fixes.append('the package is named %s, not %s (question 9 asks for %s): graded as it is'
                      % (shown_name(name or '?'), PACKAGE, PACKAGE))
     parent = os.path.dirname(chosen)
-    if os.path.basename(parent) == 'src' and any(os.path.isdir(os.path.join(parent, s)) for s in SIMULATORS) \
-            or os.path.basename(parent) == 'src' and os.path.exists(os.path.join(os.path.dirname(parent), 'devel')):
+    if os.path.basename(parent) == 'src':
         notes.append('a whole catkin workspace was uploaded: graded its package %s' % _shown(chosen, scratch, path))
     if len(found) > 1:
         notes.append('several candidate packages found; graded %s, ignored %s'
@@ -481,9 +480,12 @@ def _archives_in(folder):
 
 
 def _shown(path, *bases):
+    """``path`` as the teacher knows it: inside the upload, not inside the grader's scratch folder."""
     for base in bases:
         if path.startswith(base):
-            return os.path.relpath(path, base)
+            rel = os.path.relpath(path, base)
+            first = rel.split(os.sep, 1)
+            return first[1] if len(first) == 2 and first[0].startswith('unpacked') else rel
     return path
 
 
