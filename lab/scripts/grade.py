@@ -11,7 +11,7 @@ import argparse
 import os
 import sys
 
-from exam_lab.grader import report, runner
+from exam_lab.grader import report, runner, unpack
 from exam_lab.grader.sheets import SHEETS
 
 
@@ -55,6 +55,9 @@ def main(argv=None):
             print('grades.csv and one folder per student in %s' % out)
     except RuntimeError as err:
         sys.stderr.write('grade: %s\n' % err)
+        return 1
+    except unpack.UnpackError as err:  # the class archive itself (one student's upload never gets here)
+        sys.stderr.write('grade: the class archive cannot be opened safely: %s\n' % err)
         return 1
     return 0
 
