@@ -139,6 +139,7 @@ def test_status_of_each_case():
     python2 = dict(STATIC, python2=['scripts/exam_node.py:3: print statement'])
     status, reason = rubric.status(python2, crashed)
     assert status == rubric.HAND_GRADE and reason.startswith('Python 2 code (scripts/exam_node.py:3: print statement)')
+    assert rubric.status(python2, measured()) == (rubric.GRADED, ''), 'an unused Python 2 file does not stop a node'
     assert set(rubric.STATUSES) == {'graded', 'graded with fixes', 'needs a hand grade', 'not graded'}
 
 

@@ -433,9 +433,8 @@ def status(static, session, fixes=()):
     if build is None and not session.get('no_node'):
         return NOT_GRADED, _one_line(session.get('error', 'the submission could not be graded'))
     python2 = static.get('python2') or []
-    if python2:
-        return HAND_GRADE, _one_line('Python 2 code (%s): it cannot start under ROS Noetic\'s Python 3; '
-                                     'read its algorithm by hand' % ', '.join(python2[:3]))
+    python2_words = 'Python 2 code (%s): it cannot start under ROS Noetic\'s Python 3; read its algorithm by hand' \
+        % ', '.join(python2[:3])
     if build is None:
         return HAND_GRADE, _one_line(session.get('error', 'nothing to run'))
     if build.get('status') != 0:
@@ -444,6 +443,8 @@ def status(static, session, fixes=()):
     runs = session.get('runs', [])
     tails = '\n'.join(r.get('launch', {}).get('tail', '') for r in runs)
     if not node_ran(session) or not stayed_up(session):
+        if python2:
+            return HAND_GRADE, _one_line(python2_words)
         crash = crash_summary(tails)
         return HAND_GRADE, _one_line('the node %s%s' % ('does not start' if not node_ran(session) else 'died',
                                                           ': %s' % crash if crash else ' (see runs)'))
