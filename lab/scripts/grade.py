@@ -11,7 +11,7 @@ import argparse
 import os
 import sys
 
-from exam_lab.grader import report, runner
+from exam_lab.grader import report, runner, unpack
 from exam_lab.grader.sheets import SHEETS
 
 
@@ -34,19 +34,30 @@ def main(argv=None):
         if args.submission:
             record = runner.grade_submission(args.submission, out, args.sheet)
             print(report.table([record]))
+            if record.get('status_reason'):
+                print('%s: %s' % (record['status'], record['status_reason']))
             for line in report.evidence_lines(record):
                 print('  ' + line)
             print('grade.json and grade.md in %s' % out)
         else:
             def progress(record):
-                sys.stdout.write('graded %s: %s/%s (%.0f s)\n' % (record['student'], record['total'],
-                                                                   record['max'], record['seconds']))
+                sys.stdout.write('graded %s: %s/%s, %s (%.0f s)\n' % (record['student'], record['total'],
+                                                                       record['max'], record['status'],
+                                                                       record['seconds']))
                 sys.stdout.flush()
             records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=progress)
             print(report.table(records))
+            waiting = report.needing_the_teacher(records)
+            if waiting:
+                print('\n%d student(s) need the teacher (their points are not a grade yet):' % len(waiting))
+                for line in waiting:
+                    print('  ' + line)
             print('grades.csv and one folder per student in %s' % out)
     except RuntimeError as err:
         sys.stderr.write('grade: %s\n' % err)
+        return 1
+    except unpack.UnpackError as err:  # the class archive itself (one student's upload never gets here)
+        sys.stderr.write('grade: the class archive cannot be opened safely: %s\n' % err)
         return 1
     return 0
 

@@ -27,15 +27,15 @@ import time
 import traceback
 
 from exam_lab.grader import launch, report, rubric, source, unpack
-from exam_lab.grader.sheets import DELAY, PACKAGE, SHEETS
+from exam_lab.grader.sheets import DELAY, LATE_WARNING_S, PACKAGE, SHEETS
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
 #: Time limits, s: the student's catkin_make, the node's start (to registering with the master),
-#: the probe of one run, the whole session of one submission.
+#: the probe of one run (a late WARNING is waited for up to LATE_WARNING_S), the whole session.
 BUILD_TIMEOUT = 180.0
 START_TIMEOUT = 20.0
-RUN_TIMEOUT = 90.0
-SESSION_TIMEOUT = 420.0
+RUN_TIMEOUT = 90.0 + LATE_WARNING_S
+SESSION_TIMEOUT = 420.0 + 2 * LATE_WARNING_S
 #: The simulator packages of the underlay.
 SIMULATORS = ('drone_sim', 'mydrone', 'submarinedrone')
 
@@ -150,24 +150,31 @@ def margin_of(threshold):
     return max(0.1 * abs(threshold), 10.0)
 
 
-def prepare(submission, work, wanted_sheet, notes):
+def prepare(submission, work, wanted_sheet, notes, fixes=None):
     """Unpack and read a submission; write the workspace, the derived launch files and the job.
+    ``fixes`` receives what the grader changed in what the student uploaded (``notes`` when None).
 
     :returns: ``(sheet, static, job)``; ``job`` is None when nothing can be run (no node script).
     """
-    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes)
+    fixes = notes if fixes is None else fixes
+    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes, fixes)
+    name = unpack.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
     workspace = os.path.join(work, 'ws')
-    pkg = os.path.join(workspace, 'src', PACKAGE)
-    unpack.copy_package(pkg_source, pkg, notes)
-    analyses = [launch.analyse(path, pkg) for path in launch.launch_files(pkg)]
+    pkg = os.path.join(workspace, 'src', name if re.match(r'^[A-Za-z][\w-]*$', name) else PACKAGE)
+    unpack.copy_package(pkg_source, pkg, fixes)
+    fixes.extend(source.fix_text(pkg))
+    analyses = [launch.analyse(path, pkg, name) for path in launch.launch_files(pkg)]
     sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
     notes.insert(0, how)
     chosen = launch.choose(analyses, sheet)
     scripts = source.node_scripts(pkg)
     launched = [n.type for n in chosen.exam_nodes] if chosen else [os.path.basename(p) for p in scripts[:1]]
-    notes.extend(source.make_runnable(pkg, launched))
-    static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses],
+    fixes.extend(source.make_runnable(pkg, launched))
+    static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses], 'package': name,
+              'package_dir': pkg, 'python2': source.python2_evidence(pkg),
               'params_in_code': source.param_names(pkg), 'launch': None, 'threshold': None}
+    if static['python2']:
+        notes.append('Python 2 code, which ROS Noetic cannot run: %s' % ', '.join(static['python2']))
     for analysis in analyses:
         for problem in analysis.problems:
             notes.append('launch: %s' % problem)
@@ -176,8 +183,8 @@ def prepare(submission, work, wanted_sheet, notes):
     if chosen is not None:
         exam = chosen.exam_nodes[0]
         static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),
-                            'exam_type': exam.type, 'exam_name': exam.name,
-                            'exam_type_found': _executable_in(pkg, exam.type)}
+                            'exam_type': exam.type, 'exam_name': exam.name, 'package': name,
+                            'comments': chosen.comments(), 'exam_type_found': _executable_in(pkg, exam.type)}
         param, why = launch.threshold_param(chosen, sheet)
         static['threshold_reason'] = why
         if param is not None:
@@ -196,12 +203,13 @@ def prepare(submission, work, wanted_sheet, notes):
         main_launch = os.path.join(pkg, '.grader-main-minimal.launch')
         with open(main_launch, 'w') as f:
             f.write('<launch><node pkg="%s" type="%s" name="exam" output="screen"/></launch>\n'
-                    % (PACKAGE, os.path.basename(scripts[0])))
+                    % (name, os.path.basename(scripts[0])))
         namespace = '/'
         param = None
     margin = margin_of(threshold_value)
     plan = {'kind': 'main', 'sheet': sheet, 'threshold': threshold_value, 'margin': margin, 'delay': DELAY,
-            'start_timeout': START_TIMEOUT, 'output': SHEETS[sheet].output}
+            'start_timeout': START_TIMEOUT, 'output': SHEETS[sheet].output,
+            'late_warning': LATE_WARNING_S if source.calls_a_service(pkg) else 0.0}
     runs.append({'tag': 'main', 'launch': main_launch, 'plan': plan})
     if param is not None and param.origin is not None:
         lowered = threshold_value - 2 * margin
@@ -284,10 +292,11 @@ def hints(static, session, notes, pkg, isolate, user=None):
             out.append('%s run, odd lines in the log: %s' % (run['tag'], ' | '.join(odd[:4])))
     if static and static.get('launch') and static['launch']['file'] and len(static.get('launch_files', [])) > 1:
         out.append('launch file graded: %s (of %s)' % (static['launch']['file'], ', '.join(static['launch_files'])))
-    out.append('ran in a network namespace with only loopback' if isolate else
-               'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
-    out.append('ran as user %s' % pwd.getpwuid(user[0]).pw_name if user is not None else
-               'ran as the grading user %s (as root the grader runs it as nobody)' % pwd.getpwuid(os.geteuid()).pw_name)
+    if (session or {}).get('build') is not None:  # something of the student's ran
+        out.append('ran in a network namespace with only loopback' if isolate else
+                   'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
+        out.append('ran as user %s' % pwd.getpwuid(user[0]).pw_name if user is not None else
+                   'ran as the grading user %s (as root the grader runs it as nobody)' % pwd.getpwuid(os.geteuid()).pw_name)
     out.append('not scored by the machine: %s' % report.NOT_SCORED)
     return out
 
@@ -302,24 +311,27 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     # In the system's temp folder (any user can reach it), not under OUT (which may be private).
     work = tempfile.mkdtemp(prefix='exam-grade-')
     user = unprivileged_user(underlay)
-    notes, static, session, chosen_sheet, pkg = [], {}, None, sheet, None
+    notes, fixes, static, session, chosen_sheet, pkg = [], [], {}, None, sheet, None
     try:
         try:
-            chosen_sheet, static, job = prepare(submission, work, sheet, notes)
-            pkg = os.path.join(work, 'ws', 'src', PACKAGE)
+            chosen_sheet, static, job = prepare(submission, work, sheet, notes, fixes)
+            pkg = static['package_dir']
             if job is None:
-                session = {'build': None, 'runs': [], 'error': 'no script of the package starts a ROS node'}
+                session = {'build': None, 'runs': [], 'no_node': True,
+                           'error': 'no script of the package starts a ROS node'}
             else:
                 session = run_session(job, work, underlay, isolate, user)
         except unpack.UnpackError as err:
-            session = {'build': None, 'runs': [], 'error': 'submission refused: %s' % err}
+            session = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % err}
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
             session = {'build': None, 'runs': [], 'error': 'the grader failed on this submission: %r' % err}
             notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
         chosen_sheet = chosen_sheet or 'altitude'
         items = rubric.score(chosen_sheet, static, session)
-        record = report.grade_record(student, chosen_sheet, items, hints(static, session, notes, pkg, isolate, user),
-                                     {'seconds': round(time.monotonic() - start, 1)})
+        record = report.grade_record(student, chosen_sheet, items,
+                                     hints(static, session, notes + fixes, pkg, isolate, user),
+                                     {'seconds': round(time.monotonic() - start, 1)},
+                                     rubric.status(static, session, fixes))
         logs = os.path.join(out_dir, 'logs')
         shutil.rmtree(logs, ignore_errors=True)
         if os.path.isdir(os.path.join(work, 'logs')):
