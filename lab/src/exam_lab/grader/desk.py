@@ -9,13 +9,16 @@ reports handed in (listed with their page count, never graded).
 import json
 import os
 import re
+import shutil
 import zlib
 
-from exam_lab.grader import flightplot, gradescope, moodle, page
+from exam_lab.grader import flightplot, gradescope, moodle, page, similarity, unpack
 
 #: Bytes of a PDF read to count its pages, and most bytes one of its streams may inflate to.
 PDF_READ_BYTES = 50 * 1024 * 1024
 PDF_STREAM_BYTES = 5 * 1024 * 1024
+#: A page tree node's dictionary (no nested dictionary in it): its /Count is the pages below it.
+_PAGE_TREE = re.compile(rb'<<((?:(?!<<|>>).)*?/Type\s*/Pages\b(?:(?!<<|>>).)*)>>', re.S)
 #: PDFs listed per submission, and how deep in its folder they are looked for.
 MAX_DOCUMENTS = 10
 MAX_DEPTH = 3
@@ -43,8 +46,8 @@ def pdf_pages(path):
             continue
     counts, pages = [], 0
     for text in texts:
-        if re.search(rb'/Type\s*/Pages\b', text):
-            counts += [int(n) for n in re.findall(rb'/Count\s+(\d+)', text)]
+        for tree in _PAGE_TREE.findall(text):
+            counts += [int(n) for n in re.findall(rb'/Count\s+(\d+)', tree)]
         pages += len(re.findall(rb'/Type\s*/Page(?![A-Za-z])', text))
     if counts:
         return max(counts)
@@ -75,6 +78,21 @@ def submission_facts(path):
     folder's name, or None), ``folder`` (that name), ``documents`` (the PDFs handed in)."""
     name = os.path.basename(os.path.abspath(path).rstrip('/'))
     return {'participant': moodle.participant_number(name), 'folder': name, 'documents': documents(path)}
+
+
+def class_similarity(klass, out, records):
+    """The similarity check over a class's submissions (unpacked anew, as the runner did), each
+    named as its grade record names it; ``{"error"}`` when it could not run (the grades stand)."""
+    scratch = os.path.join(out, '.similarity-class')
+    try:
+        by_folder = {r.get('folder'): r['student'] for r in records}
+        submissions = [(by_folder.get(os.path.basename(folder), name), folder)
+                       for name, folder in unpack.list_students(klass, scratch)]
+        return similarity.check(submissions, out)
+    except Exception as err:  # a bug of the check must not cost the class its page
+        return {'error': repr(err)}
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
 
 
 def _grade_md(folder, record):
