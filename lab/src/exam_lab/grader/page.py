@@ -172,6 +172,7 @@ def render(records, title, entries, pairs=None, notes=None):
     else:
         parts.append('<p>Nobody: every submission was graded by the machine.</p>')
     if notes:
+        parts.append('<h2 id="notes">Moodle worksheet and checks</h2>')
         parts.append('<ul>%s</ul>' % ''.join('<li>%s</li>' % _e(n) for n in notes))
     parts.append('<h2 id="histogram">Totals</h2>')
     parts.append(histogram_svg(totals, maximum))
