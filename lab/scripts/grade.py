@@ -15,7 +15,7 @@ import argparse
 import os
 import sys
 
-from exam_lab.grader import desk, progress, report, runner
+from exam_lab.grader import desk, documents, progress, report, runner
 from exam_lab.grader.sheets import SHEETS
 
 
@@ -39,7 +39,7 @@ def main(argv=None):
     try:
         if args.submission:
             record = runner.grade_submission(args.submission, out, args.sheet, on_step=progress.StepProgress(),
-                                             extra=desk.submission_facts(args.submission))
+                                             extra=documents.submission_facts(args.submission))
             print(report.table([record]))
             for line in report.evidence_lines(record):
                 print('  ' + line)

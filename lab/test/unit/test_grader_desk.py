@@ -10,7 +10,7 @@ from html.parser import HTMLParser
 
 import pytest
 
-from exam_lab.grader import desk, flightplot, gradescope, page, progress, report
+from exam_lab.grader import desk, documents, flightplot, gradescope, page, progress, report
 from exam_lab.grader.sheets import ITEMS
 
 T0 = 1000.0
@@ -182,12 +182,12 @@ def test_pdf_pages(tmp_path):
             figure = plt.figure()
             pdf.savefig(figure)
             plt.close(figure)
-    assert desk.pdf_pages(path) == 3
+    assert documents.pdf_pages(path) == 3
     (tmp_path / 'fake.pdf').write_bytes(b'not a pdf')
-    assert desk.pdf_pages(str(tmp_path / 'fake.pdf')) is None
-    found = desk.documents(str(tmp_path))
+    assert documents.pdf_pages(str(tmp_path / 'fake.pdf')) is None
+    found = documents.documents(str(tmp_path))
     assert found == [{'name': 'fake.pdf', 'pages': None}, {'name': 'report.pdf', 'pages': 3}]
-    facts = desk.submission_facts(str(tmp_path))
+    facts = documents.submission_facts(str(tmp_path))
     assert facts['participant'] is None and len(facts['documents']) == 2
 
 

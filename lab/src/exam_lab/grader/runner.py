@@ -26,7 +26,7 @@ import threading
 import time
 import traceback
 
-from exam_lab.grader import desk, launch, progress, report, rubric, source, unpack
+from exam_lab.grader import documents, launch, progress, report, rubric, source, unpack
 from exam_lab.grader.sheets import DELAY, PACKAGE, SHEETS
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
@@ -298,7 +298,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
 
     :param on_step: called with each step's name as it starts (unpack, build, main flight...).
-    :param extra: added to the record (:func:`exam_lab.grader.desk.submission_facts`).
+    :param extra: added to the record (:func:`exam_lab.grader.documents.submission_facts`).
     """
     start = time.monotonic()
     student = student or unpack.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
@@ -376,7 +376,7 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
                 progress.started(name)
             record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
                                       on_step=(lambda step: progress.step(name, step)) if progress else None,
-                                      extra=desk.submission_facts(folder))
+                                      extra=documents.submission_facts(folder))
             if progress:
                 progress.finished(record)
             return record
