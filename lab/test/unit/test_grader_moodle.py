@@ -126,6 +126,14 @@ def test_a_malformed_worksheet_is_refused():
         moodle.parse('a,"b\n')
 
 
+def test_the_identifier_column_in_another_language_is_found_by_its_cells():
+    text = WORKSHEET.replace('Identifier', 'Kennung').replace('"Participant ', '"Teilnehmer/in ')
+    _, summary = moodle.fill(text, RECORDS)
+    assert [g[:2] for g in summary['graded']] == [('Jane Doe', 101), ('Paul Martin', 102)]
+    with pytest.raises(moodle.WorksheetError, match='switch it to English'):
+        moodle.fill(WORKSHEET.replace('Grade,', 'Bewertungxyz,', 1), RECORDS)
+
+
 def test_points_above_the_maximum_are_not_written():
     text = WORKSHEET.replace('17.00', '10.00')
     _, summary = moodle.fill(text, RECORDS)

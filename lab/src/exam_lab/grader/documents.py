@@ -8,7 +8,8 @@ import zlib
 
 from exam_lab.grader import moodle
 
-#: Bytes of a PDF read to count its pages, and most bytes one of its streams may inflate to.
+#: Bytes of a PDF read to count its pages (and inflated from its streams, all together), and most
+#: bytes one of its streams may inflate to.
 PDF_READ_BYTES = 50 * 1024 * 1024
 PDF_STREAM_BYTES = 5 * 1024 * 1024
 #: A page tree node's dictionary (no nested dictionary in it): its /Count is the pages below it.
@@ -31,13 +32,16 @@ def pdf_pages(path):
         return None
     if not data.startswith(b'%PDF'):
         return None
-    texts = [data]
+    texts, budget = [data], PDF_READ_BYTES
     for match in re.finditer(rb'stream\r?\n', data):
+        if budget <= 0:
+            break  # a PDF made to inflate without end: its first pages' worth is counted
         try:
             texts.append(zlib.decompressobj().decompress(data[match.end():match.end() + PDF_STREAM_BYTES],
-                                                         PDF_STREAM_BYTES))
+                                                         min(PDF_STREAM_BYTES, budget)))
         except zlib.error:
             continue
+        budget -= len(texts[-1])
     counts, pages = [], 0
     for text in texts:
         for tree in _PAGE_TREE.findall(text):

@@ -118,8 +118,22 @@ def _column(header, names, what):
     for name in names:
         if name in header:
             return header.index(name)
-    raise WorksheetError('no %s column (looked for %s) in the header: %s'
+    raise WorksheetError('no %s column (looked for %s) in the header: %s. Moodle names the columns in the '
+                         'language of its interface: switch it to English and download the worksheet again'
                          % (what, ', '.join(repr(n) for n in names), ', '.join(header)))
+
+
+def _identifier_column(header, rows):
+    """The identifier column by its header, else the one column whose every cell is a word and a
+    number (``Participant 12``, ``Teilnehmer/in 12``) in any language."""
+    try:
+        return _column(header, IDENTIFIER_HEADERS, 'identifier')
+    except WorksheetError:
+        found = [i for i in range(len(header)) if rows and all(
+            len(fields) == len(header) and re.match(r'^\D+\s?\d+$', fields[i][1].strip()) for fields, _ in rows)]
+        if len(found) == 1:
+            return found[0]
+        raise
 
 
 def _feedback_column(header):
@@ -174,7 +188,7 @@ def fill(text, records):
     if not rows:
         raise WorksheetError('the worksheet is empty')
     header = [value.strip() for _, value in rows[0][0]]
-    ident = _column(header, IDENTIFIER_HEADERS, 'identifier')
+    ident = _identifier_column(header, rows[1:])
     grade = _column(header, GRADE_HEADERS, 'grade')
     comments = _feedback_column(header)
     names = next((header.index(n) for n in NAME_HEADERS if n in header), None)
