@@ -91,6 +91,9 @@ def _panel(ax, tag, probe):
         xs = [t for t, _ in oracle] + [end]
         ys = [v for _, v in oracle] + [oracle[-1][1]]
         ax.step(xs, ys, where='post', color='#888888', lw=1.5, label='oracle (equation 1)')
+    if not published:
+        ax.text(0.5, 0.5, 'the node published no value the probe could read', transform=ax.transAxes,
+                ha='center', fontsize=10, color='#b00000')
     if published:
         ax.plot([t for t, _ in published], [v for _, v in published], '.', ms=2.5, color='#1f5fa8',
                 label='published by the node')
