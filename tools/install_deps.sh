@@ -16,6 +16,8 @@ packages=(
   python3-diagnostic-updater python3-diagnostic-msgs
   python3-pytest python3-hypothesis python3-matplotlib
   iproute2
+  # the teacher's page is tested in a headless browser; the similarity check has a venv of its own
+  chromium python3-venv
   "$@"
 )
 

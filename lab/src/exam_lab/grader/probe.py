@@ -160,6 +160,7 @@ class Probe(object):
         self.drone = Drone(self.sheet)
         self.recorder = self.drone.output
         self.t0 = rospy.get_time()
+        self.flown = []  # [time, oracle value] at every input change, for the flight plot's trace
 
     # --- helpers ------------------------------------------------------------------------------------
 
@@ -169,7 +170,9 @@ class Probe(object):
     def set_inputs(self, fixed, moving):
         drone = self.drone
         drone.feeder.set(drone.fixed_topic, fixed)
-        return drone.feeder.set(drone.moving_topic, moving)
+        since = drone.feeder.set(drone.moving_topic, moving)
+        self.flown.append([since, drone.expected(fixed, moving)])
+        return since
 
     def fly(self, x):
         """Put the drone where the oracle's value is ``x`` (reference fixed input); return the time."""
@@ -373,7 +376,24 @@ class Probe(object):
         self.result['graph'] = self.graph.summary()
         self.result['alive_at_end'] = bool(self.graph.student_nodes())
         self.result['t0'] = self.t0
+        self.result['trace'] = trace(self.recorder.samples(self.t0) if self.recorder is not None else [], self.flown)
         return self.result
+
+
+#: The flight plot's trace keeps one published value per this many s (the node's 10 Hz).
+TRACE_PERIOD_S = 0.09
+
+
+def trace(samples, flown, period=TRACE_PERIOD_S):
+    """The flight for the teacher's plot (not for scoring): ``{"published": [[t, value]] at most one
+    sample per ``period`` (non-finite values as None), "oracle": [[t, value]] (the oracle's value from t
+    on)}``, ROS times like the calls and the schedule."""
+    kept, last = [], None
+    for t, v in samples:
+        if last is None or t - last >= period:
+            kept.append([round(t, 3), round(v, 3) if math.isfinite(v) else None])
+            last = t
+    return {'published': kept, 'oracle': [[round(t, 3), round(x, 3)] for t, x in flown]}
 
 
 #: Most seconds the probe keeps the drone up after writing its result, waiting to be stopped.

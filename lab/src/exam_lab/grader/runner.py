@@ -26,7 +26,7 @@ import threading
 import time
 import traceback
 
-from exam_lab.grader import launch, report, rubric, source, unpack
+from exam_lab.grader import documents, launch, progress, report, rubric, source, unpack
 from exam_lab.grader.sheets import DELAY, LATE_WARNING_S, PACKAGE, SHEETS
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
@@ -230,11 +230,12 @@ def _executable_in(pkg, name):
     return False
 
 
-def run_session(job, work, underlay, isolate, user=None):
+def run_session(job, work, underlay, isolate, user=None, on_step=None):
     """Run the session of one submission; return what it measured (or why it could not).
 
     :param isolate: in a network namespace of its own with only loopback (needs root).
     :param user: ``(uid, gid)`` to run it as (root only): the work folder is handed to that user.
+    :param on_step: called with each step's name as the session starts it (:mod:`~exam_lab.grader.progress`).
     """
     log_dir = os.path.join(work, 'logs')
     os.makedirs(log_dir, exist_ok=True)
@@ -251,7 +252,7 @@ def run_session(job, work, underlay, isolate, user=None):
         argv = _as_user(user) + argv
     if isolate:
         argv = ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + argv
-    with Supervisor(os.path.join(work, 'outer')) as sup:
+    with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
         status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT, env=env)
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
     path = os.path.join(log_dir, 'session.json')
@@ -301,8 +302,13 @@ def hints(static, session, notes, pkg, isolate, user=None):
     return out
 
 
-def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False):
-    """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record."""
+def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False,
+                     on_step=None, extra=None):
+    """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
+
+    :param on_step: called with each step's name as it starts (unpack, build, main flight...).
+    :param extra: added to the record (:func:`exam_lab.grader.documents.submission_facts`).
+    """
     start = time.monotonic()
     student = student or unpack.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
     isolate = can_isolate() if isolate is None else isolate
@@ -314,13 +320,14 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     notes, fixes, static, session, chosen_sheet, pkg = [], [], {}, None, sheet, None
     try:
         try:
+            progress.report(on_step, 'unpack')
             chosen_sheet, static, job = prepare(submission, work, sheet, notes, fixes)
             pkg = static['package_dir']
             if job is None:
                 session = {'build': None, 'runs': [], 'no_node': True,
                            'error': 'no script of the package starts a ROS node'}
             else:
-                session = run_session(job, work, underlay, isolate, user)
+                session = run_session(job, work, underlay, isolate, user, on_step)
         except unpack.UnpackError as err:
             session = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % err}
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
@@ -330,7 +337,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
         items = rubric.score(chosen_sheet, static, session)
         record = report.grade_record(student, chosen_sheet, items,
                                      hints(static, session, notes + fixes, pkg, isolate, user),
-                                     {'seconds': round(time.monotonic() - start, 1)},
+                                     dict(extra or {}, seconds=round(time.monotonic() - start, 1)),
                                      rubric.status(static, session, fixes))
         logs = os.path.join(out_dir, 'logs')
         shutil.rmtree(logs, ignore_errors=True)
@@ -354,7 +361,10 @@ def default_underlay():
 
 
 def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=None):
-    """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv."""
+    """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv.
+
+    :param progress: told of the run as it goes (:class:`exam_lab.grader.progress.ClassProgress`).
+    """
     os.makedirs(out_dir, exist_ok=True)
     scratch = tempfile.mkdtemp(prefix='class-', dir=out_dir)
     try:
@@ -369,12 +379,18 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
             seen.add(unique)
             names.append(unique)
         records = [None] * len(students)
+        if progress:
+            progress.begin(names)
 
         def one(index):
             name, folder = names[index], students[index][1]
-            record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate)
             if progress:
-                progress(record)
+                progress.started(name)
+            record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
+                                      on_step=(lambda step: progress.step(name, step)) if progress else None,
+                                      extra=documents.submission_facts(folder))
+            if progress:
+                progress.finished(record)
             return record
 
         with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
