@@ -19,6 +19,7 @@ help:
 	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
 	@echo "make mutation       mutation testing of the nodes' code against its tests (about 30 min)"
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
+	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv>]"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
 
@@ -51,10 +52,12 @@ mutation: build
 	@lab/mutation/run.sh
 
 # make grade SUBMISSION=<dir or zip> | CLASS=<dir or zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]
+#            [WORKSHEET=<Moodle's offline grading worksheet, filled into OUT>]
 grade: build
 	@$(ENV) && exec python3 lab/scripts/grade.py \
 	  $(if $(SUBMISSION),--submission "$(SUBMISSION)") $(if $(CLASS),--class "$(CLASS)") \
-	  $(if $(SHEET),--sheet "$(SHEET)") $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)")
+	  $(if $(SHEET),--sheet "$(SHEET)") $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)") \
+	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)")
 
 clean:
 	rm -rf .ws

@@ -16,6 +16,8 @@ packages=(
   python3-diagnostic-updater python3-diagnostic-msgs
   python3-pytest python3-hypothesis python3-matplotlib
   iproute2 bubblewrap
+  # the teacher's page is tested in a headless browser; the similarity check has a venv of its own
+  chromium python3-venv
   "$@"
 )
 
@@ -32,6 +34,10 @@ if [ "$(id -u)" -ne 0 ]; then
   command -v sudo >/dev/null || { echo "install_deps: not root and no sudo; install: ${missing[*]}" >&2; exit 1; }
   sudo="sudo"
 fi
-echo "install_deps: installing ${missing[*]}"
-$sudo apt-get update -qq
-DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+# A first install takes minutes: say what and why, and let apt show its own progress (each download,
+# each package unpacked and set up) rather than minutes of silence.
+echo "install_deps: ${#missing[@]} Debian packages missing, installing them with apt-get (a first install"
+echo "install_deps: of ROS takes a few minutes): ${missing[*]}"
+$sudo apt-get update
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends "${missing[@]}"
+echo "install_deps: done"

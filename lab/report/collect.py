@@ -5,16 +5,18 @@ Usage: collect.py --work DIR --run-dir DIR [--run-seconds S]
 
 The order follows the exam sheets:
 
-1. ``catkin_make`` in a scratch workspace whose src/ links to this repository's packages (question 1),
-   with no workspace of ours on CMAKE_PREFIX_PATH, as on a student's machine.
+1. ``catkin_make`` in a scratch workspace as a student has it (question 1): src/ links to the drones'
+   packages (and drone_sim, which they share) and to the simple answer, docs/simple_answer/exam, with
+   no workspace of ours on CMAKE_PREFIX_PATH.
 2. A master; ``rosrun mydrone mydrone_node.py`` alone; questions 4 to 8, the warning service by hand,
    and question 10's first step (a node that only logs what it receives).
 3. ``catkin_create_pkg`` in a scratch folder (question 9); a launch with a bad threshold (question 12).
 4. The full default flight: ``rosbag record`` then ``roslaunch exam exam.launch`` for one profile loop;
    meanwhile the commands of questions 10 to 14. At the same time, on a second master, the same flight
-   with ``threshold:=1200 delay:=3`` (question 14), recorded too.
+   with ``threshold:=1200 delay:=3`` (question 14), and on a third the simple answer's launch, in
+   question 1's workspace; both recorded too.
 5. The same for the underwater drone on a fresh master: questions 4 to 8 and 10's first step, then one
-   full dive.
+   full dive, with the simple answer's dive beside it on a master of its own.
 
 Everything is bounded in time, and every process started is ended on the way out: the harness's
 supervisor runs them all, with their consoles in ``--run-dir`` (report.sh's trap ends them by that
@@ -29,11 +31,13 @@ import shlex
 import sys
 import time
 
-from exam_lab.harness.supervisor import Supervisor
+from exam_lab.harness.supervisor import Supervisor, workspace_env
 from exam_lab.harness.wait import wait_until
 
 import command_list
 
+#: The packages of question 1's workspace, as a student has them: the drones and their exam package.
+STUDENT_PACKAGES = ['drone_sim', 'mydrone', 'submarinedrone', 'docs/simple_answer/exam']
 #: Seconds of one recorded run: the default profiles loop in 100 s; the rest is start-up margin.
 DEFAULT_RUN_SECONDS = 106.0
 
@@ -105,13 +109,15 @@ def recorded_run(run, master, record, launch, output_topic, bag_topic):
 
 
 def catkin_make(run):
-    """Question 1: build this repository's packages in a fresh workspace, as a student builds theirs."""
+    """Question 1: build a student's workspace (the drones and the simple answer) in a fresh folder.
+
+    :returns: that workspace's environment (its devel/setup.bash sourced), to run the simple answer in.
+    """
     repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     workspace = os.path.join(run.supervisor.log_dir, 'catkin_ws')
     os.makedirs(os.path.join(workspace, 'src'))
-    for manifest in sorted(glob.glob(os.path.join(repo, '*', 'package.xml'))):
-        package = os.path.dirname(manifest)
-        os.symlink(package, os.path.join(workspace, 'src', os.path.basename(package)))
+    for package in STUDENT_PACKAGES:
+        os.symlink(os.path.join(repo, package), os.path.join(workspace, 'src', os.path.basename(package)))
     # As in a student's first build from a shell: no workspace of ours as an underlay, and none of the
     # variables `make report` hands its children (make would print every directory it enters).
     # catkin_make takes the workspace from PWD, which a shell's cd would set.
@@ -119,9 +125,17 @@ def catkin_make(run):
            if name not in ('CMAKE_PREFIX_PATH', 'MAKEFLAGS', 'MFLAGS', 'MAKELEVEL')}
     env['PWD'] = workspace
     run.run_all(env, [command_list.CATKIN_MAKE], cwd=workspace)
+    return workspace_env(os.path.join(workspace, 'devel', 'setup.bash'), base=run.supervisor.env)
 
 
-def flight(run, run_seconds):
+def student_master(run, name, student_env):
+    """A master whose commands run in the student's workspace (its ``exam`` is the simple answer)."""
+    master = run.supervisor.start_master(name)
+    master.env = dict(student_env, ROS_MASTER_URI=master.uri)
+    return master
+
+
+def flight(run, run_seconds, student_env):
     master = run.supervisor.start_master('flight.master')
     log('mydrone alone on %s' % master.uri)
     node_alone(run, master, command_list.MYDRONE_NODE, '/temperature', command_list.MYDRONE_ALONE)
@@ -142,18 +156,22 @@ def flight(run, run_seconds):
                                         command_list.FLIGHT_LAUNCH, '/altitude', '/alt_warn_led')
     custom_bag, custom_launch, _ = recorded_run(run, custom, command_list.CUSTOM_RECORD,
                                                 command_list.CUSTOM_LAUNCH, '/altitude', '/alt_warn_led')
+    simple = student_master(run, 'simple.master', student_env)
+    simple_bag, simple_launch, _ = recorded_run(run, simple, command_list.SIMPLE_RECORD,
+                                                command_list.SIMPLE_LAUNCH, '/altitude', '/alt_warn_led')
     run.run_all(master.env, command_list.FLIGHT_LIVE)
     run.run_all(custom.env, command_list.CUSTOM_LIVE)
+    run.run_all(simple.env, command_list.SIMPLE_LIVE)
     time.sleep(max(0.0, started + run_seconds - time.time()))
     # The bags first, so they end on the running system rather than on its shutdown.
-    run.stop([bag, custom_bag, launch, custom_launch],
+    run.stop([bag, custom_bag, simple_bag, launch, custom_launch, simple_launch],
              [command_list.FLIGHT_RECORD, command_list.FLIGHT_LAUNCH, command_list.CUSTOM_RECORD,
-              command_list.CUSTOM_LAUNCH])
-    run.supervisor.stop(custom.proc)
-    run.supervisor.stop(master.proc)
+              command_list.CUSTOM_LAUNCH, command_list.SIMPLE_RECORD, command_list.SIMPLE_LAUNCH])
+    for one in (simple, custom, master):
+        run.supervisor.stop(one.proc)
 
 
-def dive(run, run_seconds):
+def dive(run, run_seconds, student_env):
     master = run.supervisor.start_master('dive.master')
     log('submarine_drone alone on %s' % master.uri)
     node_alone(run, master, command_list.SUBMARINE_NODE, '/pressure_robot',
@@ -161,9 +179,15 @@ def dive(run, run_seconds):
     log('default dive on %s, %.0f s' % (master.uri, run_seconds))
     bag, launch, started = recorded_run(run, master, command_list.DIVE_RECORD,
                                         command_list.DIVE_LAUNCH, '/depth', '/depth_warn_led')
+    simple = student_master(run, 'simple_dive.master', student_env)
+    simple_bag, simple_launch, _ = recorded_run(run, simple, command_list.SIMPLE_DIVE_RECORD,
+                                                command_list.SIMPLE_DIVE_LAUNCH, '/depth', '/depth_warn_led')
     run.run_all(master.env, command_list.DIVE_LIVE)
     time.sleep(max(0.0, started + run_seconds - time.time()))
-    run.stop([bag, launch], [command_list.DIVE_RECORD, command_list.DIVE_LAUNCH])
+    run.stop([bag, simple_bag, launch, simple_launch],
+             [command_list.DIVE_RECORD, command_list.SIMPLE_DIVE_RECORD, command_list.DIVE_LAUNCH,
+              command_list.SIMPLE_DIVE_LAUNCH])
+    run.supervisor.stop(simple.proc)
     run.supervisor.stop(master.proc)
 
 
@@ -175,14 +199,14 @@ def main():
                         help='length of each recorded flight and dive [s]')
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
-    for name in ('flight.bag', 'flight_1200.bag', 'dive.bag'):
+    for name in ('flight.bag', 'flight_1200.bag', 'dive.bag', 'simple.bag', 'simple_dive.bag'):
         if os.path.exists(os.path.join(args.work, name)):
             os.remove(os.path.join(args.work, name))
     with Supervisor(args.run_dir) as supervisor:
         run = Run(supervisor, args.work)
-        catkin_make(run)
-        flight(run, args.run_seconds)
-        dive(run, args.run_seconds)
+        student_env = catkin_make(run)
+        flight(run, args.run_seconds, student_env)
+        dive(run, args.run_seconds, student_env)
     missing = [c.key for c in command_list.ALL if c.key not in run.results]
     if missing:
         sys.exit('report: commands not run: %s' % ', '.join(missing))

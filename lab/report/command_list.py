@@ -59,9 +59,10 @@ BAD_LAUNCH = Command('flight.bad_launch', 'roslaunch exam exam.launch threshold:
 
 # --- sheet 000, questions 10 to 14: the exam node with the drone, one full default flight -----------
 FLIGHT_RECORD = Command('flight.record', 'rosbag record -O flight.bag ' + FLIGHT_TOPICS, None)
-#: Shown up to the exam node's first decision: roslaunch's summary, the processes, the nodes' start.
+#: Shown from roslaunch's server to the exam node's first decision: the summary, the processes, the
+#: nodes' start (the log folder and disk check before it are left out).
 FLIGHT_LAUNCH = Command('flight.launch', 'roslaunch exam exam.launch', None,
-                        show_until=r'\]: altitude -?[0-9.]+ m at or below')
+                        show_from=r'^started roslaunch server', show_until=r'\]: altitude -?[0-9.]+ m at or below')
 FLIGHT_LIVE = [
     Command('flight.rosnode_list', 'rosnode list', 15),
     Command('flight.rosnode_info_exam', 'rosnode info /exam', 15),
@@ -101,17 +102,30 @@ SUBMARINE_ALONE = [
 DIVE_RECORD = Command('dive.record', 'rosbag record -O dive.bag ' + DIVE_TOPICS, None)
 DIVE_LAUNCH = Command('dive.launch', 'roslaunch exam exam_submarine.launch', None)
 DIVE_LIVE = [
-    Command('dive.rosnode_info_exam', 'rosnode info /exam', 15),
     Command('dive.echo_depth', 'rostopic echo -n 3 /depth', 15),
     Command('dive.hz_depth', 'timeout -s INT 3 rostopic hz /depth', 15),
     Command('dive.param_threshold', 'rosparam get /exam/threshold', 15),
 ]
 
+# --- both sheets, questions 10 to 14: the simple answer (docs/simple_answer/exam), built in question
+# 1's workspace and run beside ours, each sheet on a master of its own, recorded for its LED changes ---
+SIMPLE_RECORD = Command('simple.record', 'rosbag record -O simple.bag /temperature /pressure /altitude /alt_warn_led',
+                        None)
+SIMPLE_LAUNCH = Command('simple.launch', 'roslaunch exam exam.launch', None)
+SIMPLE_LIVE = [
+    Command('simple.hz_altitude', 'timeout -s INT 3 rostopic hz /altitude', 15),
+    Command('simple.param_threshold', 'rosparam get /exam/threshold', 15),
+]
+SIMPLE_DIVE_RECORD = Command('simple_dive.record', 'rosbag record -O simple_dive.bag /pressure_robot '
+                             '/pressure_remote /depth /depth_warn_led', None)
+SIMPLE_DIVE_LAUNCH = Command('simple_dive.launch', 'roslaunch exam exam_submarine.launch', None)
+
 #: Processes started in the background (their console is kept; they are stopped with SIGINT).
 BACKGROUND = [MYDRONE_NODE, FLIGHT_RECORD, FLIGHT_LAUNCH, CUSTOM_RECORD, CUSTOM_LAUNCH,
-              SUBMARINE_NODE, DIVE_RECORD, DIVE_LAUNCH]
+              SUBMARINE_NODE, DIVE_RECORD, DIVE_LAUNCH, SIMPLE_RECORD, SIMPLE_LAUNCH, SIMPLE_DIVE_RECORD,
+              SIMPLE_DIVE_LAUNCH]
 #: Commands run to completion, output captured.
 FOREGROUND = ([CATKIN_MAKE] + MYDRONE_ALONE + [CREATE_PKG, BAD_LAUNCH] + FLIGHT_LIVE + CUSTOM_LIVE
-              + SUBMARINE_ALONE + DIVE_LIVE)
+              + SIMPLE_LIVE + SUBMARINE_ALONE + DIVE_LIVE)
 ALL = BACKGROUND + FOREGROUND
 BY_KEY = {command.key: command for command in ALL}

@@ -16,14 +16,17 @@ def _led_band(ax, changes, end):
     ax.set_ylabel('LED', rotation=0, ha='right', va='center')
 
 
-def run_figure(path, facts, title, quantity, unit, threshold, delay, service, invert=False):
-    """True value, published estimate, threshold, LED state and service-call instants of one run."""
+def run_figure(path, facts, title, quantity, unit, threshold, delay, service, invert=False,
+               xlabel='time since roslaunch [s]'):
+    """True value (when recorded), published estimate, threshold, LED state and service-call instants
+    of one run."""
     end = max(t for t, _ in facts['published'])
     fig, (ax, led) = plt.subplots(2, 1, sharex=True, figsize=(11, 4.0),
                                   gridspec_kw={'height_ratios': [6, 1], 'hspace': 0.08})
     for start, stop, _ in facts['episodes']:
         ax.axvspan(start, end if stop is None else stop, color='#ffcc80', alpha=0.35, lw=0)
-    ax.plot(*zip(*facts['truth']), color='black', lw=1.2, label='true %s (simulator ground truth)' % quantity)
+    if facts['truth']:
+        ax.plot(*zip(*facts['truth']), color='black', lw=1.2, label='true %s (simulator ground truth)' % quantity)
     ax.plot(*zip(*facts['published']), color='#1f77b4', lw=1.0, alpha=0.9,
             label='/%s published by the exam node (10 Hz)' % quantity)
     ax.axhline(threshold, color='#d62728', ls='--', lw=1.0, label='threshold %g %s' % (threshold, unit))
@@ -42,7 +45,7 @@ def run_figure(path, facts, title, quantity, unit, threshold, delay, service, in
     ax.legend(fontsize=7.5, loc='upper left', bbox_to_anchor=(1.01, 1.0), framealpha=0.9)
     ax.grid(alpha=0.3)
     _led_band(led, facts['changes'], end)
-    led.set_xlabel('time since roslaunch [s]')
+    led.set_xlabel(xlabel)
     led.set_xlim(0.0, end)
     fig.savefig(path, dpi=110, bbox_inches='tight')
     plt.close(fig)

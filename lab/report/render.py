@@ -60,6 +60,14 @@ def console_lines(text, pattern):
     return [line for line in clean(text).splitlines() if re.search(pattern, line)]
 
 
+def logged_threshold(console):
+    """The threshold the simple answer logs at start (``threshold 150.0 m``)."""
+    found = re.search(r'\]: threshold (-?[0-9.]+) m$', clean(console), re.M)
+    if not found:
+        raise RuntimeError('the simple answer logged no threshold:\n' + console[-2000:])
+    return float(found.group(1))
+
+
 def param_value(outputs, key):
     """The number ``rosparam get`` printed."""
     return float(outputs[key]['output'].strip())
@@ -99,10 +107,14 @@ def shown(command, output):
     return '\n'.join(lines)
 
 
-def run_facts(work, outputs, name, bag, inputs, compute, output, truth, led, threshold_key, delay):
-    """analysis.summarise of one recorded run, with its origin at the roslaunch start."""
+def run_facts(work, outputs, name, bag, inputs, compute, output, truth, led, threshold, delay):
+    """analysis.summarise of one recorded run, with its origin at the roslaunch start.
+
+    :param threshold: the run's threshold, or the key of the ``rosparam get`` that read it.
+    """
     series = analysis.read_bag(os.path.join(work, bag))
-    threshold = param_value(outputs, threshold_key)
+    if isinstance(threshold, str):
+        threshold = param_value(outputs, threshold)
     origin = outputs[name]['started']
     summary = analysis.summarise(series, inputs, compute, output, truth, led, threshold, delay, origin)
     summary['threshold'] = threshold
@@ -122,6 +134,13 @@ def facts(work, repo, outputs):
     dive = run_facts(work, outputs, 'dive.launch', 'dive.bag', ['/pressure_robot', '/pressure_remote'],
                      formulas.depth, '/depth', '/submarine_drone/true_depth', '/depth_warn_led',
                      'dive.param_threshold', delay)
+    simple = run_facts(work, outputs, 'simple.launch', 'simple.bag', ['/temperature', '/pressure'],
+                       formulas.altitude, '/altitude', '/mydrone/true_altitude', '/alt_warn_led',
+                       'simple.param_threshold', delay)
+    simple_dive = run_facts(work, outputs, 'simple_dive.launch', 'simple_dive.bag',
+                            ['/pressure_robot', '/pressure_remote'], formulas.depth, '/depth',
+                            '/submarine_drone/true_depth', '/depth_warn_led',
+                            logged_threshold(outputs['simple_dive.launch']['output']), delay)
     out = os.path.join(repo, 'docs', 'figures')
     os.makedirs(out, exist_ok=True)
     figures.run_figure(os.path.join(out, 'flight.png'), flight, 'mydrone, default flight, exam.launch',
@@ -139,6 +158,17 @@ def facts(work, repo, outputs):
                                        formulas.depth, '/submarine_drone/true_depth')
 
     v = {}
+    for prefix, run in (('simple', simple), ('simple_dive', simple_dive)):
+        # The simple answer's LED changes, against the same excesses (it is the same seeded flight).
+        if len(run['changes']) < 2 or not run['warning_lag'] or not run['normal_lag']:
+            raise RuntimeError('%s: expected a WARNING and a NORMAL call; got changes %s'
+                               % (prefix, run['changes']))
+        v[prefix + '.calls'] = str(len(run['changes']))
+        v[prefix + '.changes'] = ', '.join('%s at %.1f s' % (c, t) for t, c in run['changes'])
+        v[prefix + '.warning_lag_ms'] = '%.0f' % (1000 * run['warning_lag'][0])
+        v[prefix + '.normal_lag_ms'] = '%.0f' % (1000 * run['normal_lag'][0])
+        v[prefix + '.rate'] = fmt(run['rate'], 2)
+    v['simple.hz'] = fmt(last_rate(outputs['simple.hz_altitude']['output']), 3)
     for prefix, run in (('flight', flight), ('dive', dive)):
         episodes = [e for e in run['episodes'] if e[2] is not None]
         short = [e for e in episodes if e[2] < delay]
@@ -165,6 +195,11 @@ def facts(work, repo, outputs):
         v[prefix + '.rate'] = fmt(run['rate'], 2)
         v[prefix + '.seconds'] = '%.0f' % run['published'][-1][0]
         v[prefix + '.changes'] = ', '.join('%s at %.1f s' % (c, t) for t, c in run['changes'])
+    order = re.findall(r'^-- ~~  - (\S+)', outputs['build.catkin_make']['output'], re.M)
+    if not order:
+        raise RuntimeError('catkin_make printed no package order')
+    v['build.count'] = str(len(order))
+    v['build.order'] = ', '.join('`%s`' % name for name in order)
     started = outputs['flight.launch']['started']
     v['run.date'] = time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime(started))
     v['run.host'] = socket.gethostname()
@@ -175,10 +210,16 @@ def facts(work, repo, outputs):
     v['custom.threshold'] = '%g' % custom['threshold']
     v['custom.delay'] = '%g' % param_value(outputs, 'custom.param_delay')
     v['custom.calls'] = str(len(custom['changes']))
-    v['custom.changes'] = ', '.join('%s at %.1f s' % (c, t) for t, c in custom['changes'])
+    # The 1200 m example on the drone's clock: from its first log line (the flight's time 0), which
+    # comes after roslaunch's own start-up (a few seconds, varying); README and architecture.md use it.
+    first = console_lines(outputs['custom.launch']['output'], r'\]: /mydrone: profile')
+    if not first:
+        raise RuntimeError('custom.launch: no start line of the drone')
+    drone_start = float(re.search(r'\[(\d+\.\d+)\]', first[0]).group(1)) - outputs['custom.launch']['started']
+    v['custom.drone_start'] = fmt(drone_start)
+    v['custom.changes'] = ', '.join('%s at %.1f s' % (c, t - drone_start) for t, c in custom['changes'])
     v['custom.seconds'] = '%.0f' % custom['published'][-1][0]
     custom_episodes = [e for e in custom['episodes'] if e[2] is not None]
-    v['custom.short_start'] = fmt(custom_episodes[0][0])
     v['custom.short_duration'] = fmt(custom_episodes[0][2])
     v['flight.max'] = fmt(max(value for _, value in flight['published']))
     v['flight.true_max'] = fmt(max(value for _, value in flight['truth']))
@@ -216,6 +257,10 @@ def facts(work, repo, outputs):
                                                     r'altitude_warning: ALT WARN'))
     b['dive.drone_log'] = '\n'.join(console_lines(outputs['dive.launch']['output'],
                                                   r'depth_warning: DEPTH WARN'))
+    # The simple answer's own log: its threshold, then each call it made.
+    simple_lines = r'\]: (threshold -?[0-9.]+ m$|(altitude|depth) -?[0-9.]+ m .*: (WARNING|NORMAL)$)'
+    b['simple.log'] = '\n'.join(console_lines(outputs['simple.launch']['output'], simple_lines))
+    b['simple_dive.log'] = '\n'.join(console_lines(outputs['simple_dive.launch']['output'], simple_lines))
     line = 'git ls-files -s -- exam/scripts mydrone/scripts submarinedrone/scripts'
     listed = subprocess.run(shlex.split(line), cwd=repo, stdout=subprocess.PIPE, check=True)
     b['scripts.modes'] = '$ %s\n%s' % (line, listed.stdout.decode().rstrip())

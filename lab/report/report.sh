@@ -23,10 +23,18 @@ if [ "${1:-}" != "--render-only" ]; then
 fi
 /usr/bin/python3 "$repo/lab/report/render.py" --work "$work" --repo "$repo"
 
-# Figures are embedded (self-contained HTML), so the PDF does not depend on the current folder.
+# Figures and CSS are embedded (self-contained HTML), so the PDF does not depend on the current folder.
+# weasyprint reads the HTML from stdin with no base URL (`--base-url ""`), so the links stay as report.md has them,
+# relative (architecture.md, simple_answer/exam): they work from the PDF's place in the repository,
+# where a base URL would turn each into a file:// path of the machine that built it.
 cd "$repo/docs"
 pandoc report.md --from gfm --to html5 --standalone --self-contained --resource-path=. \
   --metadata pagetitle="Model report: the ROS exam, mydrone and submarinedrone" \
-  --css "$repo/lab/report/report.css" --pdf-engine=weasyprint -o report.pdf 2> "$work/pandoc.log" \
+  --css "$repo/lab/report/report.css" 2> "$work/pandoc.log" \
+  | weasyprint --base-url "" - report.pdf 2>> "$work/pandoc.log" \
   || { cat "$work/pandoc.log" >&2; exit 1; }
+if grep -a -q 'URI (file:' report.pdf; then
+  echo "report: docs/report.pdf links to file:// paths of this machine" >&2
+  exit 1
+fi
 echo "report: docs/report.pdf written ($(pdfinfo report.pdf | awk '/^Pages:/ {print $2}') pages)"

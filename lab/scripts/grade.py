@@ -2,7 +2,11 @@
 """Grade a student's exam package, or a class of them, by running it (docs/grading.md).
 
     grade.py --submission DIR_OR_ZIP [--sheet altitude|depth] [--out DIR]
-    grade.py --class DIR_OR_ZIP [--sheet altitude|depth] [--out DIR] [--jobs N]
+    grade.py --class DIR_OR_ZIP [--sheet altitude|depth] [--out DIR] [--jobs N] [--worksheet CSV]
+
+Besides the grades, OUT/index.html (the page for the teacher), each student's results.json
+(Gradescope) and flight.png, for a class the similarity check and, with --worksheet, Moodle's
+offline grading worksheet filled (the teacher's desk: lab/src/exam_lab/grader/desk.py).
 
 Prints the score table; exits 0 whenever grading completed, whatever the scores, and 1 when the
 grader itself could not run (a missing input, the simulators not building, no sandbox: student code
@@ -12,7 +16,7 @@ import argparse
 import os
 import sys
 
-from exam_lab.grader import report, runner
+from exam_lab.grader import desk, documents, progress, report, runner, unpack
 from exam_lab.grader.sheets import SHEETS
 
 
@@ -27,6 +31,8 @@ def main(argv=None):
     parser.add_argument('--unsandboxed-student-code-can-read-and-damage-my-files', dest='unsandboxed',
                         action='store_true', help='grade even where no sandbox can be made (never as root: '
                         'as root the code runs as a user of its own, with limits)')
+    parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV) to fill")
+    parser.add_argument('--no-similarity', action='store_true', help='skip the similarity check (class)')
     args = parser.parse_args(argv)
     target = args.submission or args.klass
     if not os.path.exists(target):
@@ -36,22 +42,39 @@ def main(argv=None):
     out = os.path.abspath(args.out or os.path.join(runner.workspace(), 'grades', name))
     try:
         if args.submission:
-            record = runner.grade_submission(args.submission, out, args.sheet, unsandboxed=args.unsandboxed)
+            record = runner.grade_submission(args.submission, out, args.sheet, on_step=progress.StepProgress(),
+                                             extra=documents.submission_facts(args.submission),
+                                             unsandboxed=args.unsandboxed)
             print(report.table([record]))
+            if record.get('status_reason'):
+                print('%s: %s' % (record['status'], record['status_reason']))
             for line in report.evidence_lines(record):
                 print('  ' + line)
             print('grade.json and grade.md in %s' % out)
+            for line in desk.finish(out, [record], single=True, worksheet=args.worksheet):
+                print(line)
         else:
-            def progress(record):
-                sys.stdout.write('graded %s: %s/%s (%.0f s)\n' % (record['student'], record['total'],
-                                                                   record['max'], record['seconds']))
-                sys.stdout.flush()
-            records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=progress,
-                                         unsandboxed=args.unsandboxed)
+            shown = progress.ClassProgress(args.jobs)
+            try:
+                records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=shown,
+                                             unsandboxed=args.unsandboxed)
+            finally:
+                shown.close()
             print(report.table(records))
+            waiting = report.needing_the_teacher(records)
+            if waiting:
+                print('\n%d student(s) need the teacher (their points are not a grade yet):' % len(waiting))
+                for line in waiting:
+                    print('  ' + line)
             print('grades.csv and one folder per student in %s' % out)
+            for line in desk.finish(out, records, similar=None if args.no_similarity else
+                                    desk.class_similarity(args.klass, out, records), worksheet=args.worksheet):
+                print(line)
     except RuntimeError as err:
         sys.stderr.write('grade: %s\n' % err)
+        return 1
+    except unpack.UnpackError as err:  # the class archive itself (one student's upload never gets here)
+        sys.stderr.write('grade: the class archive cannot be opened safely: %s\n' % err)
         return 1
     return 0
 

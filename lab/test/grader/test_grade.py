@@ -1,11 +1,13 @@
 """The grader end to end: our exam node gets full marks on both sheets; each flawed student package
-loses exactly the points the rubric takes for its flaw. One class run (two students side by side, one
-of them uploaded as a zip) and one submission run; about four minutes on two cores.
+loses exactly the points the rubric takes for its flaw, and each upload form students really produce
+(a Windows zip, a whole workspace as exam.tar.gz, a package named otherwise) costs nothing. One class
+run (two students side by side) and one submission run; about eight minutes on two cores.
 """
 import csv
 import json
 import os
 import shutil
+import tarfile
 import zipfile
 
 import pytest
@@ -29,8 +31,67 @@ EXPECTED = {
     'wrong_topic': {'Q11': 2.5},                       # /profondeur instead of /depth: the publisher's 1.5
     'one_subscriber': {'Q10': 1.0, 'Q11': 2.5},        # no /pressure_remote: one subscriber, values wrong
     'ours': {},
+    # The upload's form, not the student's work: nothing lost.
+    'windows_zip': {},                                 # good_student zipped on Windows: CRLF, backslashes, no modes
+    'workspace_tgz': {'Q14a': 0.0},                    # hard_threshold in a whole catkin_ws, as exam.tar.gz
+    'renamed_package': {'Q12': 0.5},                   # exam_pkg (Q9's business); a launch file without a comment
+    # One mistake, one loss.
+    'late_warning': {'Q14b': 1.5},                     # 500 ticks at 10 Hz: a 50 s delay, only the delay's 1.5
+    'sleep_in_callback': {'Q14b': 2.0},                # sleep(5) in the callback: WARNING after a 3 s excursion
+    'float64_depth': {},                               # /depth as std_msgs/Float64: the sheet names no type
+    'python2_prints': {'runs': 1.0, 'Q10': 0.0, 'Q11': 0.0, 'Q13': 0.0, 'Q14a': 0.0, 'Q14b': 0.0},
+    'refused_upload': {item: 0.0 for item in FULL},    # an entry climbing out of the folder: not graded
 }
-SHEETS = {'wrong_topic': 'depth', 'one_subscriber': 'depth'}
+SHEETS = {'wrong_topic': 'depth', 'one_subscriber': 'depth', 'float64_depth': 'depth'}
+#: Each student's status (graded unless named): what the teacher must do with the grade.
+STATUS = {'no_kelvin': 'graded with fixes', 'windows_zip': 'graded with fixes', 'workspace_tgz': 'graded with fixes',
+          'renamed_package': 'graded with fixes', 'crash_at_start': 'needs a hand grade',
+          'python2_prints': 'needs a hand grade', 'refused_upload': 'not graded'}
+#: The folder in submissions/ each upload is made from, when not its own.
+MADE_FROM = {'windows_zip': 'good_student', 'workspace_tgz': 'hard_threshold', 'refused_upload': 'good_student'}
+
+
+def _files(source):
+    for dirpath, dirnames, filenames in os.walk(source):
+        dirnames[:] = [d for d in dirnames if d != '__pycache__']
+        for filename in filenames:
+            full = os.path.join(dirpath, filename)
+            yield full, os.path.relpath(full, source)
+
+
+def windows_zip(source, path):
+    """The package as Windows' "compressed folder" gives it: CRLF, backslash names, no Unix modes."""
+    with zipfile.ZipFile(path, 'w', zipfile.ZIP_DEFLATED) as zf:
+        for full, rel in _files(source):
+            info = zipfile.ZipInfo('exam\\' + rel.replace('/', '\\'))
+            info.create_system = 0
+            info.external_attr = 0x20
+            with open(full, 'rb') as f:
+                zf.writestr(info, f.read().replace(b'\n', b'\r\n'))
+
+
+def workspace_tgz(source, path, scratch):
+    """A whole catkin_ws after catkin_make: build/, devel/, a drone's package, catkin's link."""
+    ws = os.path.join(scratch, 'catkin_ws')
+    shutil.copytree(source, os.path.join(ws, 'src', 'exam'))
+    os.makedirs(os.path.join(ws, 'src', 'mydrone'))
+    with open(os.path.join(ws, 'src', 'mydrone', 'package.xml'), 'w') as f:
+        f.write('<package format="2"><name>mydrone</name></package>\n')
+    os.symlink('/opt/ros/noetic/share/catkin/cmake/toplevel.cmake', os.path.join(ws, 'src', 'CMakeLists.txt'))
+    for products in ('build/CMakeFiles', 'devel/lib/exam'):
+        os.makedirs(os.path.join(ws, products))
+        with open(os.path.join(ws, products, 'stale'), 'w') as f:
+            f.write('from the student\'s machine\n')
+    with tarfile.open(path, 'w:gz') as tf:
+        tf.add(ws, 'catkin_ws')
+
+
+def refused_zip(source, path):
+    """A zip with an entry that would land outside the folder: refused as a whole."""
+    with zipfile.ZipFile(path, 'w') as zf:
+        for full, rel in _files(source):
+            zf.write(full, os.path.join('exam', rel))
+        zf.writestr('../outside.txt', 'x')
 
 
 @pytest.fixture(scope='module')
@@ -41,8 +102,16 @@ def graded(tmp_path_factory):
     for name in EXPECTED:
         folder = klass / ('%s_%d_assignsubmission_file_' % (name, len(name)))
         folder.mkdir(parents=True)
-        source = OUR_EXAM if name == 'ours' else os.path.join(SUBMISSIONS, name, 'exam')
-        if name == 'good_student':  # uploaded as a zip, next to the report
+        source = OUR_EXAM if name == 'ours' else os.path.join(SUBMISSIONS, MADE_FROM.get(name, name), 'exam')
+        if name == 'windows_zip':
+            windows_zip(source, str(folder / 'exam.zip'))
+        elif name == 'workspace_tgz':
+            workspace_tgz(source, str(folder / 'exam.tar.gz'), str(root / 'ws-scratch'))
+        elif name == 'refused_upload':
+            refused_zip(source, str(folder / 'exam.zip'))
+        elif name == 'renamed_package':
+            shutil.copytree(os.path.join(SUBMISSIONS, name, 'exam_pkg'), str(folder / 'exam_pkg'))
+        elif name == 'good_student':  # uploaded as a zip, next to the report
             (folder / 'report.pdf').write_bytes(b'%PDF-1.4\n')
             with zipfile.ZipFile(str(folder / 'exam.zip'), 'w') as zf:
                 for dirpath, _, filenames in os.walk(source):
@@ -67,6 +136,8 @@ def test_each_package_gets_exactly_its_points(graded, name):
     assert got == wanted, evidence
     assert record['sheet'] == SHEETS.get(name, 'altitude')
     assert record['max'] == 17.0
+    assert record['status'] == STATUS.get(name, 'graded'), record['status_reason']
+    assert (record['status_reason'] == '') == (record['status'] == 'graded')
     for entry in record['items']:
         if entry['points'] < entry['max']:
             assert entry['evidence'], 'every point lost says why'
@@ -86,6 +157,35 @@ def test_class_outputs(graded):
         assert os.path.isfile(os.path.join(str(out), row['student'], 'grade.md'))
     assert any('made executable' in hint for hint in records['no_kelvin']['for_the_teacher'])
     assert any('KeyError' in hint for hint in records['crash_at_start']['for_the_teacher'])
+    assert [r['status'] for r in rows] == [records[r['student']]['status'] for r in rows]
+    assert list(rows[0])[:3] == ['student', 'sheet', 'status']
+
+
+def test_what_the_teacher_reads_of_each_status(graded):
+    out, records = graded
+    crash = records['crash_at_start']['status_reason']
+    assert "the node does not start: KeyError: '~threshold' at exam/scripts/exam_node.py:" in crash, crash
+    python2 = records['python2_prints']['status_reason']
+    assert 'Python 2 code (scripts/exam_node.py:19: print statement)' in python2, python2
+    windows = ' '.join(records['windows_zip']['for_the_teacher'])
+    assert 'Windows line endings (CRLF) changed to LF' in windows and 'made executable' in windows
+    workspace = ' '.join(records['workspace_tgz']['for_the_teacher'])
+    assert "catkin's link 'catkin_ws/src/CMakeLists.txt' dropped" in workspace
+    assert 'catkin_ws/build/' in workspace and 'catkin_ws/devel/' in workspace
+    assert "named 'exam_pkg'" in records['renamed_package']['status_reason']
+    refused = records['refused_upload']
+    assert "climbs out of the folder" in refused['status_reason']
+    with open(os.path.join(str(out), 'refused_upload', 'grade.md')) as f:
+        text = f.read()
+    assert '**Status: not graded**' in text and 'Graded by running the package' not in text
+    assert 'launch files: none' not in text and 'no threshold parameter' not in text
+    assert 'ran as' not in text, 'nothing of the student ran'
+    with open(os.path.join(str(out), 'python2_prints', 'grade.md')) as f:
+        assert '**Status: needs a hand grade** - Python 2 code' in f.read()
+    late = [i for i in records['late_warning']['items'] if i['id'] == 'Q13'][0]['evidence']
+    assert 'the WARNING came late' in late, late
+    assert 'std_msgs/Float64, a numeric type' in [i for i in records['float64_depth']['items']
+                                                  if i['id'] == 'Q11'][0]['evidence']
 
 
 def test_our_node_on_the_depth_sheet(tmp_path):

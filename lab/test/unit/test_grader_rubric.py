@@ -37,7 +37,8 @@ def measured(calls=None, rate=10.0, formula_error=0.0, output=('/altitude', 'std
 
 STATIC = {'launch': {'file': 'launch/exam.launch', 'starts_drone': True, 'exam_type': 'exam_node.py',
                      'exam_type_found': True},
-          'threshold': {'name': '/threshold', 'value': 1300}, 'params_in_code': ['threshold']}
+          'threshold': {'name': '/threshold', 'value': 1300}, 'params_in_code': ['threshold'],
+          'launch_files': ['launch/exam.launch']}
 
 
 def points(session, static=STATIC):
@@ -97,7 +98,7 @@ def test_wrong_values_rate_and_topic():
     assert lost(measured(rate=8.9)) == {'Q11': 1.0}
     assert lost(measured(rate=10.9)) == {}
     assert lost(measured(output=('/alt', 'std_msgs/Float32'))) == {'Q11': 1.5}
-    assert lost(measured(output=('/altitude', 'std_msgs/Float64'))) == {'Q11': 1.5}
+    assert lost(measured(output=('/altitude', 'std_msgs/String'))) == {'Q11': 1.5}
     assert lost(measured(output=(None, None))) == {'Q11': 4.0}
 
 

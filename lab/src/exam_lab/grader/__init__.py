@@ -15,4 +15,15 @@ Modules (the pure ones import no rospy and are unit-tested in lab/test/unit):
 - :mod:`~exam_lab.grader.probe` -- (rospy) plays the drone with the harness's fake drone, measures.
 - :mod:`~exam_lab.grader.session` -- builds and runs one submission under the harness's Supervisor.
 - :mod:`~exam_lab.grader.runner` -- one submission or a class: prepare, isolate, score, write.
+
+The teacher's desk, after grading (docs/grading.md, "The teacher's desk"):
+
+- :mod:`~exam_lab.grader.desk` -- writes what follows into OUT after a run.
+- :mod:`~exam_lab.grader.page` -- index.html: the class's table, histogram, who needs the teacher.
+- :mod:`~exam_lab.grader.flightplot` -- each student's flight plot (matplotlib, Agg).
+- :mod:`~exam_lab.grader.moodle` -- Moodle's offline grading worksheet, filled.
+- :mod:`~exam_lab.grader.gradescope` -- Gradescope's results.json.
+- :mod:`~exam_lab.grader.similarity` -- similar submissions (copydetect, in a venv of its own).
+- :mod:`~exam_lab.grader.documents` -- the participant number and the PDF reports of a submission.
+- :mod:`~exam_lab.grader.progress` -- k of n, who is graded now, the time left; a run's steps.
 """

@@ -65,9 +65,11 @@ class Origin(object):
 class Analysis(object):
     """What one top-level launch file (and the files it includes) would start and set."""
 
-    def __init__(self, path, package_dir):
+    def __init__(self, path, package_dir, package=PACKAGE):
         self.path = path
         self.package_dir = package_dir
+        #: The student's package name (``exam`` as asked, or whatever the student named it).
+        self.package = package
         self.nodes = []
         self.params = []
         #: Drone packages started through an ``<include>`` of their own launch files.
@@ -78,7 +80,7 @@ class Analysis(object):
 
     @property
     def exam_nodes(self):
-        return [n for n in self.nodes if n.pkg == PACKAGE]
+        return [n for n in self.nodes if n.pkg == self.package]
 
     def drone_sheets(self):
         """Sheets whose drone this launch starts (by a node or by including the drone's launch file)."""
@@ -100,7 +102,18 @@ class Analysis(object):
 
     def exam_params(self):
         """Parameters the exam node can see: global ones and the exam nodes' private ones."""
-        return [p for p in self.params if p.node is None or p.node.pkg == PACKAGE]
+        return [p for p in self.params if p.node is None or p.node.pkg == self.package]
+
+    def comments(self):
+        """XML comments in the launch file and the package's files it includes (question 12's half)."""
+        count = 0
+        for path in self.trees:
+            try:
+                with open(path, 'rb') as f:
+                    count += f.read().count(b'<!--')
+            except OSError:
+                pass
+        return count
 
 
 def _truth(text):
@@ -142,9 +155,10 @@ def _yaml_value(text):
 class _Scope(object):
     """Args of one launch file: name -> (value, Origin of its literal or None)."""
 
-    def __init__(self, path, package_dir, passed=None):
+    def __init__(self, path, package_dir, passed=None, package=PACKAGE):
         self.path = path
         self.package_dir = package_dir
+        self.package = package
         self.args = {}
         self.passed = passed or {}
 
@@ -167,7 +181,7 @@ class _Scope(object):
                 raise Unsupported('$(arg %s) of an undeclared arg' % ' '.join(rest))
             return str(self.args[rest[0]][0])
         if command == 'find':
-            if rest and rest[0] == PACKAGE:
+            if rest and rest[0] == self.package:
                 return self.package_dir
             return '/__pkg__/%s' % (rest[0] if rest else '')
         if command == 'dirname':
@@ -179,11 +193,12 @@ class _Scope(object):
         raise Unsupported('$(%s ...)' % command)
 
 
-def analyse(path, package_dir):
-    """Analyse the launch file ``path`` of the package in ``package_dir``; never raises for content."""
-    analysis = Analysis(path, package_dir)
+def analyse(path, package_dir, package=PACKAGE):
+    """Analyse the launch file ``path`` of the package ``package`` in ``package_dir``; never raises for
+    content."""
+    analysis = Analysis(path, package_dir, package)
     try:
-        _read_file(analysis, path, _Scope(path, package_dir), '/', depth=0)
+        _read_file(analysis, path, _Scope(path, package_dir, package=package), '/', depth=0)
     except Unsupported as err:
         analysis.problems.append('cannot evaluate %s: %s' % (os.path.relpath(path, package_dir), err))
     return analysis
@@ -323,7 +338,8 @@ def _read_include(analysis, element, scope, ns, depth):
         if child.tag == 'arg' and child.get('value') is not None:
             value, origin = scope.substitute(child.get('value'))
             passed[child.get('name')] = (value, origin or Origin(scope.path, child, 'attr', 'value'))
-    _read_file(analysis, target, _Scope(target, analysis.package_dir, passed), inner_ns, depth + 1)
+    _read_file(analysis, target, _Scope(target, analysis.package_dir, passed, analysis.package), inner_ns,
+               depth + 1)
 
 
 # --- choosing --------------------------------------------------------------------------------------
@@ -448,13 +464,13 @@ def _set_key(data, key, value):
 
 
 def _strip(parent, path, analysis, derived):
-    scope = _Scope(path, analysis.package_dir)
+    scope = _Scope(path, analysis.package_dir, package=analysis.package)
     for element in list(parent):
         if not isinstance(element.tag, str):
             continue
         if element.tag in ('node', 'test'):
             pkg = element.get('pkg', '')
-            if pkg != PACKAGE and '$(arg' not in pkg:
+            if pkg != analysis.package and '$(arg' not in pkg:
                 parent.remove(element)
                 continue
             element.set('output', 'screen')

@@ -10,7 +10,9 @@ measures; the points are given by :mod:`exam_lab.grader.rubric` from the JSON it
 
 Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of question 14a), ``sheet``,
 ``threshold`` (student units), ``margin`` (how far beyond the threshold to fly), ``delay`` (s), ``start_timeout``
-(s to wait for the node); for "threshold" also ``fit`` (the main run's calibration) and ``targets``.
+(s to wait for the node), ``late_warning`` (s a late WARNING is waited for, 0 for none); for
+"threshold" also ``fit`` (the main run's calibration), ``targets`` and ``warn_after`` (s the main
+run's WARNING took).
 
 The main scenario (times are the script's, all recorded as ROS time of the events):
 
@@ -20,7 +22,10 @@ The main scenario (times are the script's, all recorded as ROS time of the event
 3. calibration: from those values, the inputs that make the *node's own* value sit ``margin`` below
    and above the threshold, checked by flying there (a wrong formula costs question 11 only);
 4. the flight: rest below (``REST_S``), a short excursion above (``SHORT_S`` < delay), below again, a long
-   excursion (delay + ``AFTER_S``), below again; every service call is recorded with its arrival time.
+   excursion (delay + ``AFTER_S``, longer for a late WARNING), below again; every service call is
+   recorded with its arrival time. Each leg's hold counts from the node's own first value on its side,
+   and every leg is checked on the node's own values (``legs``): the rubric judges nothing on a leg the
+   node's value did not reach.
 """
 import json
 import math
@@ -30,8 +35,9 @@ import time
 
 import rosgraph
 import rospy
-from std_msgs.msg import Float32, Float64
+from std_msgs import msg as std_msgs
 
+from exam_lab.grader.sheets import LATE_WARNING_S
 from exam_lab.harness import oracle
 from exam_lab.harness.fake_drone import Drone, TopicRecorder
 from exam_lab.harness.wait import wait_until
@@ -49,8 +55,14 @@ REST_S = 3.0
 SHORT_S = 3.0
 GAP_S = 2.5
 AFTER_S = 2.5
-#: Message types the probe can read values from.
-VALUE_TYPES = {'std_msgs/Float32': Float32, 'std_msgs/Float64': Float64}
+#: The most seconds a leg waits for the node's own value to reach the side of the threshold it is
+#: flown for (a node that blocks a callback for 5 s publishes a stale value meanwhile).
+REACH_S = 8.0
+#: After an input change, a value read is waited for until it moved, up to this many s (a stale node).
+STALE_S = 6.0
+#: Message types the probe can read values from: every numeric std_msgs type (the sheet names none).
+NUMERIC_TYPES = ('Float32', 'Float64', 'Int8', 'Int16', 'Int32', 'Int64', 'UInt8', 'UInt16', 'UInt32', 'UInt64')
+VALUE_TYPES = {'std_msgs/%s' % name: getattr(std_msgs, name) for name in NUMERIC_TYPES}
 #: Topics every node has or that are never an answer.
 IGNORED_TOPICS = ('/rosout', '/rosout_agg', '/diagnostics')
 
@@ -104,9 +116,37 @@ def _last_value(recorder, since):
     return (samples[-1][1] if samples else None), len(samples)
 
 
-def _settled(recorder, since):
+def _settled(recorder, since, before=None):
+    """The node's value after an input change at ``since``: read SETTLE_S later; when it is still the
+    ``before`` value, waited for until it moves, up to STALE_S (a node that blocks in a callback)."""
     time.sleep(max(0.0, since + SETTLE_S - rospy.get_time()))
+    if before is not None:
+        wait_until(lambda: _last_value(recorder, since)[0] not in (None, before), STALE_S - SETTLE_S,
+                   period=0.1)
     return _last_value(recorder, since)
+
+
+def on_side(value, threshold, side):
+    """True when ``value`` is on ``side`` ('above': beyond the threshold, 'below': not beyond it)."""
+    if value is None or not math.isfinite(value):
+        return False
+    return value > threshold if side == 'above' else value <= threshold
+
+
+def leg_check(samples, threshold, side, start, end):
+    """Whether the node's own published values were on ``side`` of the threshold during a leg that
+    was flown from ``start`` to ``end``: ``{"side", "reached" (time of the first value on that side,
+    or None), "off_side" (values on the other side after that), "first", "last" (values)}``.
+
+    Judged only on what the node published: a leg whose values never reached the side (a stale
+    reading, a node that does not react) is not one the rubric may judge anything on.
+    """
+    inside = [(t, v) for t, v in samples if start <= t <= end]
+    reached = next((t for t, v in inside if on_side(v, threshold, side)), None)
+    off = len([1 for t, v in inside if reached is not None and t >= reached and not on_side(v, threshold, side)])
+    return {'side': side, 'reached': reached, 'off_side': off,
+            'first': inside[0][1] if inside else None, 'last': inside[-1][1] if inside else None,
+            'samples': len(inside)}
 
 
 class Probe(object):
@@ -120,6 +160,7 @@ class Probe(object):
         self.drone = Drone(self.sheet)
         self.recorder = self.drone.output
         self.t0 = rospy.get_time()
+        self.flown = []  # [time, oracle value] at every input change, for the flight plot's trace
 
     # --- helpers ------------------------------------------------------------------------------------
 
@@ -129,7 +170,9 @@ class Probe(object):
     def set_inputs(self, fixed, moving):
         drone = self.drone
         drone.feeder.set(drone.fixed_topic, fixed)
-        return drone.feeder.set(drone.moving_topic, moving)
+        since = drone.feeder.set(drone.moving_topic, moving)
+        self.flown.append([since, drone.expected(fixed, moving)])
+        return since
 
     def fly(self, x):
         """Put the drone where the oracle's value is ``x`` (reference fixed input); return the time."""
@@ -185,13 +228,15 @@ class Probe(object):
         cases = [(drone.fixed_value, threshold - 2 * margin), (drone.fixed_value, threshold + 2 * margin),
                  (other_fixed, threshold)]
         points, rows = [], []
+        before = None
         for fixed, x in cases:
             if self.sheet == 'altitude':
                 moving = oracle.pressure_at(x, fixed)
             else:
                 moving = oracle.pressure_robot_at(x, fixed)
             since = self.set_inputs(fixed, moving)
-            value, count = _settled(self.recorder, since)
+            value, count = _settled(self.recorder, since, before)
+            before = value
             rows.append({'inputs': {drone.fixed_topic: fixed, drone.moving_topic: moving},
                          'expected': drone.expected(fixed, moving), 'published': value, 'samples': count})
             if fixed == drone.fixed_value:
@@ -225,8 +270,9 @@ class Probe(object):
                 x = (target - b) / a
             value = None
             for _ in range(3):
+                previous = _last_value(self.recorder, 0.0)[0] if self.recorder is not None else None
                 since = self.fly(x)
-                value = _settled(self.recorder, since)[0] if self.recorder is not None else None
+                value = _settled(self.recorder, since, previous)[0] if self.recorder is not None else None
                 if calibration['by'] != 'own' or value is None or not math.isfinite(value) \
                         or abs(value - target) < margin / 3:
                     break
@@ -243,21 +289,35 @@ class Probe(object):
         self.result['calibration'] = calibration
         return chosen['lo']['x'], chosen['hi']['x']
 
+    def leg(self, x, side, hold, late=0.0):
+        """Fly at ``x`` for ``hold`` s counted from the node's own first value on ``side`` (the input's
+        change when the output cannot be read, or when that value never comes within REACH_S); with
+        ``late``, keep flying while no WARNING came, up to ``late`` s. Returns the input's change time."""
+        since = self.fly(x)
+        start = since
+        if self.recorder is not None:
+            threshold = self.plan['threshold']
+            reached = wait_until(lambda: next((t for t, v in self.recorder.samples(since)
+                                               if on_side(v, threshold, side)), None), REACH_S, period=0.05)
+            start = reached if reached is not None else since
+        time.sleep(max(0.0, start + hold - rospy.get_time()))
+        if late > hold:
+            wait_until(lambda: any(t >= since and s == 'WARNING' for t, s in self.drone.service.calls())
+                       or not self.graph.student_nodes(), start + late - rospy.get_time(), period=0.1)
+        return since
+
     def flight(self, lo, hi):
         delay = self.plan['delay']
+        late = self.plan.get('late_warning', 0.0)
         schedule = {}
-        schedule['rest'] = self.fly(lo)
-        time.sleep(REST_S)
-        schedule['short_up'] = self.fly(hi)
-        time.sleep(SHORT_S)
-        schedule['short_down'] = self.fly(lo)
-        time.sleep(GAP_S)
-        schedule['long_up'] = self.fly(hi)
-        time.sleep(delay + AFTER_S)
-        schedule['long_down'] = self.fly(lo)
-        time.sleep(AFTER_S)
+        schedule['rest'] = self.leg(lo, 'below', REST_S)
+        schedule['short_up'] = self.leg(hi, 'above', SHORT_S)
+        schedule['short_down'] = self.leg(lo, 'below', GAP_S)
+        schedule['long_up'] = self.leg(hi, 'above', delay + AFTER_S, late)
+        schedule['long_down'] = self.leg(lo, 'below', AFTER_S)
         schedule['end'] = rospy.get_time()
         self.result['schedule'] = schedule
+        self.result['legs'] = self.legs(schedule, ('rest', 'short_up', 'short_down', 'long_up', 'long_down'))
         if self.recorder is not None:
             samples = self.recorder.samples(schedule['rest'], schedule['end'])
             rate = {'samples': len(samples), 'hz': None, 'max_gap': None}
@@ -269,15 +329,29 @@ class Probe(object):
                 rate['non_finite'] = len([v for v in values if not math.isfinite(v)])
             self.result['rate'] = rate
 
+    def legs(self, schedule, names):
+        """Each leg checked on the node's own values (None when the output cannot be read)."""
+        if self.recorder is None:
+            return None
+        keys = sorted(schedule, key=schedule.get)
+        out = {}
+        for name in names:
+            end = schedule[keys[keys.index(name) + 1]]
+            side = 'above' if name.endswith('up') or name == 'step' else 'below'
+            out[name] = leg_check(self.recorder.samples(schedule[name]), self.plan['threshold'], side,
+                                  schedule[name], end)
+        return out
+
     def threshold_check(self):
         """Question 14a: the node restarted with another threshold; from a value below it, a step to a
-        value that was below the launch file's threshold but is above the new one."""
-        schedule = {'start': self.fly(self.x_of(self.plan['targets']['start']))}
-        time.sleep(REST_S)
-        schedule['step'] = self.fly(self.x_of(self.plan['targets']['step']))
-        time.sleep(self.plan['delay'] + AFTER_S)
+        value that was below the launch file's threshold but is above the new one. A node whose WARNING
+        came late in the main run (``warn_after``) is given that long."""
+        schedule = {'start': self.leg(self.x_of(self.plan['targets']['start']), 'below', REST_S)}
+        hold = max(self.plan['delay'], min(self.plan.get('warn_after') or 0.0, LATE_WARNING_S)) + AFTER_S
+        schedule['step'] = self.leg(self.x_of(self.plan['targets']['step']), 'above', hold)
         schedule['end'] = rospy.get_time()
         self.result['schedule'] = schedule
+        self.result['legs'] = self.legs(schedule, ('start', 'step'))
 
     def x_of(self, value):
         """The oracle value at which the node publishes ``value`` (the main run's fit, if any)."""
@@ -296,12 +370,30 @@ class Probe(object):
         else:
             self.fly(self.x_of(self.plan['targets']['start']))
             if self.wait_for_node():
+                self.find_output()  # the node's own values, to check the legs on
                 self.threshold_check()
         self.result['calls'] = [[t, s] for t, s in self.drone.service.calls()]
         self.result['graph'] = self.graph.summary()
         self.result['alive_at_end'] = bool(self.graph.student_nodes())
         self.result['t0'] = self.t0
+        self.result['trace'] = trace(self.recorder.samples(self.t0) if self.recorder is not None else [], self.flown)
         return self.result
+
+
+#: The flight plot's trace keeps one published value per this many s (the node's 10 Hz).
+TRACE_PERIOD_S = 0.09
+
+
+def trace(samples, flown, period=TRACE_PERIOD_S):
+    """The flight for the teacher's plot (not for scoring): ``{"published": [[t, value]] at most one
+    sample per ``period`` (non-finite values as None), "oracle": [[t, value]] (the oracle's value from t
+    on)}``, ROS times like the calls and the schedule."""
+    kept, last = [], None
+    for t, v in samples:
+        if last is None or t - last >= period:
+            kept.append([round(t, 3), round(v, 3) if math.isfinite(v) else None])
+            last = t
+    return {'published': kept, 'oracle': [[round(t, 3), round(x, 3)] for t, x in flown]}
 
 
 #: Most seconds the probe keeps the drone up after writing its result, waiting to be stopped.

@@ -16,21 +16,35 @@ def _points(x):
     return ('%.1f' % x).rstrip('0').rstrip('.')
 
 
-def grade_record(student, sheet, items, for_the_teacher, extra=None):
-    """The content of grade.json."""
+def grade_record(student, sheet, items, for_the_teacher, extra=None, status=('graded', '')):
+    """The content of grade.json; ``status`` is ``(status, reason)`` (see :func:`rubric.status`)."""
     record = {'student': student, 'sheet': sheet, 'total': sum(i['points'] for i in items),
-              'max': sum(i['max'] for i in items), 'items': items, 'for_the_teacher': for_the_teacher}
+              'max': sum(i['max'] for i in items), 'items': items, 'for_the_teacher': for_the_teacher,
+              'status': status[0], 'status_reason': status[1]}
     record.update(extra or {})
     return record
+
+
+def _status_line(record):
+    status = record.get('status', 'graded')
+    reason = record.get('status_reason', '')
+    return '**Status: %s**%s' % (status, ' - %s' % reason.replace('\n', ' ') if reason else '')
 
 
 def markdown(record):
     """grade.md: the score table, each lost point's reason, the hints for the teacher."""
     sheet = SHEETS.get(record['sheet'])
     title = sheet and 'sheet %s (%s, %s)' % (sheet.seed, sheet.name, sheet.drone_pkg) or 'no sheet'
+    if record.get('status') == 'not graded':
+        how = 'Not graded: the package could not be run, so no point below was measured. %s.' % (
+            'Not scored by the machine either: %s' % NOT_SCORED)
+    else:
+        how = 'Graded by running the package: %s. Not scored by the machine: %s.' % (title, NOT_SCORED)
     lines = ['# %s: %s / %s' % (record['student'], _points(record['total']), _points(record['max'])),
              '',
-             'Graded by running the package: %s. Not scored by the machine: %s.' % (title, NOT_SCORED),
+             _status_line(record),
+             '',
+             how,
              '',
              '| item | what is checked | points | evidence |',
              '|---|---|---|---|']
@@ -62,24 +76,31 @@ def write_csv(path, records):
     """grades.csv: one row per student, each item's points, the total."""
     with open(path, 'w', newline='') as f:
         writer = csv.writer(f)
-        writer.writerow(['student', 'sheet'] + list(ITEMS) + ['total', 'max'])
+        writer.writerow(['student', 'sheet', 'status'] + list(ITEMS) + ['total', 'max'])
         for record in records:
             points = {e['id']: e['points'] for e in record['items']}
-            writer.writerow([record['student'], record['sheet']] +
+            writer.writerow([record['student'], record['sheet'], record.get('status', 'graded')] +
                             [_points(points.get(i, 0)) for i in ITEMS] +
                             [_points(record['total']), _points(record['max'])])
 
 
 def table(records):
     """The score table printed on the terminal: one row per student (one row for one submission)."""
-    header = ['student', 'sheet'] + list(ITEMS) + ['total']
+    header = ['student', 'sheet'] + list(ITEMS) + ['total', 'status']
     rows = [header]
     for record in records:
         points = {e['id']: e['points'] for e in record['items']}
         rows.append([record['student'], record['sheet'] or '-'] + [_points(points.get(i, 0)) for i in ITEMS] +
-                    ['%s/%s' % (_points(record['total']), _points(record['max']))])
+                    ['%s/%s' % (_points(record['total']), _points(record['max'])), record.get('status', '')])
     widths = [max(len(str(r[c])) for r in rows) for c in range(len(header))]
     return '\n'.join('  '.join(str(cell).ljust(w) for cell, w in zip(r, widths)).rstrip() for r in rows)
+
+
+def needing_the_teacher(records):
+    """Lines for the terminal: each student whose grade the teacher must look at, and why (all but
+    'graded' and 'graded with fixes')."""
+    return ['%s: %s - %s' % (r['student'], r.get('status'), r.get('status_reason', ''))
+            for r in records if r.get('status') not in ('graded', 'graded with fixes')]
 
 
 def evidence_lines(record):

@@ -8,6 +8,7 @@ build, the main run and the threshold run, each with the probe's result). Output
 Each tolerance is a constant below; docs/grading.md says why each is what it is.
 """
 import math
+import re
 
 from exam_lab.grader.sheets import DELAY, ITEMS, SHEETS
 
@@ -24,6 +25,20 @@ WARNING_LATE_S = 0.5
 NORMAL_LATE_S = 0.5
 #: Question 13: this many calls repeating the previous status make "called in a loop".
 LOOP_REPEATS = 3
+#: Question 11: the publisher's types accepted on the output topic (the sheets name none).
+NUMERIC_TYPES = tuple('std_msgs/%s' % t for t in ('Float32', 'Float64', 'Int8', 'Int16', 'Int32', 'Int64',
+                                                  'UInt8', 'UInt16', 'UInt32', 'UInt64'))
+#: Question 12: what a launch file without a single comment loses ("la moitie si pas de commentaires").
+NO_COMMENT_LOSS = 0.5
+#: A leg whose node's value reached its side this many s after the input changed is said to lag.
+LAG_S = 0.5
+
+#: Every student's status: what the teacher must do with the grade.
+GRADED = 'graded'
+GRADED_WITH_FIXES = 'graded with fixes'
+HAND_GRADE = 'needs a hand grade'
+NOT_GRADED = 'not graded'
+STATUSES = (GRADED, GRADED_WITH_FIXES, HAND_GRADE, NOT_GRADED)
 
 
 def item(item_id, points, evidence):
@@ -54,7 +69,12 @@ def stayed_up(session):
 
 
 def _not_run(session):
-    build = (session or {}).get('build') or {}
+    session = session or {}
+    build = session.get('build')
+    if session.get('refused'):
+        return 'not measured: the upload was refused (see runs)'
+    if build is None:
+        return 'not measured: nothing was run (see runs)'
     if build.get('status') != 0:
         return 'not measured: the package did not build (see runs)'
     return 'not measured: the node did not run (see runs)'
@@ -122,8 +142,12 @@ def score_q11(sheet, session):
     if output.get('topic') == expected and output.get('type') == 'std_msgs/Float32':
         points += 1.5
         notes.append('publisher: %s std_msgs/Float32 (1.5)' % expected)
+    elif output.get('topic') == expected and output.get('type') in NUMERIC_TYPES:
+        points += 1.5
+        notes.append('publisher: %s %s, a numeric type (the sheet names none: any numeric std_msgs type '
+                     'is accepted) (1.5)' % (expected, output.get('type')))
     elif output.get('topic') == expected:
-        notes.append('publisher: %s is %s, not std_msgs/Float32 (0/1.5)' % (expected, output.get('type')))
+        notes.append('publisher: %s is %s, not a numeric std_msgs type (0/1.5)' % (expected, output.get('type')))
     elif output.get('topic'):
         notes.append('publisher: no %s; it publishes %s (%s) instead, measured there (0/1.5)'
                      % (expected, output['topic'], output.get('type')))
@@ -162,6 +186,8 @@ def score_q11(sheet, session):
 
 def score_q12(sheet, static):
     launch = static.get('launch')
+    if static.get('launch_files') is None:
+        return item('Q12', 0, 'not judged: the package was not read (see runs)')
     if launch is None:
         return item('Q12', 0, 'no launch file in the package starts an exam node (launch files: %s)'
                     % (', '.join(static.get('launch_files', [])) or 'none'))
@@ -169,15 +195,19 @@ def score_q12(sheet, static):
     has_drone = launch['starts_drone']
     exam_ok = launch['exam_type_found']
     where = launch['file']
+    package = launch.get('package', 'exam')
+    commented = launch.get('comments', 1) > 0
+    comment_note = '' if commented else '; but not a single comment in it (-%g: half, as the notes say)' % NO_COMMENT_LOSS
     if has_drone and exam_ok:
-        return item('Q12', 1, '%s starts %s/%s and exam/%s' % (where, drone.drone_pkg, drone.drone_type,
-                                                               launch['exam_type']))
+        return item('Q12', 1 - (0 if commented else NO_COMMENT_LOSS), '%s starts %s/%s and %s/%s%s' % (
+            where, drone.drone_pkg, drone.drone_type, package, launch['exam_type'], comment_note))
     notes = []
     if not has_drone:
         notes.append('does not start the drone (%s/%s)' % (drone.drone_pkg, drone.drone_type))
     if not exam_ok:
-        notes.append('starts exam/%s, which is no executable of the package' % launch['exam_type'])
-    return item('Q12', 0.5, '%s starts an exam node but %s' % (where, ' and '.join(notes)))
+        notes.append('starts %s/%s, which is no executable of the package' % (package, launch['exam_type']))
+    return item('Q12', 0.5 - (0 if commented else NO_COMMENT_LOSS), '%s starts an exam node but %s%s'
+                % (where, ' and '.join(notes), comment_note))
 
 
 def _calls_between(probe, start, end, status=None):
@@ -204,27 +234,67 @@ def _driven_by(probe):
         calibration.get('reason', ''))
 
 
+#: The legs of the flights, in words.
+LEG_WORDS = {'rest': 'rest below', 'short_up': 'short excursion above', 'short_down': 'gap below',
+             'long_up': 'long excursion above', 'long_down': 'return below', 'start': 'start below',
+             'step': 'step above the new threshold'}
+
+
+def unreached_legs(probe, names=None):
+    """Legs of a flight whose node's own value never reached the side they were flown for."""
+    legs = (probe or {}).get('legs') or {}
+    return [n for n in (names or sorted(legs)) if n in legs and legs[n].get('reached') is None]
+
+
+def _leg_words(probe, name):
+    leg = probe['legs'][name]
+    shown = 'nothing' if leg.get('first') is None else '%.1f to %.1f' % (leg['first'], leg['last'])
+    return ('not judged: in the %s the node\'s own value never went %s the threshold %g (it published %s), '
+            'so nothing is judged on that leg' % (LEG_WORDS.get(name, name), leg['side'],
+                                                  probe.get('threshold', float('nan')), shown))
+
+
+def _reached(probe, name):
+    """When the node's own value reached the leg's side (the input's change when it cannot be read)."""
+    leg = ((probe or {}).get('legs') or {}).get(name) or {}
+    return leg.get('reached') or probe['schedule'][name]
+
+
+def _lag(probe, name):
+    lag = _reached(probe, name) - probe['schedule'][name]
+    return (' (the node\'s own value followed %.1f s after the input)' % lag) if lag > LAG_S else ''
+
+
 def score_q13(sheet, session):
     probe = main_probe(session)
     schedule = _flight(probe)
     if not node_ran(session) or schedule is None:
         return item('Q13', 0, _not_run(session))
+    if unreached_legs(probe, ['long_up']):
+        return item('Q13', 0, '%s (%s)' % (_leg_words(probe, 'long_up'), _driven_by(probe)))
     service = SHEETS[sheet].service
     up = _calls_between(probe, schedule['long_up'], schedule['long_down'], 'WARNING')
+    down_judged = not unreached_legs(probe, ['long_down'])
     down = _calls_between(probe, schedule['long_down'], schedule['end'], 'NORMAL') if up else []
     repeats = _repeats(probe, schedule['rest'])
     total = len(_calls_between(probe, schedule['rest'], schedule['end']))
     looped = repeats >= LOOP_REPEATS
-    if up and down:
+    above = schedule['long_down'] - _reached(probe, 'long_up')
+    if up and down and down_judged:
         points = 4.0
         evidence = 'WARNING while above, NORMAL once back below'
     elif up:
         points = 2.0
-        evidence = 'WARNING while above, but no NORMAL within %.1f s back below' % (schedule['end'] - schedule['long_down'])
+        evidence = 'WARNING while above, but %s' % (
+            'no NORMAL within %.1f s back below' % (schedule['end'] - schedule['long_down']) if down_judged
+            else _leg_words(probe, 'long_down'))
     else:
         points = 0.0
-        evidence = 'no WARNING call on %s while the value stayed above the threshold for %.1f s' % (
-            service, schedule['long_down'] - schedule['long_up'])
+        evidence = 'no WARNING call on %s while the node\'s own value stayed above the threshold for %.1f s' % (
+            service, above)
+    if up and up[0][0] - schedule['long_up'] > probe.get('delay', DELAY) + WARNING_LATE_S:
+        evidence += ' (the WARNING came late, %.1f s after the value went above: the flight waited for it)' % (
+            up[0][0] - schedule['long_up'])
     if looped:
         points /= 2
         evidence += '; but called in a loop: %d calls in %.0f s of flight, %d repeating the previous status' % (
@@ -237,6 +307,8 @@ def score_q13(sheet, session):
 
 def score_q14a(sheet, static, session):
     threshold = static.get('threshold')
+    if static.get('launch_files') is None:
+        return item('Q14a', 0, 'not judged: the package was not read (see runs)')
     if threshold is None:
         return item('Q14a', 0, static.get('threshold_reason', 'no threshold parameter in the launch file'))
     name = threshold['name']
@@ -257,6 +329,9 @@ def score_q14a(sheet, static, session):
     schedule = probe2.get('schedule') or {}
     if 'step' not in schedule:
         return item('Q14a', 0, 'with %s = %g the node did not run' % (name, probe2['threshold']))
+    if unreached_legs(probe2, ['step']):
+        return item('Q14a', static_points, 'parameter %s = %s; set to %g: %s; judged from the code: %s' % (
+            name, threshold['value'], probe2['threshold'], _leg_words(probe2, 'step'), static_note))
     warned = _calls_between(probe2, schedule['step'], schedule['end'], 'WARNING')
     main = main_probe(session)
     lo = (main.get('calibration') or {}).get('lo', {})
@@ -276,27 +351,39 @@ def score_q14b(sheet, session):
     schedule = _flight(probe)
     if not node_ran(session) or schedule is None:
         return item('Q14b', 0, _not_run(session))
+    if unreached_legs(probe, ['long_up']):
+        return item('Q14b', 0, _leg_words(probe, 'long_up'))
     delay = probe.get('delay', DELAY)
     warnings = _calls_between(probe, schedule['long_up'], schedule['long_down'], 'WARNING')
     if not warnings:
         return item('Q14b', 0, 'no WARNING in %.1f s above the threshold, so no delay to judge'
-                    % (schedule['long_down'] - schedule['long_up']))
+                    % (schedule['long_down'] - _reached(probe, 'long_up')))
     latency = warnings[0][0] - schedule['long_up']
     warn_ok = delay - WARNING_EARLY_S <= latency <= delay + WARNING_LATE_S
+    short_judged = not unreached_legs(probe, ['short_up'])
     short = _calls_between(probe, schedule['short_up'], schedule['long_up'], 'WARNING')
-    short_ok = not short
+    short_ok = short_judged and not short
+    normal_judged = not unreached_legs(probe, ['long_down'])
     normals = _calls_between(probe, schedule['long_down'], schedule['end'], 'NORMAL')
     normal_latency = normals[0][0] - schedule['long_down'] if normals else None
-    normal_ok = normal_latency is not None and normal_latency <= NORMAL_LATE_S
+    normal_ok = normal_judged and normal_latency is not None and normal_latency <= NORMAL_LATE_S
     points = 1.5 * warn_ok + 1.0 * short_ok + (0.5 * normal_ok if (warn_ok or short_ok) else 0.0)
-    notes = ['WARNING %.2f s after the first reading above (%s: %.1f-%.1f s) (%s/1.5)' % (
-        latency, 'ok' if warn_ok else 'outside', delay - WARNING_EARLY_S, delay + WARNING_LATE_S,
-        1.5 if warn_ok else 0)]
-    notes.append('%.1f s excursion: %s (%s/1)' % (
-        schedule['short_down'] - schedule['short_up'],
-        'no WARNING' if short_ok else 'WARNING %.2f s after it began' % (short[0][0] - schedule['short_up']),
-        1 if short_ok else 0))
-    if normal_latency is None:
+    notes = ['WARNING %.2f s after the first reading above%s (%s: %.1f-%.1f s) (%s/1.5)' % (
+        latency, _lag(probe, 'long_up'), 'ok' if warn_ok else 'outside', delay - WARNING_EARLY_S,
+        delay + WARNING_LATE_S, 1.5 if warn_ok else 0)]
+    if not short_judged:
+        notes.append('short excursion: %s (0/1)' % _leg_words(probe, 'short_up'))
+    else:
+        back = _reached(probe, 'short_down') - schedule['short_down']
+        notes.append('%.1f s excursion%s%s: %s (%s/1)' % (
+            schedule['short_down'] - schedule['short_up'], _lag(probe, 'short_up'),
+            ' (the node\'s own value stayed above %.1f s longer: it did not follow its inputs)' % back
+            if back > LAG_S else '',
+            'no WARNING' if short_ok else 'WARNING %.2f s after it began' % (short[0][0] - schedule['short_up']),
+            1 if short_ok else 0))
+    if not normal_judged:
+        notes.append('NORMAL: %s (0/0.5)' % _leg_words(probe, 'long_down'))
+    elif normal_latency is None:
         notes.append('no NORMAL after the return below (0/0.5)')
     else:
         notes.append('NORMAL %.2f s after the first reading back below (%s/0.5%s)' % (
@@ -310,3 +397,68 @@ def score(sheet, static, session):
     return [score_runs(session), score_q10(sheet, session), score_q11(sheet, session),
             score_q12(sheet, static), score_q13(sheet, session), score_q14a(sheet, static, session),
             score_q14b(sheet, session)]
+
+
+_EXCEPTION = re.compile(r'^\s*((?:\w+\.)*\w*(?:Error|Exception|Interrupt|Exit)\b.*)$')
+_FRAME = re.compile(r'File "([^"]+)", line (\d+)')
+
+
+def crash_summary(text):
+    """The last exception line of a log and the last file:line of its traceback that is not
+    Python's or ROS's own ("KeyError: '~threshold' at exam/scripts/exam_node.py:26"), or ''."""
+    lines = (text or '').splitlines()
+    errors = [(i, m.group(1).strip()) for i, m in ((i, _EXCEPTION.match(l)) for i, l in enumerate(lines)) if m]
+    if not errors:
+        return ''
+    index, error = errors[-1]
+    frames = [m for m in (_FRAME.search(l) for l in lines[:index]) if m
+              and not m.group(1).startswith(('/usr/', '/opt/', '<'))]
+    where = ' at %s:%s' % (frames[-1].group(1), frames[-1].group(2)) if frames else ''
+    return '%s%s' % (error[:200], where)
+
+
+def status(static, session, fixes=()):
+    """``(status, reason)``: what the teacher must do with this grade (one of STATUSES; the reason is
+    one line, '' when graded).
+
+    Not graded: the upload was refused or unreadable, or the grader could not run it. Needs a hand
+    grade: the package has no node, does not build, its node does not start or dies (the traceback's
+    last line and file:line; Python 2 named), or a leg of a flight was not reached (nothing judged
+    there). Graded with fixes: the grader made a teacher's fix (each in for_the_teacher).
+    """
+    static, session = static or {}, session or {}
+    build = session.get('build')
+    if session.get('refused'):
+        return NOT_GRADED, _one_line(session.get('error', 'the upload was refused'))
+    if build is None and not session.get('no_node'):
+        return NOT_GRADED, _one_line(session.get('error', 'the submission could not be graded'))
+    python2 = static.get('python2') or []
+    python2_words = 'Python 2 code (%s): it cannot start under ROS Noetic\'s Python 3; read its algorithm by hand' \
+        % ', '.join(python2[:3])
+    if build is None:
+        return HAND_GRADE, _one_line(session.get('error', 'nothing to run'))
+    if build.get('status') != 0:
+        last = [l for l in (build.get('tail') or '').splitlines() if l.strip()]
+        return HAND_GRADE, _one_line('the package does not build%s' % (': %s' % last[-1] if last else ''))
+    runs = session.get('runs', [])
+    tails = '\n'.join(r.get('launch', {}).get('tail', '') for r in runs)
+    if not node_ran(session) or not stayed_up(session):
+        if python2:
+            return HAND_GRADE, _one_line(python2_words)
+        crash = crash_summary(tails)
+        return HAND_GRADE, _one_line('the node %s%s' % ('does not start' if not node_ran(session) else 'died',
+                                                          ': %s' % crash if crash else ' (see runs)'))
+    for run in runs:
+        missed = unreached_legs(run.get('probe'))
+        if missed:
+            return HAND_GRADE, _one_line(
+                'in the %s run the node\'s own value never reached the side of the threshold of its %s: '
+                'nothing judged there, read its code' % (run['tag'], ', '.join(LEG_WORDS.get(m, m) for m in missed)))
+    if fixes:
+        return GRADED_WITH_FIXES, _one_line('; '.join(fixes))
+    return GRADED, ''
+
+
+def _one_line(text, limit=300):
+    text = ' '.join(str(text).split())
+    return text if len(text) <= limit else text[:limit - 3] + '...'

@@ -28,16 +28,16 @@ import threading
 import time
 import traceback
 
-from exam_lab.grader import launch, report, rubric, sandbox, source, unpack
-from exam_lab.grader.sheets import DELAY, PACKAGE, SHEETS
+from exam_lab.grader import documents, launch, progress, report, rubric, sandbox, source, unpack
+from exam_lab.grader.sheets import DELAY, LATE_WARNING_S, PACKAGE, SHEETS
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
 #: Time limits, s: the student's catkin_make, the node's start (to registering with the master),
-#: the probe of one run, the whole session of one submission.
+#: the probe of one run (a late WARNING is waited for up to LATE_WARNING_S), the whole session.
 BUILD_TIMEOUT = 180.0
 START_TIMEOUT = 20.0
-RUN_TIMEOUT = 90.0
-SESSION_TIMEOUT = 420.0
+RUN_TIMEOUT = 90.0 + LATE_WARNING_S
+SESSION_TIMEOUT = 420.0 + 2 * LATE_WARNING_S
 #: The simulator packages of the underlay.
 SIMULATORS = ('drone_sim', 'mydrone', 'submarinedrone')
 
@@ -145,24 +145,31 @@ def margin_of(threshold):
     return max(0.1 * abs(threshold), 10.0)
 
 
-def prepare(submission, work, wanted_sheet, notes):
+def prepare(submission, work, wanted_sheet, notes, fixes=None):
     """Unpack and read a submission; write the workspace, the derived launch files and the job.
+    ``fixes`` receives what the grader changed in what the student uploaded (``notes`` when None).
 
     :returns: ``(sheet, static, job)``; ``job`` is None when nothing can be run (no node script).
     """
-    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes)
+    fixes = notes if fixes is None else fixes
+    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes, fixes)
+    name = unpack.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
     workspace = os.path.join(work, 'ws')
-    pkg = os.path.join(workspace, 'src', PACKAGE)
-    unpack.copy_package(pkg_source, pkg, notes)
-    analyses = [launch.analyse(path, pkg) for path in launch.launch_files(pkg)]
+    pkg = os.path.join(workspace, 'src', name if re.match(r'^[A-Za-z][\w-]*$', name) else PACKAGE)
+    unpack.copy_package(pkg_source, pkg, fixes)
+    fixes.extend(source.fix_text(pkg))
+    analyses = [launch.analyse(path, pkg, name) for path in launch.launch_files(pkg)]
     sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
     notes.insert(0, how)
     chosen = launch.choose(analyses, sheet)
     scripts = source.node_scripts(pkg)
     launched = [n.type for n in chosen.exam_nodes] if chosen else [os.path.basename(p) for p in scripts[:1]]
-    notes.extend(source.make_runnable(pkg, launched))
-    static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses],
+    fixes.extend(source.make_runnable(pkg, launched))
+    static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses], 'package': name,
+              'package_dir': pkg, 'python2': source.python2_evidence(pkg),
               'params_in_code': source.param_names(pkg), 'launch': None, 'threshold': None}
+    if static['python2']:
+        notes.append('Python 2 code, which ROS Noetic cannot run: %s' % ', '.join(static['python2']))
     for analysis in analyses:
         for problem in analysis.problems:
             notes.append('launch: %s' % problem)
@@ -171,8 +178,8 @@ def prepare(submission, work, wanted_sheet, notes):
     if chosen is not None:
         exam = chosen.exam_nodes[0]
         static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),
-                            'exam_type': exam.type, 'exam_name': exam.name,
-                            'exam_type_found': _executable_in(pkg, exam.type)}
+                            'exam_type': exam.type, 'exam_name': exam.name, 'package': name,
+                            'comments': chosen.comments(), 'exam_type_found': _executable_in(pkg, exam.type)}
         param, why = launch.threshold_param(chosen, sheet)
         static['threshold_reason'] = why
         if param is not None:
@@ -191,12 +198,13 @@ def prepare(submission, work, wanted_sheet, notes):
         main_launch = os.path.join(pkg, '.grader-main-minimal.launch')
         with open(main_launch, 'w') as f:
             f.write('<launch><node pkg="%s" type="%s" name="exam" output="screen"/></launch>\n'
-                    % (PACKAGE, os.path.basename(scripts[0])))
+                    % (name, os.path.basename(scripts[0])))
         namespace = '/'
         param = None
     margin = margin_of(threshold_value)
     plan = {'kind': 'main', 'sheet': sheet, 'threshold': threshold_value, 'margin': margin, 'delay': DELAY,
-            'start_timeout': START_TIMEOUT, 'output': SHEETS[sheet].output}
+            'start_timeout': START_TIMEOUT, 'output': SHEETS[sheet].output,
+            'late_warning': LATE_WARNING_S if source.calls_a_service(pkg) else 0.0}
     runs.append({'tag': 'main', 'launch': main_launch, 'plan': plan})
     if param is not None and param.origin is not None:
         lowered = threshold_value - 2 * margin
@@ -217,11 +225,12 @@ def _executable_in(pkg, name):
     return False
 
 
-def run_session(job, work, underlay, isolate, box):
+def run_session(job, work, underlay, isolate, box, on_step=None):
     """Run the session of one submission, its student steps in ``box``; return what it measured (or
     why it could not).
 
     :param isolate: in a network namespace of its own with only loopback (needs root).
+    :param on_step: called with each step's name as the session starts it (:mod:`~exam_lab.grader.progress`).
     """
     log_dir = os.path.join(work, 'logs')
     judge_home = os.path.join(work, 'judge')
@@ -238,7 +247,7 @@ def run_session(job, work, underlay, isolate, box):
     argv = [sys.executable, '-m', 'exam_lab.grader.session', job_path]
     if isolate:
         argv = ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + argv
-    with Supervisor(os.path.join(work, 'outer')) as sup:
+    with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
         status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT, env=dict(os.environ, HOME=judge_home))
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
     survivors = box.end()  # the box's uid: nothing may be left once its PID namespaces are gone
@@ -292,9 +301,10 @@ def hints(static, session, notes, pkg, isolate, how_run=None):
             out.append('%s run, odd lines in the log: %s' % (run['tag'], ' | '.join(odd[:4])))
     if static and static.get('launch') and static['launch']['file'] and len(static.get('launch_files', [])) > 1:
         out.append('launch file graded: %s (of %s)' % (static['launch']['file'], ', '.join(static['launch_files'])))
-    out.append('ran in a network namespace with only loopback' if isolate else
-               'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
-    out.append(how_run or 'not run')
+    if (session or {}).get('build') is not None:  # something of the student's ran
+        out.append('ran in a network namespace with only loopback' if isolate else
+                   'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
+        out.append(how_run or 'not run')
     if (session or {}).get('survivors'):
         out.append('%d processes of the student were still alive after its steps ended: killed'
                    % session['survivors'])
@@ -336,15 +346,17 @@ def _prepare_workspace(work):
 def could_not_grade(student, sheet, why, notes=()):
     """The record of a submission the grader could not grade: every item 0, and why."""
     sheet = sheet or 'altitude'
-    session = {'build': None, 'runs': [], 'error': why}
+    session = {'build': None, 'runs': [], 'error': 'could not grade: %s' % why}
     return report.grade_record(student, sheet, rubric.score(sheet, {}, session),
-                               list(notes) + ['could not grade: %s' % why], {'seconds': 0.0})
+                               list(notes) + [session['error']], {'seconds': 0.0}, rubric.status({}, session))
 
 
 def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False,
-                     unsandboxed=False):
+                     on_step=None, extra=None, unsandboxed=False):
     """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
 
+    :param on_step: called with each step's name as it starts (unpack, build, main flight...).
+    :param extra: added to the record (:func:`exam_lab.grader.documents.submission_facts`).
     :param unsandboxed: run it even where no sandbox can be made (the teacher's flag that names the
         risk); otherwise :class:`~exam_lab.grader.sandbox.SandboxUnavailable` is raised there.
     """
@@ -360,21 +372,23 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     # <work>/ws and <work>/box, and may not list <work>.
     work = tempfile.mkdtemp(prefix='exam-grade-')
     os.chmod(work, 0o711)
-    notes, static, session, chosen_sheet, pkg, how_run = [], {}, None, sheet, None, None
+    notes, fixes, static, session, chosen_sheet, pkg, how_run = [], [], {}, None, sheet, None, None
     try:
         try:
-            chosen_sheet, static, job = prepare(submission, work, sheet, notes)
-            pkg = os.path.join(work, 'ws', 'src', PACKAGE)
+            progress.report(on_step, 'unpack')
+            chosen_sheet, static, job = prepare(submission, work, sheet, notes, fixes)
+            pkg = static['package_dir']
             if job is None:
-                session = {'build': None, 'runs': [], 'error': 'no script of the package starts a ROS node'}
+                session = {'build': None, 'runs': [], 'no_node': True,
+                           'error': 'no script of the package starts a ROS node'}
             else:
                 _prepare_workspace(work)
                 with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None) as box:
                     notes.extend(box.notes)
                     how_run = _how_run(box)
-                    session = run_session(job, work, underlay, isolate, box)
+                    session = run_session(job, work, underlay, isolate, box, on_step)
         except unpack.UnpackError as err:
-            session = {'build': None, 'runs': [], 'error': 'submission refused: %s' % err}
+            session = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % err}
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
             session = {'build': None, 'runs': [], 'error': 'the grader failed on this submission: %r' % err}
             notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
@@ -386,8 +400,10 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             skipped = sandbox.copy_results(os.path.join(work, 'logs'), logs)
             if skipped:
                 notes.append('not copied to logs/ (not a regular file): %s' % ', '.join(skipped))
-        record = report.grade_record(student, chosen_sheet, items, hints(static, session, notes, pkg, isolate, how_run),
-                                     {'seconds': round(time.monotonic() - start, 1)})
+        record = report.grade_record(student, chosen_sheet, items,
+                                     hints(static, session, notes + fixes, pkg, isolate, how_run),
+                                     dict(extra or {}, seconds=round(time.monotonic() - start, 1)),
+                                     rubric.status(static, session, fixes))
         report.write_grade(out_dir, record)
         return record
     finally:
@@ -406,7 +422,10 @@ def default_underlay():
 
 def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=None, unsandboxed=False):
     """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv.
-    One student the grader cannot grade is that student's row ("could not grade"), never the class's."""
+    One student the grader cannot grade is that student's row ("could not grade"), never the class's.
+
+    :param progress: told of the run as it goes (:class:`exam_lab.grader.progress.ClassProgress`).
+    """
     refusal = sandbox_refusal(unsandboxed)
     if refusal:
         raise sandbox.SandboxUnavailable(refusal)
@@ -424,12 +443,17 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
             seen.add(unique)
             names.append(unique)
         records = [None] * len(students)
+        if progress:
+            progress.begin(names)
 
         def one(index):
             name, folder = names[index], students[index][1]
+            if progress:
+                progress.started(name)
             try:
                 record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
-                                          unsandboxed=unsandboxed)
+                                          on_step=(lambda step: progress.step(name, step)) if progress else None,
+                                          extra=documents.submission_facts(folder), unsandboxed=unsandboxed)
             except Exception as err:  # anything: this student's row says so, the class goes on
                 record = could_not_grade(name, sheet, '%r' % err,
                                          ['grader error, please report: %s'
@@ -439,7 +463,7 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
                 except OSError:
                     pass
             if progress:
-                progress(record)
+                progress.finished(record)
             return record
 
         with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:

@@ -105,6 +105,14 @@ def probe_problem(result, plan, started, finished):
     return None
 
 
+def warning_latency(probe):
+    """Seconds from the long excursion's start to the main run's first WARNING in it, or None."""
+    schedule = (probe or {}).get('schedule') or {}
+    times = [t for t, status in (probe or {}).get('calls', []) if status == 'WARNING'
+             and schedule.get('long_up', float('inf')) <= t <= schedule.get('long_down', 0.0)]
+    return min(times) - schedule['long_up'] if times else None
+
+
 def run_one(sup, job, run, base_env, box):
     """Start a master, the student's launch (in the box) and the probe; return the run's record."""
     tag = run['tag']
@@ -171,7 +179,8 @@ def session(job):
                 if not warned_in_long_excursion(main):
                     result['threshold_skipped'] = 'the node never warned in the main run'
                     break
-                run = dict(run, plan=dict(run['plan'], fit=main['calibration'].get('fit')))
+                run = dict(run, plan=dict(run['plan'], fit=main['calibration'].get('fit'),
+                                          warn_after=warning_latency(main)))
             result['runs'].append(run_one(sup, job, run, base_env, box))
             result['survivors'] += result['runs'][-1]['survivors']
     return result

@@ -19,6 +19,10 @@ SHEETS = collections.OrderedDict([
 PACKAGE = 'exam'
 #: The delay of question 14(b), s (both sheets).
 DELAY = 5.0
+#: A node whose WARNING has not come by the end of the long excursion is kept above the threshold up
+#: to this many s after its own value went there (only when its code makes a service client), so a
+#: late WARNING costs question 14b's delay only, not questions 13 and 14a too.
+LATE_WARNING_S = 60.0
 
 #: The rubric (sheet 000's grader notes, used for sheet 001 too): item id -> (points, what it asks).
 ITEMS = collections.OrderedDict([

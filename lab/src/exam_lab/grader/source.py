@@ -13,6 +13,18 @@ from exam_lab.grader.sheets import SHEETS
 
 _INIT_NODE = re.compile(r'\binit_node\s*\(')
 _GET_PARAM = re.compile(r'get_param\s*\(\s*[\'"]([^\'"]+)[\'"]')
+_SERVICE_CLIENT = re.compile(r'\b(ServiceProxy|wait_for_service)\b')
+#: Files whose line endings and BOM a teacher fixes: sources, scripts, launch and build files.
+TEXT_ENDINGS = ('.py', '.launch', '.xml', '.yaml', '.yml', '.txt', '.cfg', '.sh', '.srv', '.msg')
+_BOM = b'\xef\xbb\xbf'
+#: Python 2 on a line, with the words a teacher reads: what the SyntaxError under Python 3 means.
+_PYTHON2 = ((re.compile(r'^\s*print\b(\s+["\'\w%(>]|\s*$)'), 'print statement'),
+            (re.compile(r'^\s*except\s+[\w.]+\s*,\s*\w+\s*:'), '"except E, e:"'),
+            (re.compile(r'^\s*exec\s+["\'\w]'), 'exec statement'),
+            (re.compile(r'^\s*raise\s+[\w.]+\s*,'), '"raise E, message"'),
+            (re.compile(r'<>'), 'the <> operator'),
+            (re.compile(r'\b0[0-7]+\b'), 'an octal literal like 0777'),
+            (re.compile(r'`'), 'backquotes'))
 
 
 def python_files(package_dir):
@@ -103,6 +115,75 @@ def comment_ratio(paths):
 
 def _is_shebang(text, number):
     return number == 1 and text.startswith('#!')
+
+
+def fix_text(package_dir):
+    """What a teacher does first with files edited on Windows: CRLF line endings to LF (a shebang
+    ``python3\\r`` is no command) and no UTF-8 byte order mark (it hides ``#!``). Returns one note per
+    kind of fix, naming the files."""
+    crlf, bom = [], []
+    for dirpath, dirnames, filenames in os.walk(package_dir):
+        dirnames[:] = sorted(d for d in dirnames if not d.startswith('.'))
+        for filename in sorted(filenames):
+            full = os.path.join(dirpath, filename)
+            if os.path.islink(full) or not os.path.isfile(full):
+                continue
+            if not (filename.endswith(TEXT_ENDINGS) or filename == 'CMakeLists.txt' or '.' not in filename):
+                continue
+            with open(full, 'rb') as f:
+                data = f.read()
+            if b'\0' in data:
+                continue  # not text
+            fixed = data
+            rel = os.path.relpath(full, package_dir)
+            if fixed.startswith(_BOM):
+                fixed = fixed[len(_BOM):]
+                bom.append(rel)
+            if b'\r' in fixed:
+                fixed = fixed.replace(b'\r\n', b'\n').replace(b'\r', b'\n')
+                crlf.append(rel)
+            if fixed != data:
+                with open(full, 'wb') as f:
+                    f.write(fixed)
+    notes = []
+    if crlf:
+        notes.append('Windows line endings (CRLF) changed to LF, as dos2unix does, in %d file(s): %s'
+                     % (len(crlf), ', '.join(crlf)))
+    if bom:
+        notes.append('UTF-8 byte order mark removed from %d file(s): %s' % (len(bom), ', '.join(bom)))
+    return notes
+
+
+def python2_evidence(package_dir):
+    """Where the student's code is Python 2 (``"scripts/n.py:12: print statement"``): files that
+    Python 3 cannot compile, at a line that Python 2 would accept. Never runs anything."""
+    found = []
+    for path in student_code(package_dir):
+        text = _read(path)
+        rel = os.path.relpath(path, package_dir)
+        try:
+            compile(text, rel, 'exec', dont_inherit=True)
+            continue
+        except SyntaxError as err:
+            error_line = err.lineno
+        except (ValueError, RecursionError, MemoryError, OverflowError):  # null bytes, absurd nesting
+            continue
+        lines = text.splitlines()
+        hits = []
+        for number, line in enumerate(lines, 1):
+            words = next((w for pattern, w in _PYTHON2 if pattern.search(line)), None)
+            # Operators and literals only where Python 3 stopped: elsewhere they may sit in a string.
+            if words and (number == error_line or words.endswith('statement') or words.startswith('"')):
+                hits.append((number != error_line, number, words))
+        if hits:
+            _, number, words = min(hits)  # the line Python 3 stopped at, if it is one of them
+            found.append('%s:%d: %s' % (rel, number, words))
+    return found
+
+
+def calls_a_service(package_dir):
+    """True when the Python sources make a service client (``ServiceProxy``, ``wait_for_service``)."""
+    return any(_SERVICE_CLIENT.search(_read(p)) for p in python_files(package_dir))
 
 
 def make_runnable(package_dir, launched=()):

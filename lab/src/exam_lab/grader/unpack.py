@@ -1,99 +1,351 @@
-"""What students upload, made safe to look at: checked unzipping, finding the ``exam`` package, a class.
+"""What students upload, made safe to look at: checked unpacking, finding the package, a class.
 
-No rospy here. Nothing in a submission is trusted: an archive is refused as a whole (with the reason,
-for the teacher) when an entry would land outside the target (``../``, an absolute path, a drive
-letter), is a link, or when the archive is too big or has too many files (a zip bomb). Copies of
-folders never follow links.
+No rospy here. Nothing in a submission is trusted. An archive (zip, tar, tar.gz/tgz, tar.bz2, tar.xz)
+is refused as a whole, with the reason for the teacher, when an entry would land outside the target
+(``../``, an absolute path, a drive letter), when a name holds a control character or is beyond the
+file system's limits, or when the submission's one budget of bytes and files (every archive of it,
+nested ones included) would be exceeded or an entry expands like a zip bomb. What students really
+upload is not refused for its form: Windows names (backslashes) and missing Unix modes are read as
+meant, macOS's ``__MACOSX/`` is skipped, a whole workspace's build products (``build/``, ``devel/``...)
+are dropped, links (catkin's ``src/CMakeLists.txt``) and special files are dropped, never followed;
+each is noted. Copies of folders never follow links.
 """
 import os
 import shutil
 import stat
+import tarfile
 import xml.etree.ElementTree as ET
 import zipfile
 
-#: Most files one archive may hold (a package has tens; a workspace with build/ a few thousand).
+from exam_lab.grader.sheets import PACKAGE, drone_packages
+
+#: Most files one submission may unpack, all its archives together (a package has tens).
 MAX_FILES = 5000
-#: Most bytes one archive may unpack to, all files together.
+#: Most bytes one submission may unpack, all its archives together.
 MAX_BYTES = 200 * 1024 * 1024
-#: Highest ratio of unpacked to packed size of one entry (text compresses ~5x; bombs 1000x).
+#: A class archive ("download all submissions") holds every student's uploads.
+CLASS_FILES = 100000
+CLASS_BYTES = 4 * 1024 * 1024 * 1024
+#: Highest ratio of unpacked to packed size of one zip entry (text compresses ~5x; bombs 1000x).
 MAX_RATIO = 200
-#: Folders never copied into a workspace: build products and version control of the student's side.
-SKIPPED_DIRS = ('build', 'devel', 'install', 'log', '.git', '.svn', '__pycache__', '__MACOSX',
-                '.catkin_tools', '.vscode', '.idea')
+#: Linux limits on a name: bytes of one path component, bytes of a whole path.
+NAME_MAX = 255
+PATH_MAX = 4096
+#: How many archives deep a package may sit (a zip holding the package's zip, holding ...).
+MAX_NESTING = 2
+#: Folders of a catkin workspace that the student's build made: never unpacked, never copied.
+BUILD_PRODUCTS = ('build', 'devel', 'install', 'build_isolated', 'devel_isolated', 'install_isolated',
+                  '.catkin_tools')
+#: Folders never unpacked: build products, version control, caches, macOS's resource forks.
+SKIPPED_ON_UNPACK = BUILD_PRODUCTS + ('.git', '.svn', '__pycache__', '__MACOSX')
+#: Folders never copied into a workspace: the above and the editors' and loggers' own.
+SKIPPED_DIRS = SKIPPED_ON_UNPACK + ('log', 'logs', '.vscode', '.idea')
 #: How deep below a submission the package may sit (the zip's top, one folder down, a workspace's src).
 MAX_DEPTH = 4
+#: Packages that are the simulators, never a student's answer (a whole workspace holds them too).
+SIMULATORS = ('drone_sim',) + tuple(drone_packages())
+#: File name endings of archives the grader opens, and the magic bytes of those it cannot.
+ARCHIVE_ENDINGS = ('.zip', '.tar', '.tar.gz', '.tgz', '.tar.bz2', '.tbz2', '.tar.xz', '.txz')
+_UNSUPPORTED = ((b'Rar!\x1a\x07', 'a RAR archive'), (b'7z\xbc\xaf\x27\x1c', 'a 7-Zip archive'),
+                (b'\x1f\x8b', 'a gzip file that holds no tar'), (b'BZh', 'a bzip2 file that holds no tar'),
+                (b'\xfd7zXZ\x00', 'an xz file that holds no tar'), (b'%PDF', 'a PDF document'))
+#: At most this many notes of one kind (links dropped, duplicates) are listed; the rest are counted.
+MAX_LISTED = 5
 
 
 class UnpackError(Exception):
     """A submission that cannot be opened safely; the message says why, for the teacher."""
 
 
+class Budget(object):
+    """What one submission may unpack, every archive of it together, nested ones included: a zip of
+    zips cannot multiply the limits by the number of inner archives."""
+
+    def __init__(self, max_bytes=MAX_BYTES, max_files=MAX_FILES):
+        self.bytes_left = max_bytes
+        self.files_left = max_files
+        self.max_bytes = max_bytes
+        self.max_files = max_files
+
+    def take(self, files, nbytes, what):
+        """Charge an archive's files and bytes, or raise UnpackError (nothing charged) if too many."""
+        if files > self.files_left:
+            raise UnpackError('%s: %d more files, beyond the %d a submission may unpack'
+                              % (what, files, self.max_files))
+        if nbytes > self.bytes_left:
+            raise UnpackError('%s: %d more bytes, beyond the %d a submission may unpack'
+                              % (what, nbytes, self.max_bytes))
+        self.files_left -= files
+        self.bytes_left -= nbytes
+
+
+def shown_name(name, limit=80):
+    """An archive entry's name as it may be printed: escaped (a newline cannot inject a line), cut."""
+    text = repr(name)
+    return text if len(text) <= limit else text[:limit - 5] + '...' + text[-2:]
+
+
 def _entry_path(name):
-    """The parts of an archive entry's path, or raise UnpackError if it would escape the target."""
+    """The parts of an archive entry's path, or raise UnpackError if it is unsafe or unwritable."""
+    if any(ord(c) < 32 or ord(c) == 127 for c in name):
+        raise UnpackError('entry %s has a control character in its name' % shown_name(name))
     path = name.replace('\\', '/')  # archives made on Windows sometimes use backslashes
     if path.startswith('/') or (len(path) > 1 and path[1] == ':'):
-        raise UnpackError('entry %r has an absolute path' % name)
+        raise UnpackError('entry %s has an absolute path' % shown_name(name))
     parts = [p for p in path.split('/') if p not in ('', '.')]
     if '..' in parts:
-        raise UnpackError('entry %r climbs out of the folder (..)' % name)
+        raise UnpackError('entry %s climbs out of the folder (..)' % shown_name(name))
+    if len(path.encode('utf-8', 'surrogateescape')) > PATH_MAX:
+        raise UnpackError('entry %s has a path of more than %d bytes' % (shown_name(name), PATH_MAX))
+    for part in parts:
+        if len(part.encode('utf-8', 'surrogateescape')) > NAME_MAX:
+            raise UnpackError('entry %s has a name of more than %d bytes' % (shown_name(name), NAME_MAX))
     return parts
 
 
-def _is_link(info):
-    """True when a zip entry is a symbolic link (Unix mode in the high bits of external_attr)."""
-    return stat.S_ISLNK(info.external_attr >> 16)
+class _Plan(object):
+    """The entries of one archive that will be written, and what was dropped, before writing any."""
+
+    def __init__(self, label):
+        self.label = label
+        self.files = []        # (member, parts, size)
+        self.dirs = []         # parts
+        self.products = {}     # the path of a dropped build-product folder -> entries in it
+        self.links = []        # (name, target)
+        self.special = []      # names of FIFOs, devices
+        self.seen = {}         # parts -> count
+        self.folded = {}       # lower-cased parts -> parts first seen
+
+    def add(self, member, name, kind, size, link_target=''):
+        parts = _entry_path(name)
+        if not parts or parts[0] == '__MACOSX':
+            return
+        skipped = [i for i, p in enumerate(parts) if p in SKIPPED_ON_UNPACK]
+        if skipped:
+            i = skipped[0]
+            if parts[i] in BUILD_PRODUCTS:
+                key = '/'.join(parts[:i + 1]) + '/'
+                self.products[key] = self.products.get(key, 0) + 1
+            return
+        if kind == 'link':
+            self.links.append(('/'.join(parts), link_target))
+            return
+        if kind == 'special':
+            self.special.append('/'.join(parts))
+            return
+        if kind == 'dir':
+            self.dirs.append(parts)
+            return
+        key = tuple(parts)
+        self.seen[key] = self.seen.get(key, 0) + 1
+        folded = tuple(p.lower() for p in parts)
+        self.folded.setdefault(folded, set()).add(key)
+        self.files.append((member, parts, size))
+
+    def notes(self):
+        """What the teacher should know of this archive: what was dropped, duplicates, case clashes."""
+        out = []
+        if self.products:
+            out.append('%s: build products of a workspace not unpacked: %s' % (self.label, ', '.join(
+                '%s (%d entries)' % (k, n) for k, n in sorted(self.products.items()))))
+        if self.special:
+            out.append('%s: %d special file(s) (FIFO, device) dropped: %s' % (
+                self.label, len(self.special), _listed([shown_name(n) for n in self.special])))
+        duplicates = sorted('/'.join(k) for k, n in self.seen.items() if n > 1)
+        if duplicates:
+            out.append('%s: %d entr(ies) appear more than once, the last one kept: %s' % (
+                self.label, len(duplicates), _listed([shown_name(n) for n in duplicates])))
+        clashes = sorted(' / '.join(sorted('/'.join(k) for k in keys)) for keys in self.folded.values()
+                         if len(keys) > 1)
+        if clashes:
+            out.append('%s: names that differ only by case (one file on Windows or macOS): %s' % (
+                self.label, _listed(clashes)))
+        return out
+
+    def link_notes(self):
+        """The links dropped: a change to what the student uploaded (catkin's own link is harmless)."""
+        catkin = [n for n, _ in self.links if n.endswith('src/CMakeLists.txt') or n == 'CMakeLists.txt']
+        other = [(n, t) for n, t in self.links if n not in catkin]
+        out = []
+        if catkin:
+            out.append('%s: catkin\'s link %s dropped (links are never followed; the grader makes its '
+                       'own workspace)' % (self.label, ', '.join(shown_name(n) for n in catkin)))
+        if other:
+            out.append('%s: %d link(s) dropped, never followed: %s' % (self.label, len(other), _listed(
+                ['%s -> %s' % (shown_name(n), shown_name(t, 60)) for n, t in other])))
+        return out
 
 
-def safe_extract(archive, target, max_files=MAX_FILES, max_bytes=MAX_BYTES, max_ratio=MAX_RATIO):
-    """Extract the zip ``archive`` into ``target`` after checking every entry; return the file count.
+def _listed(names):
+    shown = ', '.join(names[:MAX_LISTED])
+    return shown + (' and %d more' % (len(names) - MAX_LISTED) if len(names) > MAX_LISTED else '')
 
-    The whole archive is refused (UnpackError) before anything is written if any entry is unsafe.
-    Entries of macOS's ``__MACOSX/`` resource forks are skipped.
+
+def archive_kind(path):
+    """'zip', 'tar', or None when ``path`` is neither (also when it cannot be read)."""
+    try:
+        if zipfile.is_zipfile(path):
+            return 'zip'
+        if tarfile.is_tarfile(path):
+            return 'tar'
+    except OSError:
+        pass
+    return None
+
+
+def what_it_is(path):
+    """Words for a file the grader cannot open ("a RAR archive"), or None when unknown."""
+    try:
+        with open(path, 'rb') as f:
+            head = f.read(8)
+    except OSError:
+        return None
+    for magic, words in _UNSUPPORTED:
+        if head.startswith(magic):
+            return words
+    return None
+
+
+def safe_extract(archive, target, max_files=MAX_FILES, max_bytes=MAX_BYTES, max_ratio=MAX_RATIO,
+                 budget=None, notes=None, fixes=None):
+    """Unpack the zip or tar ``archive`` into ``target`` after checking every entry; return the number
+    of files written.
+
+    The whole archive is refused (UnpackError) before anything is written if any entry is unsafe or the
+    ``budget`` (a new one of ``max_files`` / ``max_bytes`` when None) cannot pay for it. ``notes``
+    receives what was dropped (build products, special files) and duplicates; ``fixes`` the dropped
+    links (``notes`` when None).
     """
+    budget = budget or Budget(max_bytes, max_files)
+    notes = [] if notes is None else notes
+    fixes = notes if fixes is None else fixes
+    label = os.path.basename(archive)
+    kind = archive_kind(archive)
+    if kind == 'zip':
+        written = _extract_zip(archive, target, label, budget, max_ratio, notes, fixes)
+    elif kind == 'tar':
+        written = _extract_tar(archive, target, label, budget, notes, fixes)
+    else:
+        words = what_it_is(archive)
+        raise UnpackError('%s is %s: the grader opens zip and tar archives (%s); ask for a zip'
+                          % (label, words or 'not a readable zip or tar archive', ', '.join(ARCHIVE_ENDINGS)))
+    return written
+
+
+def _extract_zip(archive, target, label, budget, max_ratio, notes, fixes):
     try:
         zf = zipfile.ZipFile(archive)
     except (zipfile.BadZipFile, OSError) as err:
-        raise UnpackError('%s is not a readable zip: %s' % (os.path.basename(archive), err))
+        raise UnpackError('%s is not a readable zip: %s' % (label, err))
     with zf:
-        entries = []
-        total = 0
+        plan = _Plan(label)
         for info in zf.infolist():
-            parts = _entry_path(info.filename)
-            if not parts or parts[0] == '__MACOSX':
-                continue
-            if _is_link(info):
-                raise UnpackError('entry %r is a symbolic link' % info.filename)
-            total += info.file_size
-            if info.file_size > max_ratio * max(info.compress_size, 1024):
-                raise UnpackError('entry %r unpacks %d bytes from %d: a zip bomb?'
-                                  % (info.filename, info.file_size, info.compress_size))
-            entries.append((info, parts))
-        if len(entries) > max_files:
-            raise UnpackError('%d entries, more than the %d allowed' % (len(entries), max_files))
-        if total > max_bytes:
-            raise UnpackError('unpacks to %d bytes, more than the %d allowed' % (total, max_bytes))
-        os.makedirs(target, exist_ok=True)
-        for info, parts in entries:
-            dest = os.path.join(target, *parts)
-            if info.is_dir() or info.filename.endswith(('/', '\\')):
-                os.makedirs(dest, exist_ok=True)
-                continue
-            os.makedirs(os.path.dirname(dest), exist_ok=True)
-            written = 0
-            with zf.open(info) as src, open(dest, 'wb') as out:
-                # Count what really comes out: a forged header cannot smuggle more than it declares.
-                while True:
-                    chunk = src.read(65536)
-                    if not chunk:
-                        break
-                    written += len(chunk)
-                    if written > info.file_size:
-                        raise UnpackError('entry %r unpacks to more than it declares' % info.filename)
-                    out.write(chunk)
-            mode = (info.external_attr >> 16) & 0o777
+            mode = info.external_attr >> 16 if info.create_system == 3 else 0  # Unix modes, else none
+            if stat.S_ISLNK(mode):
+                plan.add(info, info.filename, 'link', 0, _zip_link_target(zf, info))
+            elif info.is_dir() or info.filename.endswith('\\'):
+                plan.add(info, info.filename, 'dir', 0)
+            else:
+                plan.add(info, info.filename, 'file', info.file_size)
+        for info, _, size in plan.files:
+            if size > max_ratio * max(info.compress_size, 1024):
+                raise UnpackError('entry %s unpacks %d bytes from %d: a zip bomb?'
+                                  % (shown_name(info.filename), size, info.compress_size))
+        budget.take(len(plan.files), sum(size for _, _, size in plan.files), label)
+        _make_dirs(target, plan)
+        for info, parts, size in plan.files:
+            dest = _dest(target, parts)
+            with zf.open(info) as src:
+                _copy_capped(src, dest, size, info.filename)
+            mode = (info.external_attr >> 16) & 0o777 if info.create_system == 3 else 0
             if mode:
                 os.chmod(dest, mode | 0o600)
-        return len(entries)
+    notes.extend(plan.notes())
+    fixes.extend(plan.link_notes())
+    return len(plan.files)
+
+
+def _zip_link_target(zf, info):
+    if info.file_size > 4096:
+        return '?'
+    return zf.read(info).decode('utf-8', 'replace')
+
+
+def _extract_tar(archive, target, label, budget, notes, fixes):
+    try:
+        tf = tarfile.open(archive, 'r:*')
+    except (tarfile.TarError, OSError, EOFError) as err:
+        raise UnpackError('%s is not a readable tar archive: %s' % (label, err))
+    with tf:
+        plan = _Plan(label)
+        read = 0
+        try:
+            # Member by member, charging as it goes: a compressed tar is read (decompressed) only as far
+            # as the budget allows, dropped build products included.
+            for member in tf:
+                read += member.size
+                if read > budget.bytes_left or len(plan.files) > budget.files_left:
+                    budget.take(len(plan.files) + 1, read, label)  # raises with the reason
+                if member.issym() or member.islnk():
+                    plan.add(member, member.name, 'link', 0, member.linkname)
+                elif member.isdir():
+                    plan.add(member, member.name, 'dir', 0)
+                elif member.isfile():
+                    plan.add(member, member.name, 'file', member.size)
+                else:
+                    plan.add(member, member.name, 'special', 0)
+        except (tarfile.TarError, OSError, EOFError) as err:
+            raise UnpackError('%s is not a readable tar archive: %s' % (label, err))
+        budget.take(len(plan.files), sum(size for _, _, size in plan.files), label)
+        _make_dirs(target, plan)
+        try:
+            for member, parts, size in plan.files:
+                dest = _dest(target, parts)
+                src = tf.extractfile(member)
+                _copy_capped(src, dest, size, member.name)
+                if member.mode & 0o777:
+                    os.chmod(dest, (member.mode & 0o777) | 0o600)
+        except (tarfile.TarError, EOFError) as err:
+            raise UnpackError('%s is not a readable tar archive: %s' % (label, err))
+    notes.extend(plan.notes())
+    fixes.extend(plan.link_notes())
+    return len(plan.files)
+
+
+def _make_dirs(target, plan):
+    os.makedirs(target, exist_ok=True)
+    for parts in plan.dirs:
+        _dest(target, parts, make=True)
+
+
+def _dest(target, parts, make=False):
+    """The path of an entry below ``target``; a file where a folder must go (or the reverse) is an
+    UnpackError, never a crash."""
+    dest = os.path.join(target, *parts)
+    try:
+        os.makedirs(dest if make else os.path.dirname(dest), exist_ok=True)
+        if not make and os.path.isdir(dest):
+            raise UnpackError('entry %s is both a folder and a file' % shown_name('/'.join(parts)))
+    except OSError as err:
+        raise UnpackError('entry %s cannot be written: %s' % (shown_name('/'.join(parts)), err.strerror))
+    return dest
+
+
+def _copy_capped(src, dest, size, name):
+    """Copy what really comes out of an entry: a forged header cannot smuggle more than it declares."""
+    written = 0
+    try:
+        with open(dest, 'wb') as out:
+            while True:
+                chunk = src.read(65536)
+                if not chunk:
+                    break
+                written += len(chunk)
+                if written > size:
+                    raise UnpackError('entry %s unpacks to more than it declares' % shown_name(name))
+                out.write(chunk)
+    except OSError as err:
+        raise UnpackError('entry %s cannot be written: %s' % (shown_name(name), err.strerror))
 
 
 def package_name(package_xml):
@@ -104,10 +356,9 @@ def package_name(package_xml):
         return None
 
 
-def find_packages(root, name='exam', max_depth=MAX_DEPTH):
-    """Folders below ``root`` (itself included) holding a package.xml named ``name``, shallowest first.
-
-    Build products and hidden folders are not searched; links are not followed.
+def find_packages(root, name=PACKAGE, max_depth=MAX_DEPTH):
+    """Folders below ``root`` (itself included) holding a package.xml named ``name`` (any name when
+    None), shallowest first. Build products and hidden folders are not searched; links are not followed.
     """
     found = []
     base_depth = root.rstrip(os.sep).count(os.sep)
@@ -117,91 +368,161 @@ def find_packages(root, name='exam', max_depth=MAX_DEPTH):
                              and not os.path.islink(os.path.join(dirpath, d)))
         if depth >= max_depth:
             dirnames[:] = []
-        if 'package.xml' in filenames and package_name(os.path.join(dirpath, 'package.xml')) == name:
-            found.append(dirpath)
+        if 'package.xml' in filenames:
+            found_name = package_name(os.path.join(dirpath, 'package.xml'))
+            if name is None or found_name == name:
+                found.append(dirpath)
             dirnames[:] = []  # a package does not hold another one
     return sorted(found, key=lambda p: (p.count(os.sep), p))
 
 
-def open_submission(path, scratch, notes):
-    """The folder of the ``exam`` package in a submission (a folder, a zip, or a folder of zips).
+def _student_packages(root):
+    """Packages below ``root`` that may be the answer: ``exam`` first; else any that is no simulator,
+    those with ``exam`` in their name first."""
+    exact = find_packages(root)
+    if exact:
+        return exact
+    others = [p for p in find_packages(root, name=None)
+              if package_name(os.path.join(p, 'package.xml')) not in SIMULATORS]
+    return sorted(others, key=lambda p: ('exam' not in (package_name(os.path.join(p, 'package.xml')) or ''),
+                                         p.count(os.sep), p))
 
-    Zips are extracted (checked) below ``scratch``. ``notes`` receives what the teacher should know
-    (other candidates, refused archives). Raises UnpackError when there is no package.
+
+def open_submission(path, scratch, notes, fixes=None, budget=None):
+    """The folder of the student's package in a submission: a folder, an archive, a folder of
+    archives, archives in archives (``MAX_NESTING`` deep), a whole workspace.
+
+    Archives are unpacked (checked) below ``scratch``, all paid from one ``budget``. ``notes`` receives
+    what the teacher should know (other candidates, refused archives, what was dropped); ``fixes`` the
+    changes to what the student uploaded (links dropped, a package not named ``exam``). Raises
+    UnpackError when there is no package, saying what was found instead.
     """
+    budget = budget or Budget()
+    fixes = notes if fixes is None else fixes
     path = os.path.abspath(path)
+    counter = [0]
+    seen = []
     if os.path.isfile(path):
-        if not zipfile.is_zipfile(path):
-            raise UnpackError('%s is neither a folder nor a zip' % os.path.basename(path))
-        target = os.path.join(scratch, 'unzipped')
-        safe_extract(path, target)
-        return open_submission(target, scratch, notes)
-    found = find_packages(path)
+        root = _unpack_one(path, scratch, notes, fixes, budget, counter)
+    else:
+        root = path
+    found = _search(root, scratch, notes, fixes, budget, counter, 0, seen)
     if not found:
-        # A student folder from the course platform: the package is in one of its zips.
-        refused = []
-        for zip_path in sorted(_zips_in(path)):
-            target = os.path.join(scratch, 'zip%d' % len(refused + found))
-            try:
-                safe_extract(zip_path, target)
-            except UnpackError as err:
-                refused.append('%s refused: %s' % (os.path.relpath(zip_path, path), err))
-                continue
-            found.extend(find_packages(target))
-        notes.extend(refused)
-        if not found:
-            raise UnpackError('no catkin package named exam in %s%s'
-                              % (os.path.basename(path), ' (%s)' % '; '.join(refused) if refused else ''))
+        refused = [s for s in seen if '(refused: ' in s or 'cannot be opened' in s]
+        if refused:  # the reason is the archive that could not be opened, not a missing package
+            raise UnpackError(_listed(refused))
+        raise UnpackError('no catkin package (package.xml) in %s%s' % (
+            os.path.basename(path), '; found: %s' % _listed(seen) if seen else ' (it is empty)'))
+    chosen = found[0]
+    name = package_name(os.path.join(chosen, 'package.xml'))
+    if name != PACKAGE:
+        fixes.append('the package is named %s, not %s (question 9 asks for %s): graded as it is'
+                     % (shown_name(name or '?'), PACKAGE, PACKAGE))
+    parent = os.path.dirname(chosen)
+    if os.path.basename(parent) == 'src':
+        notes.append('a whole catkin workspace was uploaded: graded its package %s' % _shown(chosen, scratch, path))
     if len(found) > 1:
-        notes.append('several exam packages found; graded %s, ignored %s'
-                     % (_shown(found[0], scratch, path), ', '.join(_shown(f, scratch, path) for f in found[1:])))
-    return found[0]
+        notes.append('several candidate packages found; graded %s, ignored %s'
+                     % (_shown(chosen, scratch, path), ', '.join(_shown(f, scratch, path) for f in found[1:])))
+    return chosen
 
 
-def _zips_in(folder):
+def _unpack_one(archive, scratch, notes, fixes, budget, counter):
+    target = os.path.join(scratch, 'unpacked%d' % counter[0])
+    counter[0] += 1
+    safe_extract(archive, target, budget=budget, notes=notes, fixes=fixes)
+    return target
+
+
+def _search(root, scratch, notes, fixes, budget, counter, depth, seen):
+    """Packages in ``root``, else in the archives it holds (each unpacked once, nested ones too)."""
+    found = _student_packages(root)
+    if found or depth >= MAX_NESTING:
+        return found
+    for archive in sorted(_archives_in(root)):
+        rel = os.path.relpath(archive, root)
+        if archive_kind(archive) is None:
+            words = what_it_is(archive)
+            notes.append('%s cannot be opened: it is %s; the grader opens zip and tar archives'
+                         % (shown_name(rel), words or 'not a readable archive'))
+            seen.append('%s cannot be opened: it is %s' % (shown_name(rel), words or 'not a readable archive'))
+            continue
+        try:
+            inner = _unpack_one(archive, scratch, notes, fixes, budget, counter)
+        except UnpackError as err:
+            notes.append('%s refused: %s' % (shown_name(rel), err))
+            seen.append('%s (refused: %s)' % (rel, err))
+            continue
+        got = _search(inner, scratch, notes, fixes, budget, counter, depth + 1, seen)
+        if not got:
+            seen.append('%s (no package inside)' % shown_name(rel))
+        found.extend(got)
+    if not found:
+        seen.extend(shown_name(n) for n in sorted(os.listdir(root))[:MAX_LISTED]
+                    if not any(n in s for s in seen))
+    return found
+
+
+def _archives_in(folder):
+    """Files below ``folder`` that look like archives (by their name, or any file at the top: the
+    platform may keep the student's file name, whatever it is)."""
     for dirpath, dirnames, filenames in os.walk(folder):
-        dirnames[:] = [d for d in dirnames if not os.path.islink(os.path.join(dirpath, d))]
+        dirnames[:] = [d for d in dirnames if d not in SKIPPED_DIRS
+                       and not os.path.islink(os.path.join(dirpath, d))]
         for filename in filenames:
             full = os.path.join(dirpath, filename)
-            if filename.lower().endswith('.zip') and not os.path.islink(full):
+            if os.path.islink(full) or not os.path.isfile(full):
+                continue
+            lower = filename.lower()
+            if lower.endswith(ARCHIVE_ENDINGS) or what_it_is(full) in ('a RAR archive', 'a 7-Zip archive') \
+                    or (dirpath == folder and '.' not in filename and archive_kind(full)):
                 yield full
 
 
 def _shown(path, *bases):
+    """``path`` as the teacher knows it: inside the upload, not inside the grader's scratch folder."""
     for base in bases:
         if path.startswith(base):
-            return os.path.relpath(path, base)
+            rel = os.path.relpath(path, base)
+            first = rel.split(os.sep, 1)
+            return first[1] if len(first) == 2 and first[0].startswith('unpacked') else rel
     return path
 
 
 def copy_package(source, target, notes):
-    """Copy the package folder to ``target`` without build products, hidden folders or links."""
+    """Copy the package folder to ``target``: regular files only, without build products, hidden
+    folders, links or special files (each link noted)."""
     def ignore(dirpath, names):
         skipped = set(n for n in names if n in SKIPPED_DIRS or (n.startswith('.') and
                                                               os.path.isdir(os.path.join(dirpath, n))))
         for n in names:
-            if os.path.islink(os.path.join(dirpath, n)):
+            full = os.path.join(dirpath, n)
+            if os.path.islink(full):
                 skipped.add(n)
-                notes.append('link %s not copied' % os.path.relpath(os.path.join(dirpath, n), source))
+                notes.append('link %s not copied' % shown_name(os.path.relpath(full, source)))
+            elif not (os.path.isfile(full) or os.path.isdir(full)):
+                skipped.add(n)
         return skipped
     shutil.copytree(source, target, ignore=ignore)
 
 
 def list_students(class_path, scratch):
-    """``[(student, folder)]`` of a class: one sub-folder per student, as "download all" gives.
+    """``[(student, folder or archive)]`` of a class: one sub-folder per student, as "download all"
+    gives.
 
-    ``class_path`` may be a zip of that (extracted safely below ``scratch``). A class whose top holds
-    zips instead of folders counts each zip as one student (named after the zip).
+    ``class_path`` may be an archive of that (unpacked safely below ``scratch``, with a class's budget).
+    A class whose top holds archives instead of folders counts each archive as one student (named
+    after it).
     """
     class_path = os.path.abspath(class_path)
     if os.path.isfile(class_path):
         target = os.path.join(scratch, 'class')
-        safe_extract(class_path, target)
+        safe_extract(class_path, target, budget=Budget(CLASS_BYTES, CLASS_FILES))
         class_path = target
         entries = [e for e in os.listdir(class_path) if not e.startswith('.')]
         if len(entries) == 1 and os.path.isdir(os.path.join(class_path, entries[0])) \
-                and not find_packages(os.path.join(class_path, entries[0]), max_depth=1):
-            class_path = os.path.join(class_path, entries[0])  # the zip holds the class folder
+                and not find_packages(os.path.join(class_path, entries[0]), name=None, max_depth=1):
+            class_path = os.path.join(class_path, entries[0])  # the archive holds the class folder
     students = []
     for entry in sorted(os.listdir(class_path)):
         full = os.path.join(class_path, entry)
@@ -209,8 +530,13 @@ def list_students(class_path, scratch):
             continue
         if os.path.isdir(full):
             students.append((student_name(entry), full))
-        elif entry.lower().endswith('.zip'):
-            students.append((student_name(entry[:-4]), full))
+        elif entry.lower().endswith(ARCHIVE_ENDINGS):
+            stem = entry
+            for ending in sorted(ARCHIVE_ENDINGS, key=len, reverse=True):
+                if stem.lower().endswith(ending):
+                    stem = stem[:-len(ending)]
+                    break
+            students.append((student_name(stem), full))
     return students
 
 

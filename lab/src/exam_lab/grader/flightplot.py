@@ -1,0 +1,118 @@
+"""The flight plot of one student: what its node published against the oracle, the threshold, the
+warning service's calls and the legs the grader flew, one panel per run. No rospy here.
+
+Drawn from the probe's results (``logs/probe-main.json``, ``logs/probe-threshold.json``) with
+matplotlib's Agg backend (no display needed); times are seconds from the probe's start.
+"""
+import json
+import os
+
+#: Legs of each run, in order, and the side of the threshold each is flown on.
+LEGS = {'rest': 'below', 'short_up': 'above', 'short_down': 'below', 'long_up': 'above', 'long_down': 'below',
+        'start': 'below', 'step': 'above'}
+_SIDE_COLOUR = {'above': '#f4cccc', 'below': '#d9e8f5'}
+#: Up to this many calls of a kind, each is also a vertical line across the panel.
+FEW_CALLS = 10
+_CALL_COLOUR = {'WARNING': '#cc0000', 'NORMAL': '#2a9d2a'}
+
+
+def load_runs(log_dir):
+    """``[(tag, probe result)]`` of the runs whose probe wrote a result."""
+    runs = []
+    for tag in ('main', 'threshold'):
+        path = os.path.join(log_dir, 'probe-%s.json' % tag)
+        if os.path.isfile(path):
+            try:
+                with open(path) as f:
+                    runs.append((tag, json.load(f)))
+            except ValueError:
+                continue
+    return runs
+
+
+def legs(schedule):
+    """``[(name, start, end, side)]`` of a run's schedule (ROS times)."""
+    names = sorted((k for k in schedule if k in LEGS), key=schedule.get)
+    ends = sorted(schedule.values())
+    out = []
+    for name in names:
+        later = [t for t in ends if t > schedule[name]]
+        out.append((name, schedule[name], later[0] if later else schedule[name], LEGS[name]))
+    return out
+
+
+def draw(runs, path, title=''):
+    """Write the PNG at ``path``; return False (and write nothing) when no run has anything to draw."""
+    runs = [(tag, probe) for tag, probe in runs if probe.get('trace') or probe.get('calls')]
+    if not runs:
+        return False
+    import matplotlib
+    matplotlib.use('Agg')
+    from matplotlib import pyplot as plt
+    fig, axes = plt.subplots(len(runs), 1, figsize=(9.5, 3.1 * len(runs)), dpi=90, squeeze=False)
+    for ax, (tag, probe) in zip(axes[:, 0], runs):
+        _panel(ax, tag, probe)
+    if title:
+        fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return True
+
+
+def _limits(ax, published, oracle, threshold):
+    """The y range of the node's own values and the threshold, so its crossings show; the oracle's
+    values beyond that range (a formula far off) are said in the panel rather than squashing it."""
+    own = published + ([threshold] if threshold is not None else [])
+    if not published:
+        return
+    low, high = min(own), max(own)
+    pad = max(0.08 * (high - low), 1.0)
+    low, high = low - pad, high + pad
+    ax.set_ylim(low, high)
+    outside = [v for v in oracle if not low <= v <= high]
+    if outside:
+        ax.text(0.01, 0.04, 'oracle off this scale: %.0f to %.0f' % (min(outside), max(outside)),
+                transform=ax.transAxes, fontsize=8, color='#555555', va='bottom',
+                bbox=dict(facecolor='white', alpha=0.85, lw=0))
+
+
+def _panel(ax, tag, probe):
+    t0 = probe.get('t0') or 0.0
+    trace = probe.get('trace') or {}
+    published = [(t - t0, v) for t, v in trace.get('published', []) if v is not None]
+    oracle = [(t - t0, v) for t, v in trace.get('oracle', [])]
+    end = max([t for t, _ in published] + [t for t, _ in oracle] + [(probe.get('schedule') or {}).get('end', t0) - t0])
+    for name, start, stop, side in legs(probe.get('schedule') or {}):
+        ax.axvspan(start - t0, stop - t0, color=_SIDE_COLOUR[side], alpha=0.6, lw=0)
+        ax.text((start + stop) / 2 - t0, 1.0, name.replace('_', ' '), transform=ax.get_xaxis_transform(),
+                ha='center', va='bottom', fontsize=7, color='#555555')
+    if oracle:
+        xs = [t for t, _ in oracle] + [end]
+        ys = [v for _, v in oracle] + [oracle[-1][1]]
+        ax.step(xs, ys, where='post', color='#888888', lw=1.5, label='oracle (equation 1)')
+    if not published:
+        ax.text(0.5, 0.5, 'the node published no value the probe could read', transform=ax.transAxes,
+                ha='center', fontsize=10, color='#b00000')
+    if published:
+        ax.plot([t for t, _ in published], [v for _, v in published], '.', ms=2.5, color='#1f5fa8',
+                label='published by the node')
+    threshold = probe.get('threshold')
+    if threshold is not None:
+        ax.axhline(threshold, color='#cc0000', ls='--', lw=1, label='threshold %g' % threshold)
+    for kind in ('WARNING', 'NORMAL'):
+        times = [t - t0 for t, status in probe.get('calls', []) if status == kind]
+        if len(times) <= FEW_CALLS:
+            for t in times:
+                ax.axvline(t, color=_CALL_COLOUR[kind], lw=1, alpha=0.8)
+        if times:
+            ax.plot(times, [0.96] * len(times), 'v', color=_CALL_COLOUR[kind], ms=6, clip_on=False,
+                    transform=ax.get_xaxis_transform(), label='%s call (%d)' % (kind, len(times)))
+    _limits(ax, [v for _, v in published], [v for _, v in oracle], threshold)
+    run = 'main run' if tag == 'main' else 'threshold run (lowered threshold, question 14a)'
+    ax.set_title(run, fontsize=9, loc='left', pad=12)
+    ax.set_xlabel('s from the probe\'s start')
+    ax.set_ylabel(probe.get('sheet') or 'value')
+    ax.set_xlim(0, max(end, 1.0))
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc='center left', bbox_to_anchor=(1.0, 0.5))

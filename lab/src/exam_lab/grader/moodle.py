@@ -1,0 +1,271 @@
+"""Grades back into Moodle: the assignment's offline grading worksheet, filled. No rospy here.
+
+The layout is Moodle's own (``mod/assign/gradingtable.php`` in download mode, written by
+``dataformat/csv``; read back by ``mod/assign/feedback/offline/importgradeslib.php`` through
+``lib/csvlib.class.php``), see docs/grading.md:
+
+- UTF-8, usually with a byte order mark; comma-separated, ``"`` encloses a field holding a comma, a
+  quote (doubled), a line break or a space; one header row, then one row per participant.
+- The importer finds its columns by their header, in the teacher's language: the identifier
+  (``Identifier``, values ``Participant 1234567``; the number after the word is the participant's
+  unique id, the same number as in the "download all submissions" folder ``Jane Doe_1234567_
+  assignsubmission_file_``), ``Grade``, ``Last modified (grade)`` and each feedback plugin's field
+  (``Feedback comments``). It needs every row to have as many fields as the header; it skips a grade
+  that is empty, negative, above the maximum or equal to the one it has, and any row whose grade was
+  changed in Moodle after the worksheet was downloaded.
+
+So the filled copy changes only the grade and the feedback cells of the rows it matched, byte for byte
+everything else (the mark, the quoting of every other cell, the line ends), and leaves a grade or a
+feedback already in the worksheet as it was (a teacher's grade wins over the machine's).
+"""
+import html
+import re
+
+from exam_lab.grader.sheets import ITEMS
+
+#: The participant's number in a "download all submissions" name (folder or flat file).
+_FOLDER_NUMBER = re.compile(r'_(\d+)_assign(?:submission|feedback)_')
+#: A cell of the identifier column: Moodle's word for participant (any language), then the number.
+_IDENTIFIER = re.compile(r'^\D*?(\d+)$')
+#: Column headers by language (Moodle's strings; en first).
+IDENTIFIER_HEADERS = ('Identifier', 'Identifiant', 'ID', 'Identificador', 'Identificativo')
+GRADE_HEADERS = ('Grade', 'Note', 'Bewertung', 'Calificación', 'Nota', 'Voto', 'Cijfer')
+MAX_GRADE_HEADERS = ('Maximum grade', 'Note maximale', 'Bestwertung', 'Calificación máxima')
+FEEDBACK_HEADERS = ('Feedback comments', 'Commentaires de feedback', 'Commentaires',
+                    'Feedback als Kommentar', 'Comentarios de retroalimentación')
+NAME_HEADERS = ('Full name', 'Nom complet', 'Vollständiger Name', 'Nombre completo')
+#: Statuses whose points go into the grade column (the others wait for the teacher).
+GRADED = ('graded', 'graded with fixes')
+_BOM = '\ufeff'
+
+
+class WorksheetError(Exception):
+    """The file is not a worksheet this module can fill without changing what it must not."""
+
+
+def participant_number(name):
+    """The participant's unique id in a Moodle "download all submissions" name, or None."""
+    match = _FOLDER_NUMBER.search(name + '_' if not name.endswith('_') else name)
+    return int(match.group(1)) if match else None
+
+
+def parse(text):
+    """Split CSV text into records, keeping the raw text of every field.
+
+    :returns: ``[(fields, end)]``: ``fields`` a list of ``[raw, value]``, ``end`` the record's line end
+        as written (``'\\n'``, ``'\\r\\n'``, ``'\\r'`` or ``''`` for the last one). Joining the raw
+        fields with commas and the ends gives ``text`` back exactly.
+    """
+    records, fields, i, n = [], [], 0, len(text)
+    while i < n or fields:
+        start = i
+        if i < n and text[i] == '"':
+            i += 1
+            value = []
+            while True:
+                if i >= n:
+                    raise WorksheetError('a quoted field never ends (from character %d)' % start)
+                if text[i] == '"':
+                    if i + 1 < n and text[i + 1] == '"':
+                        value.append('"')
+                        i += 2
+                        continue
+                    i += 1
+                    break
+                value.append(text[i])
+                i += 1
+            tail_start = i
+            while i < n and text[i] not in ',\r\n':
+                i += 1
+            value = ''.join(value) + text[tail_start:i]
+        else:
+            while i < n and text[i] not in ',\r\n':
+                i += 1
+            value = text[start:i]
+        fields.append([text[start:i], value])
+        if i < n and text[i] == ',':
+            i += 1
+            if i == n:
+                fields.append(['', ''])
+            else:
+                continue
+        end = ''
+        if i < n and text[i] == '\r':
+            end = '\r\n' if text[i + 1:i + 2] == '\n' else '\r'
+        elif i < n and text[i] == '\n':
+            end = '\n'
+        i += len(end)
+        records.append((fields, end))
+        fields = []
+        if i >= n:
+            break
+    return records
+
+
+def unparse(records):
+    return ''.join(','.join(raw for raw, _ in fields) + end for fields, end in records)
+
+
+def quoted(value):
+    """A field as Moodle writes one (PHP's fputcsv): enclosed when it holds a delimiter, a quote, a
+    line break, a tab, a space or a backslash, quotes doubled."""
+    if re.search(r'[,"\r\n\t \\]', value):
+        return '"%s"' % value.replace('"', '""')
+    return value
+
+
+def _column(header, names, what):
+    for name in names:
+        if name in header:
+            return header.index(name)
+    raise WorksheetError('no %s column (looked for %s) in the header: %s. Moodle names the columns in the '
+                         'language of its interface: switch it to English and download the worksheet again'
+                         % (what, ', '.join(repr(n) for n in names), ', '.join(header)))
+
+
+def _identifier_column(header, rows):
+    """The identifier column by its header, else the one column whose every cell is a word and a
+    number (``Participant 12``, ``Teilnehmer/in 12``) in any language."""
+    try:
+        return _column(header, IDENTIFIER_HEADERS, 'identifier')
+    except WorksheetError:
+        found = [i for i in range(len(header)) if rows and all(
+            len(fields) == len(header) and re.match(r'^\D+\s?\d+$', fields[i][1].strip()) for fields, _ in rows)]
+        if len(found) == 1:
+            return found[0]
+        raise
+
+
+def _feedback_column(header):
+    try:
+        return _column(header, FEEDBACK_HEADERS, 'feedback comments')
+    except WorksheetError:
+        found = [i for i, h in enumerate(header) if 'comment' in h.lower()]
+        if len(found) == 1:
+            return found[0]
+        raise
+
+
+def _points(x, comma=False):
+    text = ('%.2f' % x).rstrip('0').rstrip('.')
+    return text.replace('.', ',') if comma else text
+
+
+def feedback(record):
+    """The feedback comment of one student (HTML, as Moodle's feedback comments are): the total, then
+    one line per item with its points, and why for each point lost."""
+    lines = []
+    for entry in record['items']:
+        line = '%s %s/%s' % (entry['id'], _points(entry['points']), _points(entry['max']))
+        if entry['points'] < entry['max'] and entry.get('evidence'):
+            why = entry['evidence'].split('\n', 1)[0]
+            line += ': ' + (why if len(why) <= 200 else why[:197] + '...')
+        lines.append(line)
+    head = ('Machine-graded by running the package: %s / %s points (%s). Not scored by the machine: '
+            'comments, code quality and the report.' % (_points(record['total']), _points(record['max']),
+                                                        ', '.join(ITEMS)))
+    text = '<p>%s</p><ul>%s</ul>' % (_escape(head), ''.join('<li>%s</li>' % _escape(l) for l in lines))
+    return text
+
+
+def _escape(text):
+    # No double quote and no backslash in what we write: no field of ours needs PHP's escape rules.
+    return html.escape(text, quote=True).replace('\\', '&#92;')
+
+
+def fill(text, records):
+    """Fill the worksheet ``text`` with the grades of ``records`` (each with ``participant``).
+
+    :returns: ``(filled text, summary)``; summary: ``graded`` [(student, participant, points)],
+        ``kept`` [(student, why)] (rows matched but left as they were), ``unmatched`` [(student, why)],
+        ``no_submission`` [row names of the worksheet no record matched].
+    :raises WorksheetError: the file lacks a column the import needs, or a row is malformed.
+    """
+    bom = text.startswith(_BOM)
+    body = text[1:] if bom else text
+    records_csv = parse(body)
+    rows = [r for r in records_csv if any(value.strip() for _, value in r[0])]
+    if not rows:
+        raise WorksheetError('the worksheet is empty')
+    header = [value.strip() for _, value in rows[0][0]]
+    ident = _identifier_column(header, rows[1:])
+    grade = _column(header, GRADE_HEADERS, 'grade')
+    comments = _feedback_column(header)
+    names = next((header.index(n) for n in NAME_HEADERS if n in header), None)
+    maximum = next((header.index(n) for n in MAX_GRADE_HEADERS if n in header), None)
+    by_number = {}
+    for fields, _ in rows[1:]:
+        if len(fields) != len(header):
+            raise WorksheetError('a row has %d fields, the header %d (Moodle refuses such a file): %s'
+                                 % (len(fields), len(header), ','.join(raw for raw, _ in fields)[:200]))
+        match = _IDENTIFIER.match(fields[ident][1].strip())
+        if match:
+            by_number[int(match.group(1))] = fields
+    summary = {'graded': [], 'kept': [], 'unmatched': [], 'no_submission': []}
+    matched = set()
+    for record in records:
+        number = record.get('participant')
+        student = record['student']
+        if number is None:
+            summary['unmatched'].append((student, 'no participant number in the submission\'s name'))
+            continue
+        fields = by_number.get(number)
+        if fields is None:
+            summary['unmatched'].append((student, 'participant %d is not in the worksheet' % number))
+            continue
+        matched.add(number)
+        status = record.get('status', 'graded')
+        if status not in GRADED:
+            summary['kept'].append((student, 'status "%s": %s' % (status, record.get('status_reason', ''))))
+            continue
+        if fields[grade][1].strip() or fields[comments][1].strip():
+            summary['kept'].append((student, 'the worksheet already has a grade or a feedback for it'))
+            continue
+        top = fields[maximum][1].strip() if maximum is not None else ''
+        comma = ',' in top and '.' not in top
+        if top and _number(top) is not None and record['total'] > _number(top) + 1e-9:
+            summary['kept'].append((student, '%s points exceed the maximum grade %s' % (record['total'], top)))
+            continue
+        points = _points(record['total'], comma)
+        fields[grade][:] = [quoted(points), points]
+        note = feedback(record)
+        fields[comments][:] = [quoted(note), note]
+        summary['graded'].append((student, number, points))
+    for number, fields in sorted(by_number.items()):
+        if number not in matched:
+            summary['no_submission'].append(fields[names][1] if names is not None else 'Participant %d' % number)
+    return (_BOM if bom else '') + unparse(records_csv), summary
+
+
+def _number(text):
+    try:
+        return float(text.replace(',', '.'))
+    except ValueError:
+        return None
+
+
+def fill_file(source, target, records):
+    """Read the worksheet at ``source``, write the filled copy at ``target``; return the summary."""
+    with open(source, 'rb') as f:
+        raw = f.read()
+    try:
+        text = raw.decode('utf-8')
+    except UnicodeDecodeError as err:
+        raise WorksheetError('not UTF-8 (download the worksheet again from Moodle): %s' % err)
+    filled, summary = fill(text, records)
+    with open(target, 'wb') as f:
+        f.write(filled.encode('utf-8'))
+    return summary
+
+
+def summary_lines(summary, target):
+    """What the teacher reads after the run: where the file is, and every row not graded."""
+    lines = ['worksheet: %d grade(s) written into %s; import it in Moodle (Assignment > View all '
+             'submissions > Grading action: Upload grading worksheet)' % (len(summary['graded']), target)]
+    for student, why in summary['kept']:
+        lines.append('  left as it was: %s (%s)' % (student, why))
+    for student, why in summary['unmatched']:
+        lines.append('  NOT MATCHED: %s (%s)' % (student, why))
+    if summary['no_submission']:
+        lines.append('  in the worksheet, no graded submission: %s' % ', '.join(summary['no_submission']))
+    return lines

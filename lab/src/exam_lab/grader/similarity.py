@@ -1,0 +1,290 @@
+"""Similarity across a class: pairs of submissions whose code is suspiciously alike. No rospy here.
+
+The detector is copydetect (PyPI, pinned :data:`VERSION`): winnowing over the tokens of the code, in
+the style of MOSS, with names, strings and comments normalised away (renaming variables or rewording
+comments does not hide a copy) and a boilerplate set whose fingerprints never count. It is installed
+on first use into a virtual environment of its own (``$EXAM_WS/similarity-venv``, seeing Debian's
+packages), and runs there as ``python -m exam_lab.grader.similarity JOB.json``; the grader's own
+Python needs nothing new.
+
+What every student got is boilerplate: ``catkin_create_pkg``'s CMakeLists.txt and package.xml (made
+anew here, for both sheets), the launch file's skeleton, and the code of the sheets' packages (the
+drones, which students read and copy idioms from). Only a package's code is compared: Python, launch
+and YAML files, CMakeLists.txt and package.xml.
+
+A pair is flagged when the code of one of the two is at least :data:`THRESHOLD` alike the other's (the
+share of its fingerprinted tokens found in the other). It flags; it never changes a grade.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+from exam_lab.grader import unpack
+
+VERSION = '0.5.0'
+#: copydetect's noise threshold (k, characters of normalised code) and window.
+NOISE = 25
+WINDOW = 4
+#: Share of a submission's fingerprinted code found in the other's, from which a pair is flagged.
+THRESHOLD = 0.5
+#: Files compared, and the most bytes read of one.
+CODE_SUFFIXES = ('.py', '.launch', '.yaml', '.yml', '.xml')
+CODE_NAMES = ('CMakeLists.txt',)
+MAX_FILE_BYTES = 200 * 1024
+#: Languages by suffix, for files pygments does not know by name.
+LANGUAGES = {'.launch': 'xml', '.xml': 'xml', '.txt': 'cmake', '.yaml': 'yaml', '.yml': 'yaml', '.py': 'python'}
+#: The launch file's skeletons students write from the sheets' question 12 (the drone's node or its
+#: launch file, the exam node, the threshold as a parameter or an argument, in the usual orders).
+LAUNCH_TEMPLATES = [
+    """<launch>
+  <node pkg="{drone}" name="{drone}" type="{node}" output="screen"/>
+  <node pkg="exam" name="exam" type="exam_node.py" output="screen">
+    <param name="threshold" value="{limit}" />
+  </node>
+</launch>
+""",
+    """<launch>
+  <param name="threshold" value="{limit}" />
+  <node pkg="{drone}" name="{drone}" type="{node}" output="screen"/>
+  <node pkg="exam" name="exam" type="exam_node.py" output="screen"/>
+</launch>
+""",
+    """<launch>
+  <arg name="threshold" default="{limit}" />
+  <include file="$(find {drone})/launch/{drone}.launch" />
+  <node pkg="exam" type="exam_node.py" name="exam_node" output="screen">
+    <param name="threshold" value="$(arg threshold)" />
+  </node>
+</launch>
+""",
+]
+#: Packages whose code every student had (the sheets' drones).
+SHEET_PACKAGES = ('mydrone', 'submarinedrone', 'drone_sim')
+
+
+class SimilarityError(Exception):
+    """The detector could not be installed or run."""
+
+
+def venv_dir():
+    from exam_lab.grader import runner
+    return os.path.join(runner.workspace(), 'similarity-venv')
+
+
+def ensure_venv(path=None):
+    """The Python of the detector's virtual environment, made (with copydetect VERSION) when missing."""
+    path = path or venv_dir()
+    python = os.path.join(path, 'bin', 'python')
+    probe = [python, '-c', 'import importlib.metadata as m; print(m.version("copydetect"))']
+    try:
+        if os.path.exists(python) and subprocess.run(probe, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                                     timeout=60).stdout.decode().strip() == VERSION:
+            return python
+    except (OSError, subprocess.SubprocessError):
+        pass
+    log = path + '.log'
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(log, 'w') as out:
+        for argv in ([sys.executable, '-m', 'venv', '--system-site-packages', '--clear', path],
+                     [python, '-m', 'pip', 'install', '-q', 'copydetect==%s' % VERSION]):
+            try:
+                done = subprocess.run(argv, stdout=out, stderr=subprocess.STDOUT, timeout=600)
+            except (OSError, subprocess.SubprocessError) as err:
+                raise SimilarityError('%s failed: %s (log: %s)' % (' '.join(argv[:4]), err, log))
+            if done.returncode != 0:
+                raise SimilarityError('%s failed (exit %d); log: %s' % (' '.join(argv[:4]), done.returncode, log))
+    return python
+
+
+def code_files(package):
+    """The package's files that are compared, relative to it."""
+    found = []
+    for dirpath, dirnames, filenames in os.walk(package):
+        dirnames[:] = sorted(d for d in dirnames if not d.startswith('.') and d not in ('build', 'devel'))
+        for name in sorted(filenames):
+            full = os.path.join(dirpath, name)
+            if (name.endswith(CODE_SUFFIXES) or name in CODE_NAMES) and not os.path.islink(full) \
+                    and os.path.getsize(full) <= MAX_FILE_BYTES:
+                found.append(os.path.relpath(full, package))
+    return sorted(found)
+
+
+def stage(submissions, target):
+    """Copy each submission's package code into ``target/<n>/``.
+
+    :param submissions: ``[(name, folder or zip)]``.
+    :returns: ``({name: staged folder}, [notes on submissions left out])``.
+    """
+    staged, notes = {}, []
+    for index, (name, path) in enumerate(submissions):
+        notes_here = []
+        try:
+            package = unpack.open_submission(path, os.path.join(target, 'unpacked-%d' % index), notes_here)
+        except Exception as err:  # a refused or odd upload is compared by nobody, and said so
+            notes.append('%s: not compared (%s)' % (name, err))
+            continue
+        folder = os.path.join(target, 'code', str(index))
+        for relative in code_files(package):
+            os.makedirs(os.path.dirname(os.path.join(folder, relative)), exist_ok=True)
+            shutil.copyfile(os.path.join(package, relative), os.path.join(folder, relative))
+        if os.path.isdir(folder):
+            staged[name] = folder
+        else:
+            notes.append('%s: no code to compare' % name)
+    return staged, notes
+
+
+def boilerplate(target):
+    """Write what every student got into ``target``; return it."""
+    os.makedirs(target, exist_ok=True)
+    for drone in ('mydrone', 'submarinedrone'):
+        where = os.path.join(target, 'catkin_create_pkg-%s' % drone)
+        os.makedirs(where)
+        try:
+            subprocess.run(['catkin_create_pkg', 'exam', 'rospy', 'std_msgs', drone], cwd=where, timeout=60,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        except (OSError, subprocess.SubprocessError):
+            pass  # without catkin_create_pkg, its files count like any other
+    for index, template in enumerate(LAUNCH_TEMPLATES):
+        for drone, node, limit in (('mydrone', 'mydrone_node.py', 1300), ('submarinedrone', 'submarine_drone_node.py', 150)):
+            with open(os.path.join(target, 'template-%d-%s.launch' % (index, drone)), 'w') as f:
+                f.write(template.format(drone=drone, node=node, limit=limit))
+    import rospkg
+    packs = rospkg.RosPack()
+    for name in SHEET_PACKAGES:
+        try:
+            source = packs.get_path(name)
+        except rospkg.ResourceNotFound:
+            continue
+        for relative in code_files(source):
+            if '/test/' in '/' + relative:
+                continue
+            os.makedirs(os.path.dirname(os.path.join(target, name, relative)), exist_ok=True)
+            shutil.copyfile(os.path.join(source, relative), os.path.join(target, name, relative))
+    return target
+
+
+def check(submissions, out_dir, python=None):
+    """Compare every pair of ``submissions`` (``[(name, folder or zip)]``); write
+    ``out_dir/similarity.json`` and return it: ``{"pairs": [...], "students", "threshold", "notes"}``
+    or ``{"error": why}`` when the detector could not run (the grades stand either way)."""
+    scratch = tempfile.mkdtemp(prefix='similarity-')
+    try:
+        staged, notes = stage(submissions, scratch)
+        job = {'students': staged, 'boilerplate': boilerplate(os.path.join(scratch, 'boilerplate')),
+               'noise': NOISE, 'window': WINDOW, 'threshold': THRESHOLD, 'result': os.path.join(scratch, 'result.json')}
+        with open(os.path.join(scratch, 'job.json'), 'w') as f:
+            json.dump(job, f)
+        try:
+            python = python or ensure_venv()
+            env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+                [os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))] +
+                [p for p in os.environ.get('PYTHONPATH', '').split(os.pathsep) if p]))
+            done = subprocess.run([python, '-m', 'exam_lab.grader.similarity', os.path.join(scratch, 'job.json')],
+                                  env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=900)
+            if done.returncode != 0 or not os.path.isfile(job['result']):
+                raise SimilarityError('the detector failed (exit %d): %s' % (
+                    done.returncode, done.stdout.decode('utf-8', 'replace')[-1500:]))
+            with open(job['result']) as f:
+                result = json.load(f)
+        except (SimilarityError, subprocess.SubprocessError) as err:
+            result = {'error': str(err)}
+        result['notes'] = notes
+        with open(os.path.join(out_dir, 'similarity.json'), 'w') as f:
+            json.dump(result, f, indent=1, sort_keys=True)
+        return result
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+# --- inside the detector's environment -------------------------------------------------------------
+
+def _fingerprints(folder, noise, window, hashes):
+    from copydetect import CodeFingerprint
+    prints = {}
+    for relative in code_files(folder):
+        language = LANGUAGES.get(os.path.splitext(relative)[1], 'cmake')
+        try:
+            fp = CodeFingerprint(os.path.join(folder, relative), noise, window, hashes, language=language)
+        except (UnicodeDecodeError, ValueError):
+            continue
+        if fp.token_coverage > 0:
+            prints[relative] = fp
+    return prints
+
+
+def compare(job):
+    """The detector's work (runs where copydetect is installed): every pair of students, every pair of
+    their files of one language; a student's score is the share of its fingerprinted code found in
+    the other's (each file counted by its best match)."""
+    import numpy as np
+    from copydetect import CodeFingerprint, compare_files
+    from copydetect.utils import highlight_overlap
+
+    hashes = []
+    for relative in code_files(job['boilerplate']):
+        language = LANGUAGES.get(os.path.splitext(relative)[1], 'cmake')
+        try:
+            hashes.extend(CodeFingerprint(os.path.join(job['boilerplate'], relative), job['noise'], 1,
+                                          language=language).hashes)
+        except (UnicodeDecodeError, ValueError):
+            continue
+    hashes = np.unique(np.array(hashes))
+    prints = {name: _fingerprints(folder, job['noise'], job['window'], hashes)
+              for name, folder in sorted(job['students'].items())}
+    names = sorted(prints)
+    pairs = []
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            best_a, best_b, matches = {}, {}, []
+            for file_a, fp_a in prints[a].items():
+                for file_b, fp_b in prints[b].items():
+                    if LANGUAGES.get(os.path.splitext(file_a)[1]) != LANGUAGES.get(os.path.splitext(file_b)[1]):
+                        continue
+                    overlap, (sim_a, sim_b), (slices_a, slices_b) = compare_files(fp_a, fp_b)
+                    if overlap <= 0:
+                        continue
+                    tokens_a = sim_a * fp_a.token_coverage
+                    tokens_b = sim_b * fp_b.token_coverage
+                    best_a[file_a] = max(best_a.get(file_a, 0.0), tokens_a)
+                    best_b[file_b] = max(best_b.get(file_b, 0.0), tokens_b)
+                    matches.append((float(max(tokens_a, tokens_b)), file_a, file_b, float(sim_a), float(sim_b),
+                                    slices_a, slices_b, fp_a, fp_b))
+            cover_a = sum(fp.token_coverage for fp in prints[a].values()) or 1
+            cover_b = sum(fp.token_coverage for fp in prints[b].values()) or 1
+            score_a, score_b = sum(best_a.values()) / cover_a, sum(best_b.values()) / cover_b
+            job.setdefault('scores', []).append([a, b, float(score_a), float(score_b)])
+            if max(score_a, score_b) < job['threshold']:
+                continue
+            matches.sort(key=lambda m: -m[0])
+            files = []
+            for _, file_a, file_b, sim_a, sim_b, slices_a, slices_b, fp_a, fp_b in matches[:3]:
+                html_a, _ = highlight_overlap(fp_a.raw_code, slices_a, "<span class='highlight-red'>", '</span>',
+                                              escape_html=True)
+                html_b, _ = highlight_overlap(fp_b.raw_code, slices_b, "<span class='highlight-green'>",
+                                              '</span>', escape_html=True)
+                files.append({'file_a': file_a, 'file_b': file_b, 'sim_a': sim_a, 'sim_b': sim_b,
+                              'html_a': html_a, 'html_b': html_b})
+            pairs.append({'a': a, 'b': b, 'score_a': float(score_a), 'score_b': float(score_b), 'files': files})
+    pairs.sort(key=lambda p: -max(p['score_a'], p['score_b']))
+    return {'pairs': pairs, 'students': len(names), 'threshold': job['threshold'],
+            'detector': 'copydetect ' + VERSION, 'scores': job.get('scores', [])}
+
+
+def main(argv):
+    if len(argv) != 1:
+        sys.stderr.write('usage: python -m exam_lab.grader.similarity JOB.json\n')
+        return 2
+    with open(argv[0]) as f:
+        job = json.load(f)
+    result = compare(job)
+    with open(job['result'], 'w') as f:
+        json.dump(result, f)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))

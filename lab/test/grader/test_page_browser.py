@@ -1,0 +1,128 @@
+"""The teacher's page in a real browser: a class of two graded by the real grader (about 1.5 minutes),
+its desk written (plots, similarity, page), then OUT/index.html opened by headless Chromium from the
+file system: no console message, one table row per student, every flight plot an image that loaded,
+the table sorts, the screenshot is a picture of the page.
+
+Chromium is installed by tools/install_deps.sh (Debian's ``chromium``); without it the test is
+skipped, saying so. GRADER_PAGE_SCREENSHOT=<path> keeps the screenshot (docs/figures/grader_page.png).
+"""
+import json
+import os
+import re
+import shutil
+import subprocess
+
+import pytest
+
+from exam_lab.grader import desk, runner
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SUBMISSIONS = os.path.join(HERE, 'submissions')
+CHROMIUM = shutil.which('chromium') or shutil.which('chromium-browser')
+STUDENTS = {'Jane Doe_101_assignsubmission_file_': 'good_student', 'Paul Martin_102_assignsubmission_file_': 'no_kelvin'}
+#: Appended to a copy of the page: after load, what the browser made of it, into the DOM it dumps.
+CHECK = """<script>
+window.addEventListener('load', function () {
+  var images = Array.prototype.map.call(document.images, function (img) {
+    return [img.getAttribute('src'), img.complete, img.naturalWidth, img.naturalHeight];
+  });
+  var table = document.querySelector('table.scores');
+  var names = function () {
+    return Array.prototype.map.call(table.tBodies[0].rows, function (row) { return row.cells[0].textContent; });
+  };
+  var headers = Array.prototype.slice.call(table.tHead.rows[0].cells);
+  var total = headers[headers.length - 1];
+  total.click();
+  var down = names();
+  total.click();
+  var up = names();
+  document.body.setAttribute('data-check', JSON.stringify(
+    {images: images, rows: table.tBodies[0].rows.length, down: down, up: up}));
+});
+</script>"""
+
+pytestmark = pytest.mark.skipif(CHROMIUM is None, reason='NO BROWSER: chromium is not installed '
+                                '(tools/install_deps.sh installs it); the page was not tested in a browser')
+
+
+@pytest.fixture(scope='module')
+def graded(tmp_path_factory):
+    root = tmp_path_factory.mktemp('page')
+    klass = root / 'class'
+    for folder, package in STUDENTS.items():
+        shutil.copytree(os.path.join(SUBMISSIONS, package, 'exam'), str(klass / folder / 'exam'))
+    _two_page_pdf(str(klass / 'Jane Doe_101_assignsubmission_file_' / 'report.pdf'))
+    out = str(root / 'out')
+    records = runner.grade_class(str(klass), out, jobs=2)
+    lines = desk.finish(out, records, similar=desk.class_similarity(str(klass), out, records))
+    return out, records, lines
+
+
+def _two_page_pdf(path):
+    import matplotlib
+    matplotlib.use('Agg')
+    from matplotlib import pyplot as plt
+    from matplotlib.backends.backend_pdf import PdfPages
+    with PdfPages(path) as pdf:
+        for page in (1, 2):
+            figure = plt.figure()
+            figure.text(0.4, 0.5, 'page %d' % page)
+            pdf.savefig(figure)
+            plt.close(figure)
+
+
+def chromium(args, page, timeout=120):
+    """Run headless Chromium on ``page``; return (stdout, the console messages it logged)."""
+    done = subprocess.run([CHROMIUM, '--headless', '--no-sandbox', '--disable-gpu', '--no-first-run',
+                           '--enable-logging=stderr', '--v=0', '--virtual-time-budget=10000',
+                           '--user-data-dir=%s' % os.path.join(os.path.dirname(page), '.chromium')] + args +
+                          ['file://' + page], stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=timeout)
+    console = [l for l in done.stderr.decode('utf-8', 'replace').splitlines() if ':CONSOLE' in l]
+    return done.stdout.decode('utf-8', 'replace'), console
+
+
+def test_console_messages_are_captured(tmp_path):
+    """The capture the next test relies on: a page that logs an error is seen to."""
+    page = tmp_path / 'bad.html'
+    page.write_text('<!DOCTYPE html><html><body><script>console.error("broken page")</script></body></html>')
+    _, console = chromium(['--dump-dom'], str(page))
+    assert any('broken page' in line for line in console), console
+
+
+def test_the_page_in_a_browser(graded):
+    out, records, lines = graded
+    with open(os.path.join(out, 'index.html')) as f:
+        text = f.read()
+    check = os.path.join(out, 'check.html')
+    with open(check, 'w') as f:
+        f.write(text.replace('</body>', CHECK + '</body>'))
+    dom, console = chromium(['--dump-dom'], check)
+    assert console == []
+    _, console = chromium(['--dump-dom'], os.path.join(out, 'index.html'))
+    assert console == [], 'the page itself logs: %s' % console
+    found = re.search(r'data-check="([^"]*)"', dom)
+    assert found, dom[-2000:]
+    got = json.loads(found.group(1).replace('&quot;', '"').replace('&amp;', '&'))
+    assert got['rows'] == len(records) == 2
+    assert len(got['images']) == 2
+    for src, complete, width, height in got['images']:
+        assert complete and width > 600 and height > 400, (src, width, height)
+    totals = {r['student']: r['total'] for r in records}
+    assert [totals[n] for n in got['down']] == sorted(totals.values(), reverse=True)
+    assert [totals[n] for n in got['up']] == sorted(totals.values())
+    assert 'report.pdf (2 pages)' in text
+    assert any(l.startswith('similarity:') for l in lines)
+
+
+def test_a_screenshot_of_the_page(graded, tmp_path):
+    out, _, _ = graded
+    shot = str(tmp_path / 'page.png')
+    chromium(['--hide-scrollbars', '--window-size=1280,2300', '--screenshot=%s' % shot],
+             os.path.join(out, 'index.html'))
+    with open(shot, 'rb') as f:
+        head = f.read(24)
+    assert head[:8] == b'\x89PNG\r\n\x1a\n'
+    assert (int.from_bytes(head[16:20], 'big'), int.from_bytes(head[20:24], 'big')) == (1280, 2300)
+    assert os.path.getsize(shot) > 50000  # a page with plots, not a blank one
+    if os.environ.get('GRADER_PAGE_SCREENSHOT'):
+        shutil.copyfile(shot, os.environ['GRADER_PAGE_SCREENSHOT'])

@@ -1,0 +1,255 @@
+"""The teacher's desk on synthetic records: Gradescope's results.json, the page (one row per student,
+the ones needing the teacher first, every plot it names written), the flight plot, PDF page counts,
+progress lines and time estimates, the probe's trace. No master, no browser (the browser test is
+lab/test/grader/test_page_browser.py)."""
+import io
+import json
+import os
+import re
+from html.parser import HTMLParser
+
+import pytest
+
+from exam_lab.grader import desk, documents, flightplot, gradescope, page, progress, report
+from exam_lab.grader.sheets import ITEMS
+
+T0 = 1000.0
+
+
+def record(student, lost=None, status='graded', reason='', participant=None):
+    lost = lost or {}
+    items = [{'id': i, 'points': top - lost.get(i, 0.0), 'max': top,
+              'evidence': 'why %s <lost> "x"' % i if lost.get(i) else 'ok'} for i, (top, _) in ITEMS.items()]
+    return dict(report.grade_record(student, 'altitude', items, ['hint'], {'seconds': 40.0, 'participant': participant}),
+                status=status, status_reason=reason)
+
+
+def probe_result(kind='main'):
+    """A probe result as the probe writes one: schedule, calls, trace."""
+    if kind == 'main':
+        schedule = {'rest': T0 + 5, 'short_up': T0 + 8, 'short_down': T0 + 11, 'long_up': T0 + 13.5,
+                    'long_down': T0 + 21, 'end': T0 + 23.5}
+        calls = [[T0 + 18.5, 'WARNING'], [T0 + 21.0, 'NORMAL']]
+    else:
+        schedule = {'start': T0 + 1, 'step': T0 + 4, 'end': T0 + 11.5}
+        calls = [[T0 + 9.0, 'WARNING']]
+    oracle = [[t, 1430.0 if k.endswith('up') or k == 'step' else 1170.0] for k, t in sorted(schedule.items())
+              if k != 'end']
+    published = [[T0 + 1 + 0.1 * i, 1300.0 + 100 * ((i // 30) % 2)] for i in range(220)]
+    return {'kind': kind, 'sheet': 'altitude', 'threshold': 1300.0, 't0': T0, 'schedule': schedule,
+            'calls': calls, 'trace': {'published': published, 'oracle': oracle}}
+
+
+class Collector(HTMLParser):
+    """The page's elements; every tag must close in order (a browser would forgive it, we do not)."""
+    VOID = ('meta', 'img', 'br', 'input')
+
+    def __init__(self):
+        HTMLParser.__init__(self)
+        self.stack, self.rows, self.images, self.ids, self.links = [], 0, [], [], []
+        self.table = None
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if tag not in self.VOID:
+            self.stack.append(tag)
+        if tag == 'table':
+            self.table = attrs.get('class')
+        if tag == 'tr' and 'tbody' in self.stack and self.table == 'scores':
+            self.rows += 1
+        if tag == 'img':
+            self.images.append(attrs['src'])
+        if 'id' in attrs:
+            self.ids.append(attrs['id'])
+        if tag == 'a' and attrs.get('href', '').startswith('#'):
+            self.links.append(attrs['href'][1:])
+
+    def handle_startendtag(self, tag, attrs):
+        self.handle_starttag(tag, attrs)
+        if tag not in self.VOID:
+            self.stack.pop()
+
+    def handle_endtag(self, tag):
+        assert self.stack and self.stack[-1] == tag, (tag, self.stack[-5:])
+        self.stack.pop()
+
+
+def parsed(text):
+    collector = Collector()
+    collector.feed(text)
+    collector.close()
+    assert collector.stack == [], collector.stack
+    return collector
+
+
+def test_gradescope_results_follow_the_schema():
+    got = gradescope.results(record('Jane', {'Q11': 1.5}))
+    assert got['score'] == 15.5
+    assert [t['name'].split(':')[0] for t in got['tests']] == list(ITEMS)
+    q11 = got['tests'][2]
+    assert (q11['score'], q11['max_score'], q11['status']) == (2.5, 4.0, 'failed')
+    assert q11['output'].startswith('why Q11')
+    assert set(got['tests'][0]) >= {'name', 'score', 'max_score', 'output'}
+    assert 'visibility' not in got
+    held = gradescope.results(record('Bob', {'runs': 2}, status='not graded', reason='crash'))
+    assert held['visibility'] == 'hidden' and 'crash' in held['output']
+
+
+def test_page_has_one_row_per_student_and_the_teacher_first(tmp_path):
+    records = [record('Jane Doe', participant=101), record('Paul <Martin>', {'Q11': 1.5}, participant=102),
+               record('Ada', {'runs': 2, 'Q10': 2}, status='not graded', reason='the build failed'),
+               record('Bob', {'Q13': 2}, status='needs a hand grade', reason='odd design')]
+    entries = {'Jane Doe': {'plot': 'Jane Doe/flight.png', 'grade_md': report.markdown(records[0]),
+                            'folder': 'Jane Doe', 'documents': [{'name': 'report.pdf', 'pages': 3}]}}
+    pairs = [{'a': 'Jane Doe', 'b': 'Bob', 'score_a': 0.9, 'score_b': 0.8,
+              'files': [{'file_a': 'scripts/n.py', 'file_b': 'scripts/m.py', 'sim_a': 0.9, 'sim_b': 0.8,
+                         'html_a': "<span class='highlight-red'>x = 1</span>", 'html_b': 'y'}]}]
+    text = page.render(records, 'Class', entries, pairs, ['worksheet: 2 grades'])
+    got = parsed(text)
+    assert got.rows == 4
+    assert got.images == ['Jane Doe/flight.png']
+    for target in got.links:
+        assert target in got.ids, target
+    first = text[text.index('id="first"'):text.index('id="histogram"')]
+    assert 'Ada' in first and 'Bob' in first and 'Jane Doe' not in first
+    assert 'Paul &lt;Martin&gt;' in text and 'Paul <Martin>' not in text
+    assert 'report.pdf (3 pages)' in text
+    assert 'Jane Doe and Bob: 90 % / 80 % alike' in text
+    assert 'http' not in text.replace('http://www.w3.org/2000/svg', '')  # no network
+    assert text.count('<rect ') == 18  # the histogram: one bar per point, 0 to 17
+
+
+def test_markdown_of_a_grade_renders_its_table():
+    html = page.markdown_html(report.markdown(record('Jane', {'Q11': 1.5})))
+    assert html.count('<tr>') == 1 + len(ITEMS) + 1  # header, items, total
+    assert '<strong>15.5 / 17</strong>' in html
+    assert 'why Q11 &lt;lost&gt; &quot;x&quot;' in html
+    parsed('<div>%s</div>' % html)
+
+
+def test_flight_plot_is_a_png_of_both_runs(tmp_path):
+    path = str(tmp_path / 'flight.png')
+    assert flightplot.draw([('main', probe_result()), ('threshold', probe_result('threshold'))], path, 'Jane')
+    with open(path, 'rb') as f:
+        head = f.read(24)
+    assert head[:8] == b'\x89PNG\r\n\x1a\n'
+    width, height = int.from_bytes(head[16:20], 'big'), int.from_bytes(head[20:24], 'big')
+    assert width > 600 and height > 2 * 200
+    assert not flightplot.draw([('main', {'calls': [], 'trace': {}})], str(tmp_path / 'none.png'))
+    assert not os.path.exists(str(tmp_path / 'none.png'))
+
+
+def test_legs_of_a_schedule():
+    got = flightplot.legs(probe_result()['schedule'])
+    assert [(n, s - T0, e - T0, side) for n, s, e, side in got] == [
+        ('rest', 5, 8, 'below'), ('short_up', 8, 11, 'above'), ('short_down', 11, 13.5, 'below'),
+        ('long_up', 13.5, 21, 'above'), ('long_down', 21, 23.5, 'below')]
+
+
+def test_finish_writes_the_desk_for_a_class(tmp_path):
+    out = str(tmp_path)
+    records = [record('Jane Doe', participant=101), record('Paul', {'Q11': 1.5}, participant=102)]
+    for r in records:
+        logs = os.path.join(out, r['student'], 'logs')
+        os.makedirs(logs)
+        with open(os.path.join(logs, 'probe-main.json'), 'w') as f:
+            json.dump(probe_result(), f)
+        report.write_grade(os.path.join(out, r['student']), r)
+    worksheet = tmp_path / 'ws.csv'
+    worksheet.write_text('\ufeffIdentifier,Full name,Grade,Maximum grade,Last modified (grade),Feedback comments\n'
+                         '"Participant 101","Jane Doe",,17.00,-,\n', encoding='utf-8')
+    lines = desk.finish(out, records, similar={'pairs': [], 'students': 2}, worksheet=str(worksheet))
+    assert any('1 grade(s) written' in l for l in lines)
+    assert any('NOT MATCHED: Paul' in l for l in lines)
+    for r in records:
+        assert os.path.isfile(os.path.join(out, r['student'], 'flight.png'))
+        with open(os.path.join(out, r['student'], 'results.json')) as f:
+            assert json.load(f)['score'] == r['total']
+    with open(os.path.join(out, 'index.html')) as f:
+        got = parsed(f.read())
+    assert got.images == ['Jane Doe/flight.png', 'Paul/flight.png']
+    assert os.path.isfile(os.path.join(out, 'ws-filled.csv'))
+
+
+def test_pdf_pages(tmp_path):
+    import matplotlib
+    matplotlib.use('Agg')
+    from matplotlib import pyplot as plt
+    from matplotlib.backends.backend_pdf import PdfPages
+    path = str(tmp_path / 'report.pdf')
+    with PdfPages(path) as pdf:
+        for _ in range(3):
+            figure = plt.figure()
+            pdf.savefig(figure)
+            plt.close(figure)
+    assert documents.pdf_pages(path) == 3
+    (tmp_path / 'fake.pdf').write_bytes(b'not a pdf')
+    assert documents.pdf_pages(str(tmp_path / 'fake.pdf')) is None
+    found = documents.documents(str(tmp_path))
+    assert found == [{'name': 'fake.pdf', 'pages': None}, {'name': 'report.pdf', 'pages': 3}]
+    facts = documents.submission_facts(str(tmp_path))
+    assert facts['participant'] is None and len(facts['documents']) == 2
+
+
+class Clock(object):
+    def __init__(self):
+        self.now = 0.0
+
+    def __call__(self):
+        return self.now
+
+
+def test_time_left_estimate():
+    assert progress.estimate_left([], [], 4, 2) == pytest.approx(2 * 45.0)
+    assert progress.estimate_left([40.0, 60.0], [10.0], 2, 2) == pytest.approx((2 * 50 + 40) / 2)
+    assert progress.estimate_left([50.0], [70.0], 0, 2) == pytest.approx(5.0)  # overdue: a tenth
+    assert progress.estimate_left([50.0], [], 0, 2) == 0.0
+
+
+def test_class_progress_on_a_terminal_and_off():
+    clock, stream = Clock(), io.StringIO()
+    shown = progress.ClassProgress(2, stream, live=True, clock=clock)
+    shown.total = 3  # begin() without its redraw thread
+    shown.started('Jane')
+    clock.now = 12.0
+    shown.step('Jane', 'main flight')
+    assert shown.line() == '[0 of 3 graded] now: Jane (main flight, 12 s); about 1 min 02 s left'
+    shown.finished(dict(record('Jane'), seconds=40.0))
+    shown.close()
+    text = stream.getvalue()
+    assert 'graded Jane: 17.0/17.0, graded (40 s)\n' in text and '\r\x1b[K' in text
+    quiet = io.StringIO()
+    off = progress.ClassProgress(2, quiet, live=False, clock=clock)
+    off.begin(['Jane'])
+    off.started('Jane')
+    off.step('Jane', 'build')
+    off.finished(dict(record('Jane'), seconds=40.0))
+    off.close()
+    assert quiet.getvalue() == 'graded Jane: 17.0/17.0, graded (40 s)\n'
+
+
+def test_steps_seen_in_the_log_folder(tmp_path):
+    seen = []
+    with progress.watching(str(tmp_path), seen.append):
+        (tmp_path / 'build.log').write_text('')
+        (tmp_path / 'plan-main.json').write_text('{}')
+        from exam_lab.harness.wait import wait_until
+        assert wait_until(lambda: len(seen) == 2, 10.0, period=0.05)
+    assert seen == ['build', 'main flight']
+    stream = io.StringIO()
+    steps = progress.StepProgress(stream, live=True, clock=Clock())
+    steps('unpack')
+    assert stream.getvalue() == '   0.0 s  unpack\n'
+    off = io.StringIO()
+    progress.StepProgress(off, live=False)('unpack')
+    assert off.getvalue() == ''
+
+
+def test_the_probe_trace_is_compact():
+    from exam_lab.grader import probe
+    samples = [(T0 + 0.01 * i, float(i)) for i in range(1000)] + [(T0 + 11.0, float('nan'))]
+    got = probe.trace(samples, [[T0, 1170.0], [T0 + 3.0, 1430.123456]])
+    assert 100 <= len(got['published']) <= 112
+    assert got['published'][-1] == [T0 + 11.0, None]
+    assert got['oracle'][1] == [T0 + 3.0, 1430.123]
+    json.dumps(got, allow_nan=False)

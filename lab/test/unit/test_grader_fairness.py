@@ -1,0 +1,186 @@
+"""One mistake, one loss; evidence never false; a status for every student. The rubric, the probe's
+leg check and the status on synthetic measurements (the stale-reading case included)."""
+import pytest
+
+from exam_lab.grader import launch, probe, report, rubric, session, source
+
+from test_grader_rubric import STATIC, SCHEDULE, lost, measured, points
+
+
+def main_of(session_record):
+    return session_record['runs'][0]['probe']
+
+
+def with_legs(session_record, reached=None, values=None):
+    """The main run's legs as the probe checks them: each reached 0.1 s after its input changed,
+    unless ``reached`` says otherwise (None: never reached)."""
+    reached = reached or {}
+    legs = {}
+    for name in ('rest', 'short_up', 'short_down', 'long_up', 'long_down'):
+        side = 'above' if name.endswith('up') else 'below'
+        at = reached.get(name, SCHEDULE[name] + 0.1)
+        first = (values or {}).get(name, 1430.0 if side == 'above' else 1170.0)
+        legs[name] = {'side': side, 'reached': at, 'off_side': 0, 'first': first, 'last': first, 'samples': 30}
+    main_of(session_record)['legs'] = legs
+    main_of(session_record)['threshold'] = 1300.0
+    return session_record
+
+
+def test_the_stale_reading_leg_is_not_reached():
+    """A node blocked 5 s in a callback keeps publishing 1040 m while the grader flies it "above":
+    the leg is not reached, and nothing is judged on it."""
+    samples = [(10.0 + 0.1 * i, 1040.0) for i in range(75)]  # the whole long excursion, stale
+    leg = probe.leg_check(samples, 1300.0, 'above', 10.0, 17.5)
+    assert leg['reached'] is None and leg['first'] == 1040.0 and leg['samples'] == 75
+    record = with_legs(measured(calls=[[13.0, 'WARNING'], [16.1, 'NORMAL']]), reached={'long_up': None},
+                       values={'long_up': 1040.0})
+    items = {i['id']: i for i in rubric.score('altitude', STATIC, record)}
+    for item_id in ('Q13', 'Q14b'):
+        assert items[item_id]['points'] == 0
+        assert 'never went above the threshold 1300 (it published 1040.0 to 1040.0)' in items[item_id]['evidence']
+        assert 'stayed above' not in items[item_id]['evidence'], 'no false evidence'
+    status, reason = rubric.status(STATIC, record)
+    assert status == rubric.HAND_GRADE and 'long excursion above' in reason
+
+
+def test_a_leg_reached_late_counts_from_the_node_and_says_so():
+    samples = [(10.0 + 0.1 * i, 1040.0 if i < 20 else 1430.0) for i in range(75)]
+    leg = probe.leg_check(samples + [(17.6, 1040.0)], 1300.0, 'above', 10.0, 17.5)
+    assert leg['reached'] == pytest.approx(12.0) and leg['off_side'] == 0 and leg['first'] == 1040.0
+    leg = probe.leg_check(samples + [(17.4, 1040.0)], 1300.0, 'above', 10.0, 17.5)
+    assert leg['off_side'] == 1
+    assert not probe.on_side(float('nan'), 1300.0, 'below') and probe.on_side(1300.0, 1300.0, 'below')
+
+
+def test_legs_reached_change_nothing_for_a_good_node():
+    assert lost(with_legs(measured())) == {}
+    assert rubric.status(STATIC, with_legs(measured())) == (rubric.GRADED, '')
+
+
+def test_a_blocked_node_loses_the_short_excursion_only():
+    """sleep(5) in the callback: its own value stays above 2 s after the short excursion; it warns."""
+    calls = [[3.0 + 5.0, 'WARNING'], [8.1, 'NORMAL'], [8.5 + 5.0, 'WARNING'], [16.1, 'NORMAL']]
+    record = with_legs(measured(calls=calls), reached={'short_down': 8.0})
+    assert lost(record) == {'Q14b': 1.0}
+    q14b = [i for i in rubric.score('altitude', STATIC, record) if i['id'] == 'Q14b'][0]['evidence']
+    assert 'stayed above 2.0 s longer' in q14b
+
+
+def test_a_late_warning_costs_the_delay_only():
+    """500 ticks at 10 Hz: the flight waited for the WARNING (50 s), so Q13 and Q14a are judged."""
+    schedule = dict(SCHEDULE, long_down=8.5 + 52.5, end=8.5 + 55.0)
+    calls = [[8.5 + 50.0, 'WARNING'], [61.05, 'NORMAL']]
+    record = measured(calls=calls)
+    main_of(record)['schedule'] = schedule
+    assert lost(record) == {'Q14b': 1.5}
+    q13 = [i for i in rubric.score('altitude', STATIC, record) if i['id'] == 'Q13'][0]['evidence']
+    assert 'the WARNING came late, 50.0 s' in q13
+    assert session.warning_latency(main_of(record)) == pytest.approx(50.0)
+    assert session.warning_latency({'schedule': schedule, 'calls': []}) is None
+
+
+@pytest.mark.parametrize('kind', ['std_msgs/Float64', 'std_msgs/Int32', 'std_msgs/UInt16'])
+def test_any_numeric_type_on_the_right_topic(kind):
+    record = measured(output=('/altitude', kind))
+    assert lost(record) == {}
+    q11 = [i for i in rubric.score('altitude', STATIC, record) if i['id'] == 'Q11'][0]['evidence']
+    assert '/altitude %s, a numeric type' % kind in q11
+
+
+def test_a_launch_file_without_a_comment_gets_half():
+    static = dict(STATIC, launch=dict(STATIC['launch'], comments=0))
+    assert points(measured(), static)['Q12'] == 0.5
+    static = dict(STATIC, launch=dict(STATIC['launch'], comments=0, starts_drone=False))
+    assert points(measured(), static)['Q12'] == 0.0, 'no drone and no comment: two losses'
+    static = dict(STATIC, launch=dict(STATIC['launch'], comments=2, package='exam_pkg'))
+    q12 = [i for i in rubric.score('altitude', static, measured()) if i['id'] == 'Q12'][0]
+    assert q12['points'] == 1 and 'exam_pkg/exam_node.py' in q12['evidence']
+
+
+def test_launch_comments_and_a_package_named_otherwise(tmp_path):
+    pkg = tmp_path / 'exam_pkg'
+    (pkg / 'launch').mkdir(parents=True)
+    (pkg / 'launch' / 'a.launch').write_text('<launch><include file="$(find exam_pkg)/launch/b.launch"/>'
+                                             '<node pkg="exam_pkg" type="n.py" name="n"><param name="seuil" '
+                                             'value="1300"/></node></launch>')
+    (pkg / 'launch' / 'b.launch').write_text('<launch><!-- the drone --><node pkg="mydrone" '
+                                             'type="mydrone_node.py" name="d"/></launch>')
+    analysis = launch.analyse(str(pkg / 'launch' / 'a.launch'), str(pkg), 'exam_pkg')
+    assert [n.type for n in analysis.exam_nodes] == ['n.py'] and analysis.starts_drone('altitude')
+    assert analysis.comments() == 1
+    assert launch.threshold_param(analysis, 'altitude')[0].name == '/n/seuil'
+    assert launch.analyse(str(pkg / 'launch' / 'a.launch'), str(pkg)).exam_nodes == []
+
+
+TRACEBACK = ('[ INFO] started\nTraceback (most recent call last):\n'
+             '  File "exam/scripts/exam_node.py", line 26, in <module>\n'
+             '    threshold = rospy.get_param("~threshold")\n'
+             '  File "/opt/ros/noetic/lib/python3/dist-packages/rospy/client.py", line 467, in get_param\n'
+             "KeyError: '~threshold'\n[exam-1] process has died [pid 1, exit code 1]\n")
+
+
+def test_status_of_each_case():
+    fixes = ['scripts/exam_node.py was not executable: made executable']
+    assert rubric.status(STATIC, measured(), fixes) == (rubric.GRADED_WITH_FIXES, fixes[0])
+    refused = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: entry \'../x\' climbs'}
+    assert rubric.status({}, refused) == (rubric.NOT_GRADED, "submission refused: entry '../x' climbs")
+    failed = {'build': None, 'runs': [], 'error': 'the session did not finish within 540 s'}
+    assert rubric.status(STATIC, failed)[0] == rubric.NOT_GRADED
+    no_node = {'build': None, 'runs': [], 'no_node': True, 'error': 'no script of the package starts a ROS node'}
+    assert rubric.status(STATIC, no_node) == (rubric.HAND_GRADE, 'no script of the package starts a ROS node')
+    broken = measured()
+    broken['build'] = {'status': 2, 'seconds': 1.0, 'tail': 'make: ***\nCMake Error: no mydrone\n', 'timeout': 180}
+    assert rubric.status(STATIC, broken) == (rubric.HAND_GRADE, 'the package does not build: CMake Error: no mydrone')
+    crashed = measured(died=True)
+    main_of(crashed)['nodes'] = []
+    crashed['runs'][0]['launch']['tail'] = TRACEBACK
+    assert rubric.status(STATIC, crashed) == (
+        rubric.HAND_GRADE, "the node does not start: KeyError: '~threshold' at exam/scripts/exam_node.py:26")
+    python2 = dict(STATIC, python2=['scripts/exam_node.py:3: print statement'])
+    status, reason = rubric.status(python2, crashed)
+    assert status == rubric.HAND_GRADE and reason.startswith('Python 2 code (scripts/exam_node.py:3: print statement)')
+    assert rubric.status(python2, measured()) == (rubric.GRADED, ''), 'an unused Python 2 file does not stop a node'
+    assert set(rubric.STATUSES) == {'graded', 'graded with fixes', 'needs a hand grade', 'not graded'}
+
+
+def test_crash_summary():
+    assert rubric.crash_summary(TRACEBACK) == "KeyError: '~threshold' at exam/scripts/exam_node.py:26"
+    syntax = ('  File "exam/scripts/exam_node.py", line 19\n    print "x"\n    ^\n'
+              "SyntaxError: Missing parentheses in call to 'print'. Did you mean print(...)?\n")
+    assert rubric.crash_summary(syntax).startswith("SyntaxError: Missing parentheses in call to 'print'")
+    assert rubric.crash_summary(syntax).endswith('at exam/scripts/exam_node.py:19')
+    assert rubric.crash_summary('[ INFO] all good\n') == ''
+
+
+def test_python2_is_named(tmp_path):
+    pkg = tmp_path / 'exam'
+    (pkg / 'scripts').mkdir(parents=True)
+    (pkg / 'scripts' / 'old.py').write_text('import rospy\nprinter = 1\nprint "hello"\n')
+    (pkg / 'scripts' / 'new.py').write_text('print("hello")\nprint\n')
+    (pkg / 'scripts' / 'typo.py').write_text('def f(:\n    pass\n')
+    (pkg / 'scripts' / 'handler.py').write_text('try:\n    pass\nexcept ValueError, e:\n    pass\n')
+    assert source.python2_evidence(str(pkg)) == ['scripts/handler.py:3: "except E, e:"',
+                                                 'scripts/old.py:3: print statement']
+
+
+def test_calls_a_service(tmp_path):
+    pkg = tmp_path / 'exam'
+    (pkg / 'scripts').mkdir(parents=True)
+    (pkg / 'scripts' / 'n.py').write_text('import rospy\n')
+    assert not source.calls_a_service(str(pkg))
+    (pkg / 'scripts' / 'n.py').write_text('import rospy\nled = rospy.ServiceProxy("w", X)\n')
+    assert source.calls_a_service(str(pkg))
+
+
+def test_reports_say_the_status():
+    items = rubric.score('altitude', {}, {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: x'})
+    record = report.grade_record('Ann', 'altitude', items, [], status=rubric.status({}, {'refused': True,
+                                                                                      'error': 'refused: x'}))
+    text = report.markdown(record)
+    assert '**Status: not graded** - refused: x' in text
+    assert 'Graded by running the package' not in text and 'launch files: none' not in text
+    assert 'no threshold parameter' not in text and 'did not build' not in text
+    assert text.count('the upload was refused') == 4 and text.count('the package was not read') == 2
+    assert report.needing_the_teacher([record, dict(record, student='Bob', status='graded')]) == [
+        'Ann: not graded - refused: x']
+    assert record['status'] == 'not graded' and record['status_reason'] == 'refused: x'
