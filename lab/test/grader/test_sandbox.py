@@ -203,15 +203,18 @@ def test_a_box_is_another_user_and_sees_only_its_own():
     for folder in (work, os.path.join(work, 'ws'), os.path.join(work, 'ws', 'src'), os.path.join(work, 'ws', 'src', 'exam')):
         os.chmod(folder, 0o755)
     host_file = os.path.join(work, 'host-file')
+    shown = os.path.join(work, 'underlay')  # a grader's folder under the host's /tmp, bound read-only
+    os.makedirs(shown)
+    os.chmod(shown, 0o755)
     with open(host_file, 'w') as f:
         f.write('host')
     script = ('id -u; test -e /root && echo ROOT_VISIBLE; test -e %s && echo HOST_TMP_VISIBLE; '
               'touch /box/ws/src/exam/x 2>/dev/null && echo PACKAGE_WRITABLE; touch /box/ws/devel/x && echo OK; '
               'env; tr "\\0" "\\n" < /proc/1/environ; (setsid sh -c "sleep 77; true" &) ; '
-              'cat /proc/self/limits; head -c %d /dev/zero > /box/ws/devel/big; echo "BIG $(wc -c < /box/ws/devel/big)"'
-              % (host_file, sandbox.FILE_BYTES + 4096))
+              'test -d %s && echo BOUND; cat /proc/self/limits; head -c %d /dev/zero > /box/ws/devel/big; echo "BIG $(wc -c < /box/ws/devel/big)"'
+              % (host_file, shown, sandbox.FILE_BYTES + 4096))
     try:
-        with sandbox.Box(work) as box:
+        with sandbox.Box(work, [shown]) as box:
             grader_env = dict(os.environ, GRADER_SECRET='leak')
             done = subprocess.run(box.argv(['sh', '-c', script], grader_env), env=grader_env,
                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60)
@@ -221,7 +224,7 @@ def test_a_box_is_another_user_and_sees_only_its_own():
         shutil.rmtree(work, ignore_errors=True)
     lines = output.splitlines()
     assert lines[0] == str(uid) and uid != 0
-    assert 'OK' in lines
+    assert 'OK' in lines and 'BOUND' in lines
     assert 'BIG %d' % sandbox.FILE_BYTES in lines, 'a file stops growing at the limit'
     limits = dict((line[:26].strip(), line[26:].split()) for line in lines if line.startswith('Max '))
     assert limits['Max processes'][0] == str(sandbox.PROCESSES)

@@ -320,11 +320,11 @@ class Box(object):
                 box += ['--ro-bind', '/etc/' + name, '/etc/' + name]
         if os.path.isdir('/opt/ros'):
             box += ['--ro-bind', '/opt/ros', '/opt/ros']
-        for path in self.binds:
-            box += ['--ro-bind', path, path]
         box += ['--proc', '/proc', '--dev', '/dev']
         for path in ('/tmp', '/var/tmp', '/dev/shm', BOX_HOME):
             box += ['--size', str(TMP_BYTES), '--tmpfs', path]
+        for path in self.binds:  # after the private /tmp: an underlay may live in the host's /tmp
+            box += ['--ro-bind', path, path]
         box += ['--bind', os.path.join(self.folder, 'ws'), BOX_WS,
                 '--ro-bind', os.path.join(self.work, 'ws', 'src'), BOX_WS + '/src',
                 '--remount-ro', '/', '--chdir', cwd]
