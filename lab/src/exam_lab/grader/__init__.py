@@ -13,7 +13,10 @@ Modules (the pure ones import no rospy and are unit-tested in lab/test/unit):
 - :mod:`~exam_lab.grader.rubric` -- points and evidence from the measurements.
 - :mod:`~exam_lab.grader.report` -- grade.json, grade.md, grades.csv, the terminal table.
 - :mod:`~exam_lab.grader.probe` -- (rospy) plays the drone with the harness's fake drone, measures.
-- :mod:`~exam_lab.grader.session` -- builds and runs one submission under the harness's Supervisor.
+- :mod:`~exam_lab.grader.sandbox` -- the box a submission's code runs in (bubblewrap, a uid of its
+  own, limits) and the capped, regular-file-only copy of what a session leaves.
+- :mod:`~exam_lab.grader.session` -- builds and runs one submission: the student's steps in its box,
+  the master and probe outside.
 - :mod:`~exam_lab.grader.runner` -- one submission or a class: prepare, isolate, score, write.
 
 The teacher's desk, after grading (docs/grading.md, "The teacher's desk"):
