@@ -229,9 +229,14 @@ class MasterLink(object):
 
 
 def _private_params():
-    """The node's private parameters from the master, or None when it cannot be asked now."""
+    """The node's private parameters, asked of the master itself, or None when it cannot be asked now.
+
+    Not ``rospy.get_param('~')``: that answers from rospy's parameter cache when the cache holds any
+    key of the node's namespace (``~diagnostic_period``, see :func:`quiet_master_outages`).
+    """
     try:
-        return rospy.get_param('~', {})
+        return _value(_proxy(rosgraph.get_master_uri()).getParam(rospy.get_name(),
+                                                                  rospy.resolve_name('~')), 'getParam ~')
     except Exception:  # the master went away: the first poll that reaches it reads them
         return None
 
