@@ -57,8 +57,8 @@ import rospy
 from std_msgs.msg import Float32, String
 
 from drone_sim import lifecycle, master_link, params
-from exam import diagnostics
-from exam.debounce import WARNING, Debouncer, excess_news
+from exam import diagnostics, messages
+from exam.debounce import Debouncer, excess_news
 from exam.inputs import InputCache
 from exam.modes import MODES
 from exam.warning_link import LED_STATES, ServiceConnection, WarningLink
@@ -101,11 +101,15 @@ class ExamNode(object):
 
         # 2. Outputs and the service link, before any callback can fire.
         self._pub = rospy.Publisher(mode.output, Float32, queue_size=10)
-        self._service = service = rospy.resolve_name(mode.service)
+        service = rospy.resolve_name(mode.service)
         connection = ServiceConnection(service, lambda: master_link.open_persistent(
             service, mode.service_type), rospy.loginfo)
-        self._link = WarningLink(connection.call, self._on_call_failed, self._on_call_delivered,
-                                 retry_period=RETRY_PERIOD_S, connect=connection.open)
+        self._link = WarningLink(
+            connection.call, connect=connection.open, retry_period=RETRY_PERIOD_S,
+            on_failure=lambda state, reason: rospy.logwarn_throttle(
+                THROTTLE_S, 'could not set %s to %s (retrying every %.0f s): %s'
+                % (service, state, RETRY_PERIOD_S, reason)),
+            on_delivered=lambda state: rospy.loginfo('%s: LED set to %s', service, state))
         self._link.start()
         lifecycle.on_stop(lambda: self._link.stop(timeout=LINK_STOP_S))
 
@@ -143,7 +147,7 @@ class ExamNode(object):
             rospy.logwarn_throttle(THROTTLE_S, 'ignoring %s = %r %s: %s'
                                    % (rospy.resolve_name(spec.topic), msg.data, spec.unit, reason))
             return
-        self._report(news, value, 'back %s it' % self._mode.within)
+        self._report(news, value, messages.back_within(self._mode))
         if change is not None:
             self._announce(change, value)
 
@@ -161,17 +165,13 @@ class ExamNode(object):
 
     def _report(self, news, value, why):
         """Log an excess that began (and arm its deadline) or a pending WARNING cancelled (``why``)."""
-        if news is None:
-            return
-        mode, debouncer = self._mode, self._debouncer
-        words = (mode.output, value, mode.unit, mode.above, debouncer.threshold, mode.unit)
+        debouncer = self._debouncer
         if news == 'pending':
-            since, deadline = debouncer.excess_since, debouncer.deadline
-            rospy.loginfo('%s %.1f %s %s the threshold %.1f %s since %.3f, WARNING due at %.3f'
-                          % (words + (since, deadline)))
-            self._arm(deadline)
-        else:
-            rospy.loginfo('%s %.1f %s: the pending WARNING is cancelled (%s)' % (words[:3] + (why,)))
+            rospy.loginfo(messages.excess_began(self._mode, value, debouncer.threshold,
+                                                debouncer.excess_since, debouncer.deadline))
+            self._arm(debouncer.deadline)
+        elif news == 'cancelled':
+            rospy.loginfo(messages.excess_cancelled(self._mode, value, why))
 
     def _arm(self, deadline):
         """Arm a one-shot timer for the debouncer's ``deadline`` (once per deadline)."""
@@ -206,13 +206,9 @@ class ExamNode(object):
 
     def _announce(self, state, value):
         """Log a change of the warning state and hand it to the link, which calls the service."""
-        mode, debouncer = self._mode, self._debouncer
-        if state == WARNING:
-            why = '%s the threshold %.1f %s for %.1f s' % (mode.above, debouncer.threshold, mode.unit,
-                                                           debouncer.delay)
-        else:
-            why = '%s the threshold %.1f %s' % (mode.within, debouncer.threshold, mode.unit)
-        rospy.loginfo('%s %.1f %s %s: %s', mode.output, value, mode.unit, why, state)
+        debouncer = self._debouncer
+        rospy.loginfo(messages.state_changed(self._mode, state, value, debouncer.threshold,
+                                             debouncer.delay))
         self._link.want(state)
 
     def _on_led(self, msg):
@@ -223,13 +219,6 @@ class ExamNode(object):
                                    % (rospy.resolve_name(self._mode.led_topic), msg.data))
             return
         self._link.led_reported(state)
-
-    def _on_call_failed(self, state, reason):
-        rospy.logwarn_throttle(THROTTLE_S, 'could not set %s to %s (retrying every %.0f s): %s'
-                               % (self._service, state, RETRY_PERIOD_S, reason))
-
-    def _on_call_delivered(self, state):
-        rospy.loginfo('%s: LED set to %s', self._service, state)
 
     # --- output -------------------------------------------------------------------------------------
 
