@@ -113,10 +113,11 @@ class ExamNode(object):
         self._link.start()
         lifecycle.on_stop(lambda: self._link.stop(timeout=LINK_STOP_S))
 
+        self._output = rospy.resolve_name(mode.output)
         rospy.loginfo('%s: mode %s, %s > %.1f %s for %.1f s -> WARNING via %s; publishing %s at %.1f Hz; '
                       'inputs %s stale after %.1f s', rospy.get_name(), mode.name, mode.output, threshold,
-                      mode.unit, delay, service, rospy.resolve_name(mode.output), rate,
-                      ', '.join(rospy.resolve_name(c.topic) for c in self._inputs), self._timeout)
+                      mode.unit, delay, service, self._output, rate, self._names(self._inputs),
+                      self._timeout)
 
         # 3. Inputs and timers last, so no callback sees a half-built node.
         for spec, cache in zip(mode.inputs, self._inputs):
@@ -239,9 +240,8 @@ class ExamNode(object):
         if all(cache.stamp is None for cache in stale):
             rospy.loginfo_throttle(THROTTLE_S, 'waiting for the first reading of %s' % self._names(stale))
         else:
-            rospy.logwarn_throttle(THROTTLE_S, 'not publishing %s: no fresh reading of %s for more '
-                                   'than %.1f s' % (rospy.resolve_name(self._mode.output),
-                                                    self._names(stale), self._timeout))
+            rospy.logwarn_throttle(THROTTLE_S, 'not publishing %s: no fresh reading of %s for more than '
+                                   '%.1f s' % (self._output, self._names(stale), self._timeout))
 
     @staticmethod
     def _names(caches):
