@@ -4,13 +4,14 @@ ROS 1 nodes register with the master once: rospy never registers again, so after
 and started again on the same port (a ground-station laptop that crashed) the node runs on, its
 existing connections keep flowing, but nobody can find it any more: no new subscriber, no service
 lookup, no ``rosnode list``, and its parameters are gone. :func:`start` runs a daemon thread that asks
-the master about once a second whether it lists every publication, subscription and service of this
-node (``getSystemState``, with a short socket timeout), and follows
+the master about once a second whether it is the master the node registered with and still knows
+the node (one multicall of ``getPid`` and ``lookupNode`` of its own name, with a short socket
+timeout: its cost does not grow with the graph, see :mod:`drone_sim.outage`), and follows
 :class:`drone_sim.outage.MasterWatch`:
 
 - master unreachable: one warning for the whole outage; the node keeps running;
-- master answers but misses registrations of the node (it restarted): the node's private parameters
-  are set again with the values it read at start-up (so ``rosparam get /exam/threshold`` is right
+- master answers but does not know the node, or has another pid (it restarted): the node's private
+  parameters are set again with the values it read at start-up (so ``rosparam get /exam/threshold`` is right
   again and a tool that reads them sees what the node runs with), then every publication, subscription
   and service is registered again, as ``rospy.impl.registration.RegManager.start`` does at start-up, and
   each subscription is told of the publishers the master returns (through the node's own XML-RPC
