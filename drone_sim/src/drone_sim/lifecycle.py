@@ -26,8 +26,9 @@ all before step 2 begins:
 
 The hook closes the gate (no callback starts any more), waits up to ``DRAIN_TIMEOUT_S`` for those in
 progress, shuts the timers down, stops the threads, and only then raises ``is_shutdown()`` itself
-(rospy's own loops, such as its registration retries, end on it; see :func:`_stop`). :func:`run` is a node's whole life
-(init, build, spin), quiet when it is stopped while it starts. No ROS parameters, topics or services.
+(rospy's own loops, such as its registration retries, end on it; see :func:`_stop`). :func:`run` is a
+node's whole life (init, build, spin), quiet when it is stopped while it starts. No ROS parameters,
+topics or services.
 """
 import functools
 import signal

@@ -17,8 +17,8 @@ sends it, at one of these moments, each announced by the launch's own output (an
 
 Asserted for every run: zero ``Traceback`` and zero ``Exception in thread`` in the screen output
 and in every log file of the run (the nodes' own logs under ROS_LOG_DIR, roslaunch's), and no node
-that roslaunch had to escalate to SIGTERM (a node that hangs at the stop). Runs go in SLOTS parallel lanes, each with a master of its own, so
-the 40 stops take a few minutes on a loaded machine.
+that roslaunch had to escalate to SIGTERM (a node that hangs at the stop). Runs go in SLOTS parallel
+lanes, each with a master of its own: the 40 stops take 1 to 3 minutes on a loaded machine.
 """
 import glob
 import json
