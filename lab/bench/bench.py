@@ -30,7 +30,7 @@ FULL = {
     'rate_window': 60, 'floor_window': 20,
     'crossings': 22, 'delay': 1.0, 'hold': 0.6, 'slow_crossings': 3, 'slow_hold': 2.5,
     'rates': [10, 100, 500, 1000], 'max_rate_window': 10,
-    'fleet_sizes': [1, 5, 10, 20], 'baseline_fleet_sizes': [1, 5, 10, 20], 'fleet_window': 20,
+    'fleet_sizes': [1, 5, 10, 20, 50, 100], 'baseline_fleet_sizes': [1, 5, 10, 20], 'fleet_window': 20,
     'jitter_rounds': 2, 'jitter_window': 20, 'profile_window': 30,
 }
 QUICK = {
@@ -165,6 +165,9 @@ def main(argv):
     parser.add_argument('--render-only', action='store_true',
                         help='measure nothing: render the report again from --json')
     parser.add_argument('--command', default='make bench', help='command shown in the report')
+    parser.add_argument('--fleet-sizes', default=None,
+                        help='comma-separated fleet sizes of ours (default 1,5,10,20,50,100): what a '
+                             'smaller machine can hold')
     args = parser.parse_args(argv)
     unknown = set(args.stages.split(',')) - set(STAGES)
     if unknown:
@@ -176,7 +179,9 @@ def main(argv):
         return 0
     if not args.log_dir:
         parser.error('--log-dir is required to measure')
-    cfg = QUICK if args.quick else FULL
+    cfg = dict(QUICK if args.quick else FULL)
+    if args.fleet_sizes:
+        cfg['fleet_sizes'] = [int(n) for n in args.fleet_sizes.split(',')]
     signal.signal(signal.SIGTERM, _on_sigterm)
 
     t0 = time.monotonic()

@@ -29,7 +29,7 @@ from exam_lab.harness.oracle import NORMAL, WARNING, debounce_transitions
 from exam_lab.harness.wait import wait_until
 
 LED_STATE = {'GREEN': NORMAL, 'RED': WARNING}
-#: A delivered call, as the exam node logs it (exam/src/exam/node.py, _on_call_delivered).
+#: A delivered call, as the exam node logs it (exam/src/exam/node.py, the link's on_delivered).
 CALL_LOG = re.compile(r'LED set to (NORMAL|WARNING)\s*$')
 #: Seconds an observed change may differ from the oracle's instant: /altitude samples the computed
 #: value at 10 Hz (up to 0.1 s after the reading), plus call and logging latency on a loaded machine.

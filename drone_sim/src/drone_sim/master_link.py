@@ -4,17 +4,30 @@ ROS 1 nodes register with the master once: rospy never registers again, so after
 and started again on the same port (a ground-station laptop that crashed) the node runs on, its
 existing connections keep flowing, but nobody can find it any more: no new subscriber, no service
 lookup, no ``rosnode list``, and its parameters are gone. :func:`start` runs a daemon thread that asks
-the master about once a second whether it lists every publication, subscription and service of this
-node (``getSystemState``, with a short socket timeout), and follows
+the master about once a second whether it is the master the node registered with and still knows
+the node (one multicall of ``getPid`` and ``lookupNode`` of its own name, with a short socket
+timeout: its cost does not grow with the graph, see :mod:`drone_sim.outage`), and follows
 :class:`drone_sim.outage.MasterWatch`:
 
 - master unreachable: one warning for the whole outage; the node keeps running;
-- master answers but misses registrations of the node (it restarted): the node's private parameters
-  are set again with the values it read at start-up (so ``rosparam get /exam/threshold`` is right
+- master answers but does not know the node, or has another pid (it restarted): the node's private
+  parameters are set again with the values it read at start-up (so ``rosparam get /exam/threshold`` is right
   again and a tool that reads them sees what the node runs with), then every publication, subscription
   and service is registered again, as ``rospy.impl.registration.RegManager.start`` does at start-up, and
   each subscription is told of the publishers the master returns (through the node's own XML-RPC
   ``publisherUpdate``, the call a master makes); one info line says what was re-registered.
+
+The link's state (up; down since; re-registered when, how many times) is the node's "<node>: master"
+status on /diagnostics, WARN while the master is down (:meth:`MasterLink.publish_status`).
+
+Two things rospy does that a master outage (or a peer's stop) turns into tracebacks in the node's log
+file, both settled here (:func:`quiet_master_outages`): rospy's rosout handler and diagnostic_updater
+read a parameter with ``get_param_cached`` at every log line and every update, and an unset
+parameter is never cached, so each read is a ``subscribeParam`` call to the master ("Unable to report
+rosout" and a traceback while it is down; a cost on the master while it is up): they are read once
+at start and put in rospy's cache. rosgraph's XML-RPC server and rospy's connection threads log a
+traceback when a peer goes away mid-request (a master killed while it tells the node of a publisher,
+a node that stops while this one connects to it): one line instead, with the error.
 
 :func:`open_persistent` serves the other side of a master outage: a service client whose connection
 is open before it is needed calls the service without asking the master.
@@ -28,17 +41,19 @@ subscriptions (``get_param_cached``); nothing of ours relies on them.
 
 No ROS parameters, topics or services of its own.
 """
+import logging
 import threading
 import time
 import xmlrpc.client
 
+import diagnostic_updater
 import rosgraph
 import rospy
-from rospy.impl import registration
+from diagnostic_msgs.msg import DiagnosticStatus
+from rospy.impl import paramserver, registration
 from rospy.impl.tcpros_base import TCPROSTransport
 
-from drone_sim.outage import (KNOWN, REREGISTER, UNKNOWN, UNREACHABLE, MasterWatch,
-                               missing_registrations)
+from drone_sim.outage import REREGISTER, UNREACHABLE, MasterWatch, classify
 
 #: Seconds between two polls of the master.
 POLL_PERIOD_S = 1.0
@@ -46,6 +61,17 @@ POLL_PERIOD_S = 1.0
 CALL_TIMEOUT_S = 2.0
 #: Caller id of the node's call to its own publisherUpdate (what a master would send).
 MASTER_CALLER_ID = '/master'
+#: Parameters read with get_param_cached at every log line (rospy's rosout) and every update
+#: (diagnostic_updater), with the default each uses when they are unset.
+CACHED_PARAMS = (('/rosout_disable_topics_generation', False), ('~diagnostic_period', 1))
+#: Errors that say a peer went away (refused, reset, cut before rospy's handshake): rosgraph's XML-RPC
+#: server and rospy's connection threads log them with a traceback.
+DROPPED = ('ConnectionResetError', 'ConnectionRefusedError', 'BrokenPipeError', 'ConnectionAbortedError',
+           'ROSHandshakeException', 'TransportInitError')
+#: The loggers whose tracebacks of a peer that went away become one line.
+PEER_LOGGERS = ('xmlrpc', 'rospy.internal')
+#: diagnostic_updater's levels of MasterWatch.status().
+LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN}
 
 
 class _TimeoutTransport(xmlrpc.client.Transport):
@@ -85,13 +111,21 @@ class MasterLink(object):
         self._name = rospy.get_name()
         self._node_uri = rospy.get_node_uri()
         self._namespace = rospy.resolve_name('~').rstrip('/')
-        # The node has read its parameters by now: these are the values it runs with.
-        self._params = rospy.get_param('~', {})
+        # The node has read its parameters by now: these are the values it runs with (read at the
+        # first poll if the master went away meanwhile).
+        self._params = _private_params()
         self._watch = MasterWatch(self._master_uri, self._name)
+        self._known_pid = None  # pid of the master the node is registered with, once seen
+        self._updater = diagnostic_updater.Updater()
+        self._updater.setHardwareID(self._name)
+        self._updater.add('master', self._fill_status)
         self._poll_period = poll_period
         # Held for a whole poll: stop() returns only once no poll runs, so that rospy's unregistration
         # at shutdown (which follows the on_shutdown hooks) is never undone by a re-registration.
         self._lock = threading.Lock()
+        # Guards the watch between the polling thread and the diagnostics timer (the poll's lock is
+        # held across calls to the master: the status must not wait for them).
+        self._lock_status = threading.Lock()
         self._stopped = threading.Event()
         self._thread = threading.Thread(target=self._run, name='master_link')
         self._thread.daemon = True
@@ -117,29 +151,53 @@ class MasterLink(object):
 
     def _poll(self):
         master = _proxy(self._master_uri)
-        topics, services = registration.get_topic_manager(), registration.get_service_manager()
-        # Taken before the master is asked: a registration made meanwhile is not counted as lost.
-        ours = ([name for name, _ in topics.get_publications()],
-                [name for name, _ in topics.get_subscriptions()],
-                [name for name, _ in services.get_services()])
+        calls = xmlrpc.client.MultiCall(master)
+        calls.getPid(self._name)
+        calls.lookupNode(self._name, self._name)
         try:
-            state = _value(master.getSystemState(self._name), 'getSystemState')
+            pid, node = list(calls())
         except Exception as err:  # refused, reset, timeout, HTTP error: no usable master
-            self._act(self._watch.observe(UNREACHABLE, time.time(), _describe(err)))
+            self._tell(self._watch.observe, UNREACHABLE, time.time(), _describe(err))
             return
-        lost = missing_registrations(state, self._name, *ours)
-        action = self._act(self._watch.observe(UNKNOWN if lost else KNOWN, time.time()))
-        if action == REREGISTER:
-            try:
-                counts = self._reregister(master)
-            except Exception as err:
-                self._act(self._watch.reregister_failed(time.time(), _describe(err)))
-            else:
-                self._act(self._watch.reregistered(time.time(), *counts))
+        pid = pid[2] if pid[0] == 1 else None
+        answer = classify(pid, node[2] if node[0] == 1 else None, self._known_pid)
+        action = self._tell(self._watch.observe, answer, time.time())
+        if action != REREGISTER:
+            if self._known_pid is None:
+                self._known_pid = pid
+            if self._params is None:
+                self._params = _private_params()
+            return
+        try:
+            counts = self._reregister(master)
+        except Exception as err:
+            self._tell(self._watch.reregister_failed, time.time(), _describe(err))
+        else:
+            self._known_pid = pid
+            self._tell(self._watch.reregistered, time.time(), *counts)
 
-    @staticmethod
-    def _act(decision):
-        action, level, message = decision
+    def _fill_status(self, stat):
+        with self._lock_status:
+            level, summary, values = self._watch.status(time.time())
+        for key, value in values:
+            stat.add(key, value)
+        stat.summary(LEVELS[level], summary)
+        return stat
+
+    def publish_status(self, event=None):
+        """Publish the "<node>: master" status on /diagnostics (a timer's callback: never raises).
+
+        ``force_update``: it publishes without asking the master for ``~diagnostic_period``.
+        """
+        try:
+            self._updater.force_update()
+        except Exception as err:
+            rospy.logerr_throttle(60.0, '/diagnostics: master status not published: %s' % _describe(err))
+
+    def _tell(self, method, *args):
+        """Give the watch one observation (``method(*args)``); log and return what it decided."""
+        with self._lock_status:
+            action, level, message = method(*args)
         if level == 'warn':
             rospy.logwarn(message)
         elif level == 'info':
@@ -149,8 +207,9 @@ class MasterLink(object):
     def _reregister(self, master):
         """Register parameters, publications, subscriptions and services again; return their counts."""
         caller, uri = self._name, self._node_uri
+        params = self._params or {}
         # Parameters first: whoever finds the node through the master then finds its parameters too.
-        for key, value in sorted(self._params.items()):
+        for key, value in sorted(params.items()):
             _value(master.setParam(caller, self._namespace + '/' + key, value), 'setParam %s' % key)
         topics, services = registration.get_topic_manager(), registration.get_service_manager()
         publications, subscriptions = topics.get_publications(), topics.get_subscriptions()
@@ -167,7 +226,52 @@ class MasterLink(object):
                        'publisherUpdate %s' % topic)
         for service, service_uri in served:
             _value(master.registerService(caller, service, service_uri, uri), 'registerService %s' % service)
-        return len(publications), len(subscriptions), len(served), len(self._params)
+        return len(publications), len(subscriptions), len(served), len(params)
+
+
+def _private_params():
+    """The node's private parameters, asked of the master itself, or None when it cannot be asked now.
+
+    Not ``rospy.get_param('~')``: that answers from rospy's parameter cache when the cache holds any
+    key of the node's namespace (``~diagnostic_period``, see :func:`quiet_master_outages`).
+    """
+    try:
+        return _value(_proxy(rosgraph.get_master_uri()).getParam(rospy.get_name(),
+                                                                  rospy.resolve_name('~')), 'getParam ~')
+    except Exception:  # the master went away: the first poll that reaches it reads them
+        return None
+
+
+class _PeerGone(logging.Filter):
+    """Turns the traceback of a peer that went away into one line: what was tried, and the error.
+
+    A node that stops (or a master that is killed) while another connects to it is an ordinary event
+    of a ROS graph: rospy reports it and retries or gives up, correctly; only the stack is noise. So
+    is any error of a connection being set up while this node stops: rospy closes the socket under
+    its own connecting thread (an AttributeError on the socket it just set to None).
+    """
+
+    def filter(self, record):
+        text = record.getMessage()
+        head, found, rest = text.partition('Traceback (most recent call last)')
+        if found:
+            last = rest.strip().splitlines()[-1]
+            if last.split(':')[0].split('.')[-1] in DROPPED or rospy.core.is_shutdown_requested():
+                record.msg, record.args = '%s%s' % (head or 'connection closed by its peer: ', last), ()
+        return True
+
+
+def quiet_master_outages():
+    """Keep rospy from calling the master at every log line and from logging a dropped peer as a
+    traceback (see the module docstring). Call right after ``init_node``, before the node logs."""
+    cache = paramserver.get_param_server_cache()
+    try:
+        for key, default in CACHED_PARAMS:
+            cache.set(rospy.resolve_name(key), rospy.get_param(key, default))
+    except Exception:  # the master went away already: rospy asks it again later, as it always did
+        pass
+    for name in PEER_LOGGERS:
+        logging.getLogger(name).addFilter(_PeerGone())
 
 
 def _describe(err):
@@ -176,10 +280,10 @@ def _describe(err):
 
 def start(poll_period=POLL_PERIOD_S):
     """Start watching the master for the running node (call it once the node is built, its parameters
-    read); returns the :class:`MasterLink`, stopped by rospy's shutdown before it unregisters."""
+    read); returns the :class:`MasterLink`, whose ``stop`` must run before rospy unregisters the node
+    (:func:`drone_sim.lifecycle.run` calls it from the node's first shutdown hook)."""
     link = MasterLink(poll_period)
     link.start()
-    rospy.on_shutdown(link.stop)
     return link
 
 

@@ -7,12 +7,17 @@ unit-tested with synthetic answers and times.
 
 An answer is one of:
 
-- ``KNOWN``: the master answers and lists every registration of this node (all is well, or it is back
-  after a network fault);
-- ``UNKNOWN``: the master answers but misses some of them: it was restarted and lost everything
-  (:func:`missing_registrations` says which; asking ``lookupNode`` is not enough: a node that merely
-  read a cached parameter from the new master is known to it, with none of its topics);
+- ``KNOWN``: the master answers, knows this node, and is the master the node registered with (all is
+  well, or it is back after a network fault);
+- ``UNKNOWN``: the master answers but was restarted: it lost everything (:func:`classify`);
 - ``UNREACHABLE``: no answer (connection refused, timeout).
+
+What a poll costs the master does not grow with the graph (issue 19): one XML-RPC multicall of
+``getPid`` (the master's process id) and ``lookupNode`` of the node's own name, two dictionary
+look-ups; ``getSystemState`` (the whole graph, once a second from every node) grew with the square
+of the fleet. A restarted master forgets every node, so ``lookupNode`` fails; and a master that
+learnt the node's name again some other way (a parameter subscription, a new publisher) without its
+other registrations has another pid than the one the node registered with.
 
 Logging rule: one line when the outage starts, one when it ends, nothing in between, so that a master
 down for an hour does not flood the log. :class:`OncePerOutage` applies the same rule to any periodic
@@ -27,18 +32,19 @@ UNREACHABLE = 'unreachable'
 REREGISTER = 'reregister'
 
 
-def missing_registrations(system_state, node, publications, subscriptions, services):
-    """The registrations of ``node`` that the master does not list, as ``[(kind, name)]``.
+def classify(pid, node_uri, known_pid):
+    """The answer of one poll, from the master's ``getPid`` and ``lookupNode(own name)`` answers.
 
-    :param system_state: the master's ``getSystemState`` value: ``[publishers, subscribers, services]``,
-        each a list of ``[name, [node, ...]]``.
-    :param publications: names of the topics the node publishes; ``subscriptions`` and ``services``
-        likewise.
+    :param pid: the master's pid, or None when ``getPid`` failed.
+    :param node_uri: the URI the master has for this node's name, or None when it does not know it.
+    :param known_pid: the pid of the master the node last registered with, None before it is known.
+    :returns: KNOWN or UNKNOWN (an unreachable master never gets here).
     """
-    listed = [{name for name, nodes in kind if node in nodes} for kind in system_state]
-    ours = (('publication', publications), ('subscription', subscriptions), ('service', services))
-    return [(kind, name) for (kind, names), known in zip(ours, listed) for name in names
-            if name not in known]
+    if node_uri is None or pid is None:
+        return UNKNOWN
+    if known_pid is not None and pid != known_pid:
+        return UNKNOWN
+    return KNOWN
 
 
 class MasterWatch(object):
@@ -56,6 +62,9 @@ class MasterWatch(object):
         self._name = name
         self._down_since = None  # time the outage began, None while the master is up
         self._reregister_failed = False
+        self._reregistered_at = None  # time of the last re-registration, None before the first
+        self._reregistrations = 0
+        self._counts = None  # what the last re-registration registered
 
     @property
     def up(self):
@@ -87,6 +96,9 @@ class MasterWatch(object):
         outage = None if self._down_since is None else now - self._down_since
         self._down_since = None
         self._reregister_failed = False
+        self._reregistered_at = now
+        self._reregistrations += 1
+        self._counts = (publications, subscriptions, services, parameters)
         down = 'restarted' if outage is None else 'restarted after %.1f s down' % outage
         return None, 'info', ('master at %s %s, without %s: re-registered %d publications, '
                               '%d subscriptions, %d services and %d private parameters'
@@ -102,6 +114,30 @@ class MasterWatch(object):
         self._reregister_failed = True
         return None, 'warn', ('could not re-register %s with the master at %s (%s): retrying every '
                               'poll' % (self._name, self._uri, error))
+
+    def status(self, now):
+        """The link to the master as /diagnostics shows it: ``(level, summary, [(key, value)])``.
+
+        ``level`` is ``'ok'``, or ``'warn'`` while the master is unreachable or the node could not
+        re-register with it. Times [s] are those given to observe() (the node passes wall time).
+        """
+        values = [('master', self._uri),
+                  ('state', 'up' if self.up else 'down'),
+                  ('down since [s]', 'up' if self.up else '%.3f' % self._down_since),
+                  ('down for [s]', '0' if self.up else '%.1f' % (now - self._down_since)),
+                  ('re-registrations', '%d' % self._reregistrations),
+                  ('last re-registration at [s]',
+                   'never' if self._reregistered_at is None else '%.3f' % self._reregistered_at)]
+        if self._counts is not None:
+            values.append(('last re-registration', '%d publications, %d subscriptions, %d services, '
+                           '%d private parameters' % self._counts))
+        if not self.up:
+            failing = ', re-registration failing' if self._reregister_failed else ''
+            return 'warn', 'master down for %.1f s%s' % (now - self._down_since, failing), values
+        if self._reregistered_at is None:
+            return 'ok', 'master up, registered since the start', values
+        return 'ok', 'master up, re-registered %d times, last at %.3f' % (
+            self._reregistrations, self._reregistered_at), values
 
 
 class OncePerOutage(object):

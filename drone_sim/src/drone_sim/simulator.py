@@ -32,18 +32,19 @@ All times are ROS times, so the node follows ``/clock`` under ``use_sim_time``; 
 counts from the node's start (or from the first clock message under sim time).
 
 A master that restarts finds the node again within about a second, parameters included
-(:mod:`drone_sim.master_link`); the sensors and the service keep working while it is down.
+(:mod:`drone_sim.master_link`, which also publishes the "<node>: master" status on /diagnostics);
+the sensors and the service keep working while it is down. Timers and the service handler go through
+:mod:`drone_sim.lifecycle`: a stop at any moment is quiet.
 """
 
 import collections
 import functools
-import sys
 import threading
 
 import rospy
 from std_msgs.msg import Float32, String
 
-from drone_sim import master_link, params
+from drone_sim import lifecycle, params
 from drone_sim.led import WarningLed
 from drone_sim.noise import GaussianNoise
 from drone_sim.profile import parse_profile
@@ -65,6 +66,10 @@ DroneSpec.__doc__ = """What makes one drone: default node name, list of Sensor, 
 waypoints), allowed profile range [lower, upper], private truth topic, warning service
 name and type, LED topic and LED label for messages.
 """
+
+
+#: Messages the LED topic's queue holds per subscriber: more changes than a writer thread can miss.
+LED_QUEUE = 10
 
 
 def _param(name, default):
@@ -107,7 +112,9 @@ class SimulatorNode:
         self._led = WarningLed(spec.led_label)
         # Serialises concurrent service calls, so the latched topic ends on the LED's final colour.
         self._led_lock = threading.Lock()
-        self._led_pub = rospy.Publisher(spec.led_topic, String, latch=True, queue_size=1)
+        # A queue of several messages: a RED followed within milliseconds by a GREEN (two calls in a
+        # row) reaches every connected subscriber as RED then GREEN; a queue of 1 dropped the RED.
+        self._led_pub = rospy.Publisher(spec.led_topic, String, latch=True, queue_size=LED_QUEUE)
         self._led_pub.publish(String(data=self._led.colour))
         self._truth_pub = rospy.Publisher('~' + spec.truth_topic, Float32, queue_size=10)
         self._pubs = {s.topic: rospy.Publisher(s.topic, Float32, queue_size=10) for s in spec.sensors}
@@ -116,10 +123,10 @@ class SimulatorNode:
         self._start_lock = threading.Lock()
         self._start = rospy.Time.now()
 
-        # Service and timers last. reset=True: a timer survives time jumping back (rosbag loop).
-        self._service = rospy.Service(spec.service_name, spec.service_type, self._on_warning_request)
-        self._timers = [rospy.Timer(rospy.Duration(1.0 / rates[s.topic]),
-                                    functools.partial(self._on_tick, s), reset=True)
+        # Service and timers last.
+        self._service = rospy.Service(spec.service_name, spec.service_type, lifecycle.guarded(
+            self._on_warning_request, rospy.ServiceException('%s is shutting down' % rospy.get_name())))
+        self._timers = [lifecycle.timer(1.0 / rates[s.topic], functools.partial(self._on_tick, s))
                         for s in spec.sensors]
 
     def _elapsed(self, now):
@@ -154,11 +161,4 @@ class SimulatorNode:
 
 def run(spec):
     """Entry point of a drone's node: init, build, spin; exit status 1 on a bad parameter."""
-    rospy.init_node(spec.node_name)
-    try:
-        SimulatorNode(spec)
-    except params.ParamError as err:
-        rospy.logfatal('%s: %s', rospy.get_name(), err)
-        sys.exit(1)
-    master_link.start()
-    rospy.spin()
+    lifecycle.run(spec.node_name, lambda: SimulatorNode(spec))

@@ -1,7 +1,7 @@
 """A node's view of its master: what to do and log for each poll's answer (synthetic answers, no ROS)."""
 
 from drone_sim.outage import (KNOWN, REREGISTER, UNKNOWN, UNREACHABLE, MasterWatch, OncePerOutage,
-                              missing_registrations)
+                              classify)
 
 URI = 'http://ground:11311/'
 
@@ -81,30 +81,46 @@ def test_after_an_outage_that_needed_nothing_a_failed_re_registration_is_logged_
     assert w.reregister_failed(30.1, 'reset')[1] == 'warn'
 
 
-SYSTEM_STATE = [
-    [['/rosout', ['/exam', '/mydrone']], ['/altitude', ['/exam']]],           # publishers
-    [['/pressure', ['/exam']], ['/rosout', ['/rosout']]],                        # subscribers
-    [['/exam/get_loggers', ['/exam']], ['/altitude_warning', ['/mydrone']]],   # services
-]
+def test_a_master_that_knows_the_node_and_kept_its_pid_is_the_one_registered_with():
+    assert classify(4242, 'http://vm:40001/', None) == KNOWN  # first poll: the pid is learnt
+    assert classify(4242, 'http://vm:40001/', 4242) == KNOWN
 
 
-def test_missing_registrations_lists_what_the_master_lost():
-    assert missing_registrations(SYSTEM_STATE, '/exam', ['/rosout', '/altitude'], ['/pressure'],
-                                 ['/exam/get_loggers']) == []
-    assert missing_registrations(SYSTEM_STATE, '/exam', ['/rosout', '/diagnostics'],
-                                 ['/pressure', '/temperature'], ['/exam/set_logger_level']) == [
-        ('publication', '/diagnostics'), ('subscription', '/temperature'),
-        ('service', '/exam/set_logger_level')]
-    # A topic registered by another node only does not count as ours.
-    assert missing_registrations(SYSTEM_STATE, '/mydrone', ['/altitude'], [], []) == [
-        ('publication', '/altitude')]
+def test_a_restarted_master_forgets_the_node():
+    assert classify(5151, None, 4242) == UNKNOWN
+    assert classify(5151, None, None) == UNKNOWN  # restarted before the first poll
 
 
-def test_a_fresh_master_misses_everything_even_if_it_knows_the_name():
-    # After a restart the node may be known to the master through a parameter subscription alone.
-    empty = [[], [], []]
-    assert missing_registrations(empty, '/exam', ['/rosout'], ['/pressure'], ['/exam/get_loggers']) == [
-        ('publication', '/rosout'), ('subscription', '/pressure'), ('service', '/exam/get_loggers')]
+def test_a_restarted_master_that_learnt_the_name_again_is_told_by_its_pid():
+    # After a restart the node may be known to the new master through a parameter subscription or
+    # a new publisher alone, with none of its other registrations: the pid differs.
+    assert classify(5151, 'http://vm:40001/', 4242) == UNKNOWN
+
+
+def test_a_master_whose_pid_cannot_be_read_is_not_trusted():
+    assert classify(None, 'http://vm:40001/', 4242) == UNKNOWN
+
+
+def test_status_up_down_and_re_registered():
+    w = watch()
+    assert w.status(5.0) == ('ok', 'master up, registered since the start', [
+        ('master', URI), ('state', 'up'), ('down since [s]', 'up'), ('down for [s]', '0'),
+        ('re-registrations', '0'), ('last re-registration at [s]', 'never')])
+    w.observe(UNREACHABLE, 10.0, 'refused')
+    level, summary, values = w.status(12.5)
+    assert (level, summary) == ('warn', 'master down for 2.5 s')
+    assert dict(values)['down since [s]'] == '10.000' and dict(values)['state'] == 'down'
+    w.reregister_failed(13.0, 'refused')
+    assert w.status(13.0)[1] == 'master down for 3.0 s, re-registration failing'
+    w.observe(UNKNOWN, 14.0)
+    w.reregistered(14.25, 3, 4, 2, 5)
+    level, summary, values = w.status(15.0)
+    assert (level, summary) == ('ok', 'master up, re-registered 1 times, last at 14.250')
+    assert dict(values)['last re-registration'] == ('3 publications, 4 subscriptions, 2 services, '
+                                                    '5 private parameters')
+    assert dict(values)['state'] == 'up' and dict(values)['re-registrations'] == '1'
+    w.reregistered(20.0, 3, 4, 2, 5)
+    assert w.status(21.0)[1] == 'master up, re-registered 2 times, last at 20.000'
 
 
 def test_once_per_outage_logs_the_first_failure_and_the_recovery():

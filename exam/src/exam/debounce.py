@@ -82,3 +82,19 @@ class Debouncer(object):
             return None
         self.state = state
         return state
+
+
+def excess_news(before, after, change):
+    """What one step of the debouncer did to the pending WARNING, for the node's log (once per excess).
+
+    :param before: :attr:`Debouncer.deadline` before the step; ``after``: after it.
+    :param change: the new state the step returned, or None.
+    :returns: ``'pending'`` when a WARNING became due at ``after`` (an excess began), ``'cancelled'``
+        when the pending one ended without a WARNING (a reading back within the limit, or stale
+        inputs), else None (nothing new; a WARNING that fires is logged as a change of state).
+    """
+    if after is not None and after != before:
+        return 'pending'
+    if before is not None and after is None and change != WARNING:
+        return 'cancelled'
+    return None

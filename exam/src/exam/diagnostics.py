@@ -24,6 +24,7 @@ import diagnostic_updater
 import rospy
 from diagnostic_msgs.msg import DiagnosticStatus
 
+from drone_sim import lifecycle
 from drone_sim.outage import OncePerOutage
 from exam.warning_link import LED_COLOURS
 
@@ -90,8 +91,7 @@ def start(snapshot, link_snapshot, mode, service, timeout):
                           'the master is unreachable; the statuses are published every %.0f s anyway '
                           '(connected subscribers keep them, a new one finds them once the master is '
                           'back)' % PERIOD_S)
-    # reset=True: the timer survives time jumping backwards (rosbag play --loop under sim time).
-    rospy.Timer(rospy.Duration(PERIOD_S), lambda event: publish(updater, guard), reset=True)
+    lifecycle.timer(PERIOD_S, lambda event: publish(updater, guard))
     return updater
 
 

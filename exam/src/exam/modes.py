@@ -25,6 +25,8 @@ Mode = collections.namedtuple('Mode', [
     'service',            # warning service to call with "NORMAL"/"WARNING"
     'service_type',       # its srv class
     'led_topic',          # latched std_msgs/String "GREEN"/"RED" the drone publishes
+    'above',              # the log's words for a value beyond the threshold ("above", "deeper than")
+    'within',             # and for one within it ("at or below", "not deeper than")
 ])
 
 ALTITUDE = Mode(
@@ -38,6 +40,8 @@ ALTITUDE = Mode(
     service='altitude_warning',
     service_type=AltitudeWarning,
     led_topic='alt_warn_led',
+    above='above',
+    within='at or below',
 )
 
 DEPTH = Mode(
@@ -51,6 +55,8 @@ DEPTH = Mode(
     service='depth_warning',
     service_type=DepthWarning,
     led_topic='depth_warn_led',
+    above='deeper than',
+    within='not deeper than',
 )
 
 MODES = {mode.name: mode for mode in (ALTITUDE, DEPTH)}

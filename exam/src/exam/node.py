@@ -18,8 +18,11 @@ How one reading travels (each step runs on the thread rospy gives it):
    input interrupts a pending excess.
 4. A 1 Hz timer publishes /diagnostics.
 5. A thread of :mod:`drone_sim.master_link` keeps the node registered across a master restart, and the
-   connection to the warning service is opened ahead of the first call and kept, so a state decided
-   while the master is down still reaches the drone.
+   connection to the warning service (:class:`exam.warning_link.ServiceConnection`) is opened ahead
+   of the first call and kept, so a state decided while the master is down still reaches the drone.
+
+Every timer and callback goes through :mod:`drone_sim.lifecycle`, so a stop at any moment ends them
+all before rospy closes the publishers: no traceback at Ctrl-C.
 
 State shared by these threads (the caches, the value, the debouncer) is guarded by one lock, held only
 for short computations, never across a publish or a service call.
@@ -41,29 +44,33 @@ Subscribed Topics:
 
 Published Topics:
     altitude mode: altitude (std_msgs/Float32, m). depth mode: depth (std_msgs/Float32, m).
-    /diagnostics (diagnostic_msgs/DiagnosticArray): "<node>: inputs" and "<node>: warning" statuses.
+    /diagnostics (diagnostic_msgs/DiagnosticArray): "<node>: inputs", "<node>: warning" and
+        "<node>: master" statuses.
 
 Services called:
     altitude mode: altitude_warning (mydrone/AltitudeWarning) with "NORMAL" or "WARNING".
     depth mode: depth_warning (submarinedrone/DepthWarning) with "NORMAL" or "WARNING".
 """
-import sys
 import threading
 
 import rospy
 from std_msgs.msg import Float32, String
 
-from drone_sim import master_link, params
-from exam import diagnostics
-from exam.debounce import WARNING, Debouncer
+from drone_sim import lifecycle, master_link, params
+from exam import diagnostics, messages
+from exam.debounce import Debouncer, excess_news
 from exam.inputs import InputCache
 from exam.modes import MODES
-from exam.warning_link import LED_STATES, WarningLink
+from exam.warning_link import LED_STATES, ServiceConnection, WarningLink
 
 #: Seconds between two identical warnings on a 10 Hz path, so a fault does not flood /rosout.
 THROTTLE_S = 5.0
 #: Seconds between two attempts while the warning service is absent or failing.
 RETRY_PERIOD_S = 1.0
+#: Seconds the shutdown waits for a service call in progress.
+LINK_STOP_S = 1.0
+#: Shortest timer rospy can arm [s] (a period of 0 divides by zero in rospy.Rate).
+MIN_TIMER_S = 0.001
 
 
 def _param(name, default):
@@ -94,26 +101,31 @@ class ExamNode(object):
 
         # 2. Outputs and the service link, before any callback can fire.
         self._pub = rospy.Publisher(mode.output, Float32, queue_size=10)
-        self._service = rospy.resolve_name(mode.service)
-        self._proxy = None  # the persistent connection to the service, used by the link's thread only
-        self._link = WarningLink(self._call_service, self._on_call_failed, self._on_call_delivered,
-                                 retry_period=RETRY_PERIOD_S, connect=self._open_service)
+        service = rospy.resolve_name(mode.service)
+        connection = ServiceConnection(service, lambda: master_link.open_persistent(
+            service, mode.service_type), rospy.loginfo)
+        self._link = WarningLink(
+            connection.call, connect=connection.open, retry_period=RETRY_PERIOD_S,
+            on_failure=lambda state, reason: rospy.logwarn_throttle(
+                THROTTLE_S, 'could not set %s to %s (retrying every %.0f s): %s'
+                % (service, state, RETRY_PERIOD_S, reason)),
+            on_delivered=lambda state: rospy.loginfo('%s: LED set to %s', service, state))
         self._link.start()
-        rospy.on_shutdown(lambda: self._link.stop(timeout=1.0))
+        lifecycle.on_stop(lambda: self._link.stop(timeout=LINK_STOP_S))
 
+        self._output = rospy.resolve_name(mode.output)
         rospy.loginfo('%s: mode %s, %s > %.1f %s for %.1f s -> WARNING via %s; publishing %s at %.1f Hz; '
                       'inputs %s stale after %.1f s', rospy.get_name(), mode.name, mode.output, threshold,
-                      mode.unit, delay, self._service, rospy.resolve_name(mode.output), rate,
-                      ', '.join(rospy.resolve_name(c.topic) for c in self._inputs), self._timeout)
+                      mode.unit, delay, service, self._output, rate, self._names(self._inputs),
+                      self._timeout)
 
         # 3. Inputs and timers last, so no callback sees a half-built node.
         for spec, cache in zip(mode.inputs, self._inputs):
-            rospy.Subscriber(spec.topic, Float32, self._on_reading, callback_args=(spec, cache),
-                             queue_size=10)
-        rospy.Subscriber(mode.led_topic, String, self._on_led, queue_size=10)
-        # reset=True: a timer survives time jumping backwards (rosbag play --loop under sim time).
-        rospy.Timer(rospy.Duration(1.0 / rate), self._on_publish_tick, reset=True)
-        diagnostics.start(self._snapshot, self._link.snapshot, mode, self._service, self._timeout)
+            rospy.Subscriber(spec.topic, Float32, lifecycle.guarded(self._on_reading),
+                             callback_args=(spec, cache), queue_size=10)
+        rospy.Subscriber(mode.led_topic, String, lifecycle.guarded(self._on_led), queue_size=10)
+        lifecycle.timer(1.0 / rate, self._on_publish_tick)
+        diagnostics.start(self._snapshot, self._link.snapshot, mode, service, self._timeout)
 
     # --- inputs -------------------------------------------------------------------------------------
 
@@ -121,24 +133,24 @@ class ExamNode(object):
         """A sensor reading: validate, cache, compute, and let the debouncer judge it at once."""
         spec, cache = args
         now = rospy.get_time()
-        change = deadline = None
+        change = news = None
         with self._lock:
             reason = cache.offer(msg.data, now)
             if reason is None:
                 value = self._compute(now)
                 if value is not None:
                     self._value = value
+                    before = self._debouncer.deadline
                     change = self._debouncer.update(value, now)
-                    deadline = self._debouncer.deadline
+                    news = excess_news(before, self._debouncer.deadline, change)
         if reason is not None:
             # Never cached, never published, never seen by the debouncer: just reported.
             rospy.logwarn_throttle(THROTTLE_S, 'ignoring %s = %r %s: %s'
                                    % (rospy.resolve_name(spec.topic), msg.data, spec.unit, reason))
             return
+        self._report(news, value, messages.back_within(self._mode))
         if change is not None:
             self._announce(change, value)
-        if deadline is not None:
-            self._arm(deadline, now)
 
     def _compute(self, now):
         """The value from the cached inputs, or None unless every input is fresh. Call under the lock."""
@@ -152,41 +164,52 @@ class ExamNode(object):
 
     # --- warning ------------------------------------------------------------------------------------
 
-    def _arm(self, deadline, now):
+    def _report(self, news, value, why):
+        """Log an excess that began (and arm its deadline) or a pending WARNING cancelled (``why``)."""
+        debouncer = self._debouncer
+        if news == 'pending':
+            rospy.loginfo(messages.excess_began(self._mode, value, debouncer.threshold,
+                                                debouncer.excess_since, debouncer.deadline))
+            self._arm(debouncer.deadline)
+        elif news == 'cancelled':
+            rospy.loginfo(messages.excess_cancelled(self._mode, value, why))
+
+    def _arm(self, deadline):
         """Arm a one-shot timer for the debouncer's ``deadline`` (once per deadline)."""
         with self._lock:
             if deadline == self._armed_deadline:
                 return
             self._armed_deadline = deadline
-        rospy.Timer(rospy.Duration(max(deadline - now, 0.0)), self._on_deadline, oneshot=True)
+        lifecycle.timer(max(deadline - rospy.get_time(), MIN_TIMER_S), self._on_deadline, oneshot=True)
 
     def _on_deadline(self, event):
         """The timer armed for the deadline fired: the debouncer judges the excess at this instant."""
         now = rospy.get_time()
         change = None
         with self._lock:
-            if self._stale_inputs(now):
+            before = self._debouncer.deadline
+            stale = self._stale_inputs(now)
+            if stale:
                 # No data for longer than the timeout: the excess was not observed continuously.
                 self._debouncer.interrupt()
             else:
                 change = self._debouncer.poll(now)
             deadline = self._debouncer.deadline
+            news = excess_news(before, deadline, change)
             value = self._value
             if change is None and deadline is not None:
                 self._armed_deadline = None  # a timer woke a little early: arm it again for the rest
+        self._report(news, value, 'no fresh reading of %s' % self._names(stale))
         if change is not None:
             self._announce(change, value)
         elif deadline is not None:
-            self._arm(deadline, now)
+            self._arm(deadline)
 
     def _announce(self, state, value):
         """Log a change of the warning state and hand it to the link, which calls the service."""
-        mode, debouncer = self._mode, self._debouncer
-        if state == WARNING:
-            why = 'above the threshold %.1f %s for %.1f s' % (debouncer.threshold, mode.unit, debouncer.delay)
-        else:
-            why = 'at or below the threshold %.1f %s' % (debouncer.threshold, mode.unit)
-        rospy.loginfo('%s %.1f %s %s: %s', mode.output, value, mode.unit, why, state)
+        debouncer = self._debouncer
+        rospy.loginfo(messages.state_changed(self._mode, state, value, debouncer.threshold,
+                                             debouncer.delay))
         self._link.want(state)
 
     def _on_led(self, msg):
@@ -198,52 +221,6 @@ class ExamNode(object):
             return
         self._link.led_reported(state)
 
-    def _open_service(self):
-        """Open the persistent connection to the warning service if none is (link's thread only).
-
-        Called by the link ahead of the first call, and again after a failed one: a connection that
-        is open needs no master, so a state decided while the master is down still reaches the drone.
-        :raises Exception: the service cannot be found or connected to (the link tries again later).
-        """
-        if self._proxy is None:
-            self._proxy, uri = master_link.open_persistent(self._service, self._mode.service_type)
-            rospy.loginfo('%s: connected to %s; the connection is kept for every call'
-                          % (self._service, uri))
-        return True
-
-    def _call_service(self, state):
-        """One call of the warning service (link's thread only, may block).
-
-        On the open connection if there is one; if a call on it raises (the drone restarted, the link
-        broke, the call failed), the connection is closed and the call made once more on a new one,
-        found through the master. A failure on the new one is the link's to retry.
-        """
-        if self._proxy is not None:
-            try:
-                return self._call_on(state)
-            except Exception as err:
-                rospy.loginfo('%s: the call on the open connection failed (%s: %s); calling again on '
-                              'a new connection' % (self._service, type(err).__name__, err))
-        self._open_service()
-        return self._call_on(state)
-
-    def _call_on(self, state):
-        """One call on the open connection; a connection whose call raised is closed and forgotten."""
-        try:
-            response = self._proxy(state)
-        except Exception:
-            self._proxy.close()
-            self._proxy = None
-            raise
-        return response.success, response.message
-
-    def _on_call_failed(self, state, reason):
-        rospy.logwarn_throttle(THROTTLE_S, 'could not set %s to %s (retrying every %.0f s): %s'
-                               % (self._service, state, RETRY_PERIOD_S, reason))
-
-    def _on_call_delivered(self, state):
-        rospy.loginfo('%s: LED set to %s', self._service, state)
-
     # --- output -------------------------------------------------------------------------------------
 
     def _on_publish_tick(self, event):
@@ -251,25 +228,24 @@ class ExamNode(object):
         now = rospy.get_time()
         with self._lock:
             stale = self._stale_inputs(now)
+            news = None
             if stale:
+                news = excess_news(self._debouncer.deadline, None, None)
                 self._debouncer.interrupt()
             value = self._value
         if not stale:
-            try:
-                self._pub.publish(Float32(value))
-            except rospy.ROSException:
-                # The publisher closed: rospy is shutting down and this was the timer's last tick.
-                if not rospy.is_shutdown():
-                    raise
+            self._pub.publish(Float32(value))
             return
+        self._report(news, value, 'no fresh reading of %s' % self._names(stale))
         if all(cache.stamp is None for cache in stale):
-            rospy.loginfo_throttle(THROTTLE_S, 'waiting for the first reading of %s'
-                                   % ', '.join(rospy.resolve_name(c.topic) for c in stale))
+            rospy.loginfo_throttle(THROTTLE_S, 'waiting for the first reading of %s' % self._names(stale))
         else:
-            rospy.logwarn_throttle(THROTTLE_S, 'not publishing %s: no fresh reading of %s for more '
-                                   'than %.1f s' % (rospy.resolve_name(self._mode.output),
-                                                    ', '.join(rospy.resolve_name(c.topic) for c in stale),
-                                                    self._timeout))
+            rospy.logwarn_throttle(THROTTLE_S, 'not publishing %s: no fresh reading of %s for more than '
+                                   '%.1f s' % (self._output, self._names(stale), self._timeout))
+
+    @staticmethod
+    def _names(caches):
+        return ', '.join(rospy.resolve_name(c.topic) for c in caches)
 
     # --- diagnostics --------------------------------------------------------------------------------
 
@@ -285,11 +261,4 @@ class ExamNode(object):
 
 
 def main():
-    rospy.init_node('exam')
-    try:
-        ExamNode()
-    except params.ParamError as err:
-        rospy.logfatal(str(err))
-        sys.exit(1)
-    master_link.start()
-    rospy.spin()
+    lifecycle.run('exam', ExamNode)

@@ -1,6 +1,7 @@
 """Delivers the wanted warning state to the drone's LED service, from a thread of its own.
 
-No rospy here: the node injects the function that performs one service call, so the delivery rules are
+No rospy here: the node injects the function that opens a connection to the service
+(:func:`drone_sim.master_link.open_persistent`), so the delivery rules and the connection's are
 unit-tested with a fake service.
 
 Why a thread (exam question 13 done right): a ROS service call is a blocking round trip to another
@@ -19,7 +20,8 @@ Rules:
 - With a ``connect`` function, the worker opens the connection to the service ahead of the first call,
   while it has nothing to deliver: at start, and again after a failed call, every ``retry_period``
   until it succeeds. A connection that is already open needs no name lookup, so a state decided while
-  the ROS master is down still reaches the drone (issue 13).
+  the ROS master is down still reaches the drone (issue 13). :class:`ServiceConnection` is that
+  connection: the link's ``connect`` and ``call``.
 """
 import threading
 
@@ -146,3 +148,59 @@ class WarningLink(object):
             reason = 'refused: %s' % message
         self._on_failure(state, reason)
         return reason
+
+
+class ServiceConnection(object):
+    """The persistent connection to the warning service: ``open`` and ``call`` of a :class:`WarningLink`.
+
+    Used by the link's thread only, so it needs no lock. A connection that is open needs no master,
+    so a state decided while the master is down still reaches the drone; a call on it that raises
+    (the drone restarted, the link broke) closes it, and the call is made once more on a new one.
+
+    :param name: the service's resolved name, for the log lines.
+    :param open_persistent: function() -> (proxy, uri): a proxy whose connection is open; raises when
+        the service cannot be found or connected to. ``proxy(state)`` returns a response with
+        ``success`` and ``message``; ``proxy.close()`` closes it.
+    :param log: function(message) for the info lines (a new connection, a call that failed on one).
+    """
+
+    def __init__(self, name, open_persistent, log):
+        self._name = name
+        self._open_persistent = open_persistent
+        self._log = log
+        self._proxy = None
+
+    def open(self):
+        """Open the connection if none is open; True once it is.
+
+        :raises Exception: the service cannot be found or connected to (the link tries again later).
+        """
+        if self._proxy is None:
+            self._proxy, uri = self._open_persistent()
+            self._log('%s: connected to %s; the connection is kept for every call' % (self._name, uri))
+        return True
+
+    def call(self, state):
+        """One call with ``state``, on the open connection if there is one, else on a new one.
+
+        :returns: ``(success, message)``. :raises Exception: the call failed on a new connection too
+            (the link's to retry).
+        """
+        if self._proxy is not None:
+            try:
+                return self._call_on(state)
+            except Exception as err:
+                self._log('%s: the call on the open connection failed (%s: %s); calling again on a new '
+                          'connection' % (self._name, type(err).__name__, err))
+        self.open()
+        return self._call_on(state)
+
+    def _call_on(self, state):
+        """One call on the open connection; a connection whose call raised is closed and forgotten."""
+        try:
+            response = self._proxy(state)
+        except Exception:
+            self._proxy.close()
+            self._proxy = None
+            raise
+        return response.success, response.message

@@ -2,7 +2,7 @@
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from exam.debounce import NORMAL, WARNING, Debouncer
+from exam.debounce import NORMAL, WARNING, Debouncer, excess_news
 
 THRESHOLD = 1300.0
 DELAY = 5.0
@@ -159,3 +159,13 @@ def test_the_properties_see_warnings():
     # Guard against vacuous properties: the strategy's shape does produce WARNINGs and returns.
     log = run([(0.5, THRESHOLD + 10, False)] * 12 + [(0.5, THRESHOLD - 10, True)])
     assert changes(log) == [WARNING, NORMAL]
+
+
+def test_excess_news_once_per_excess_and_its_cancellation():
+    assert excess_news(None, 15.0, None) == 'pending'          # an excess began, WARNING due at 15 s
+    assert excess_news(15.0, 15.0, None) is None               # the same excess goes on
+    assert excess_news(15.0, None, NORMAL) == 'cancelled'      # back within the limit
+    assert excess_news(15.0, None, None) == 'cancelled'        # interrupted (stale inputs)
+    assert excess_news(15.0, None, WARNING) is None            # it fired: logged as the WARNING
+    assert excess_news(None, None, NORMAL) is None             # nothing was pending
+    assert excess_news(15.0, 21.0, None) == 'pending'          # a new excess right after another

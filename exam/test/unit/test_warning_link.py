@@ -1,4 +1,5 @@
 """Delivery rules of the warning link, against a fake service driven by events (no sleeps)."""
+import collections
 import subprocess
 import sys
 import threading
@@ -6,7 +7,7 @@ import threading
 import pytest
 
 from exam.debounce import NORMAL, WARNING
-from exam.warning_link import WarningLink
+from exam.warning_link import ServiceConnection, WarningLink
 
 WAIT_S = 5.0  # generous deadline for the worker thread to act
 
@@ -268,3 +269,76 @@ def test_a_connection_that_cannot_be_opened_is_tried_once_per_period_not_hammere
         assert 1 <= connection.attempts <= 4
     finally:
         link.stop(timeout=WAIT_S)
+
+
+class FakeProxy(object):
+    """A persistent proxy: answers calls until ``broken``; records its calls and whether it was closed."""
+
+    def __init__(self, name, broken=False):
+        self.name = name
+        self.broken = broken
+        self.calls = []
+        self.closed = False
+
+    def __call__(self, state):
+        if self.broken:
+            raise IOError('connection to %s reset' % self.name)
+        self.calls.append(state)
+        return collections.namedtuple('Response', 'success message')(True, 'LED set by %s' % self.name)
+
+    def close(self):
+        self.closed = True
+
+
+class Opener(object):
+    """open_persistent(): hands out the prepared proxies in turn; raises when none is left."""
+
+    def __init__(self, *proxies):
+        self.proxies = list(proxies)
+        self.opened = []
+
+    def __call__(self):
+        if not self.proxies:
+            raise IOError('service /altitude_warning not found')
+        proxy = self.proxies.pop(0)
+        self.opened.append(proxy)
+        return proxy, 'rosrpc://drone:%d' % (40000 + len(self.opened))
+
+
+def connection_with(*proxies):
+    log = []
+    opener = Opener(*proxies)
+    return ServiceConnection('/altitude_warning', opener, log.append), opener, log
+
+
+def test_the_connection_is_opened_once_and_kept_for_every_call():
+    first = FakeProxy('first')
+    connection, opener, log = connection_with(first)
+    assert connection.open() and connection.open()
+    assert connection.call(WARNING) == (True, 'LED set by first')
+    assert connection.call(NORMAL) == (True, 'LED set by first')
+    assert opener.opened == [first] and first.calls == [WARNING, NORMAL] and not first.closed
+    assert log == ['/altitude_warning: connected to rosrpc://drone:40001; the connection is kept for '
+                   'every call']
+
+
+def test_a_call_that_fails_on_the_open_connection_is_made_again_on_a_new_one():
+    first, second = FakeProxy('first'), FakeProxy('second')
+    connection, opener, log = connection_with(first, second)
+    connection.open()
+    first.broken = True  # the drone restarted
+    assert connection.call(WARNING) == (True, 'LED set by second')
+    assert first.closed and not second.closed and second.calls == [WARNING]
+    assert log[1] == ('/altitude_warning: the call on the open connection failed (OSError: connection '
+                      'to first reset); calling again on a new connection')
+
+
+def test_a_call_without_a_connection_opens_one_and_a_failure_there_is_the_links_to_retry():
+    broken = FakeProxy('broken', broken=True)
+    connection, opener, _ = connection_with(broken)
+    with pytest.raises(IOError):
+        connection.call(WARNING)
+    assert broken.closed
+    with pytest.raises(IOError, match='not found'):  # nothing left to open: the service is gone
+        connection.call(WARNING)
+    assert opener.opened == [broken]

@@ -9,7 +9,9 @@ SIGKILL (and its rosout with it), and 2 s later a new roscore starts on the same
    statuses; the launch's parameters are on the new master again (``/exam/threshold`` is 1450);
 2. the LED turns RED within 1 s of the deadline of the 1450 m threshold (the first published altitude
    above 1450 m plus the 5 s delay), not at the default threshold's;
-3. nothing died: the same processes run the nodes, roslaunch is still up, no traceback in any log.
+3. nothing died: the same processes run the nodes, roslaunch is still up, no traceback in any log;
+4. each node's "<node>: master" status on /diagnostics (issue 19) said WARN "master down" during the
+   outage, and says up, re-registered once, at a time within the outage's end, once it is back.
 
 Then a second fault: the master is killed again once the LED is RED and stays down while the drone
 descends, so NORMAL is decided with no master at all: the LED must turn GREEN within 1 s of the
@@ -17,9 +19,11 @@ altitude's return below 1450 m, over the connection the exam node opened before;
 up, the nodes are back on it again, and a new subscriber reads the LED GREEN.
 
 A watcher connected before the first fault times the whole flight (topics are peer to peer: its
-connections survive the master); every other check is a process started against the new master.
+connections survive the master), and a ``rostopic echo /diagnostics`` connected before it records the
+statuses through both faults; every other check is a process started against the new master.
 """
 import json
+import re
 import time
 
 from exam_lab.harness.supervisor import Supervisor
@@ -82,6 +86,27 @@ class Flight(object):
                      if topic == '/alt_warn_led' and data == colour and t > after), None)
 
 
+def statuses(output):
+    """The diagnostic statuses ``rostopic echo /diagnostics`` printed: [(name, level, message)]."""
+    found, level = [], None
+    lines = output.splitlines()
+    for i, line in enumerate(lines):
+        match = re.match(r'\s*level: (\d+)', line)
+        if match:
+            level = int(match.group(1))
+        match = re.match(r'\s*name: "(.*)"', line)
+        if match and i + 1 < len(lines):
+            message = re.match(r'\s*message: "(.*)"', lines[i + 1])
+            if message:
+                found.append((match.group(1), level, message.group(1)))
+    return found
+
+
+def master_statuses(output, node):
+    """(level, message) of each "<node>: master" status, in order."""
+    return [(level, message) for name, level, message in statuses(output) if name == node + ': master']
+
+
 def registered(master):
     """True when ``master`` lists the nodes' topics and service (knowing a node's name is not enough:
     a node that merely read a parameter from a new master is known to it)."""
@@ -126,6 +151,7 @@ def test_master_killed_and_restarted_mid_flight(tmp_path):
         watch = procs.start('watch', ['rosrun', 'exam_lab', 'probe.py', '--echo', '--timeout', '120',
                                       '--count', '100000', '--value', '/altitude',
                                       '--led', '/alt_warn_led=RED'], env)
+        diagnostics = procs.start('diag', ['rostopic', 'echo', '/diagnostics'], env)
         flight = Flight(procs)
         assert wait_until(lambda: {topic for topic, _, _ in flight.samples()}
                           == {'/altitude', '/alt_warn_led'}, 30.0), \
@@ -135,6 +161,7 @@ def test_master_killed_and_restarted_mid_flight(tmp_path):
 
         # The fault, on the issue's schedule (the flight is scripted in time: this is not a wait).
         time.sleep(max(0.0, launched + KILL_AT - time.monotonic()))
+        killed_wall = time.time()
         killed, back = restart(master)
         print('master killed at %.1f s after the launch, a new one answering at %.1f s'
               % (killed - launched, back - launched))
@@ -147,9 +174,17 @@ def test_master_killed_and_restarted_mid_flight(tmp_path):
                                              '--value', '/altitude'], 30.0, env)
         assert status == 0, 'a subscriber started after the restart got no /altitude: ' + out
         fresh = time.monotonic() - back
-        status, out, _ = procs.run('diagnostics', ['rostopic', 'echo', '-n', '1', '/diagnostics'], 20.0,
+        status, out, _ = procs.run('diagnostics', ['rostopic', 'echo', '-n', '3', '/diagnostics'], 20.0,
                                    env)
         assert status == 0 and 'exam: inputs' in out and 'exam: warning' in out, out
+        # 4. The master link's status: up and re-registered once, during this outage's end.
+        for node in NODES:
+            seen = wait_until(lambda: [m for level, m in master_statuses(procs.output('diag'), node[1:])
+                                       if level == 0 and 're-registered 1 times' in m], 10.0)
+            assert seen, '%s: no re-registered status:\n%s' % (node, procs.output('diag')[-3000:])
+            at = float(seen[0].rsplit(' ', 1)[1])
+            assert killed_wall < at < time.time(), (node, seen[0])
+            print('%s: "%s"' % (node, seen[0]))
         print('on the new master %.2f s after it answered; a subscriber started then had 5 '
               '/altitude messages %.2f s after it answered' % (reappeared, fresh))
 
@@ -185,10 +220,20 @@ def test_master_killed_and_restarted_mid_flight(tmp_path):
                                            '--led', '/alt_warn_led=GREEN'], 30.0, env)
         assert status == 0, out
 
+        # 4. ... and WARN while the master was down (the second outage lasts seconds at least).
+        for node in NODES:
+            down = [m for level, m in master_statuses(procs.output('diag'), node[1:]) if level == 1]
+            assert down and all(m.startswith('master down for') for m in down), (node, down)
+            assert wait_until(lambda: [m for level, m in master_statuses(procs.output('diag'), node[1:])
+                                       if level == 0 and 're-registered 2 times' in m], 10.0), node
+            print('%s: %d WARN statuses while the master was down: "%s" ... "%s"'
+                  % (node, len(down), down[0], down[-1]))
+
         # 3. Nothing died, nothing was respawned.
         assert launch.poll() is None, procs.output('launch')
         assert {name: master.node_pid(name) for name in NODES} == pids
         procs.stop(watch)
+        procs.stop(diagnostics)
         procs.stop(launch)
         log = procs.output('launch')
         assert 'Traceback' not in log, log
