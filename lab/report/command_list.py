@@ -55,7 +55,7 @@ CREATE_PKG = Command('exam.create_pkg', 'catkin_create_pkg exam rospy std_msgs m
 
 # --- both sheets, question 12: a launch whose exam node refuses its parameter ends at once -----------
 BAD_LAUNCH = Command('flight.bad_launch', 'roslaunch exam exam.launch threshold:=1300m', 40,
-                     show_from=r'\]: parameter /exam/threshold')
+                     show_from=r'\]: /exam: parameter /exam/threshold')
 
 # --- sheet 000, questions 10 to 14: the exam node with the drone, one full default flight -----------
 FLIGHT_RECORD = Command('flight.record', 'rosbag record -O flight.bag ' + FLIGHT_TOPICS, None)
