@@ -38,8 +38,15 @@ def watching(log_dir, on_step):
     def watch():
         seen = set()
         while True:
+            # One listing a look: the session writes the files in the steps' order, so a listing that
+            # holds a later step's file holds the earlier ones' too (two looks at two files could
+            # see the later file without the earlier one, written between the looks).
+            try:
+                present = set(os.listdir(log_dir))
+            except OSError:
+                present = set()
             for name, step in STEPS:
-                if step not in seen and os.path.exists(os.path.join(log_dir, name)):
+                if step not in seen and name in present:
                     seen.add(step)
                     on_step(step)
             if stop.wait(POLL_S):
