@@ -4,10 +4,12 @@ ROS 1 nodes register with the master once: rospy never registers again, so after
 and started again on the same port (a ground-station laptop that crashed) the node runs on, its
 existing connections keep flowing, but nobody can find it any more: no new subscriber, no service
 lookup, no ``rosnode list``, and its parameters are gone. :func:`start` runs a daemon thread that asks
-the master about once a second whether it is the master the node registered with and still knows
-the node (one multicall of ``getPid`` and ``lookupNode`` of its own name, with a short socket
-timeout: its cost does not grow with the graph, see :mod:`drone_sim.outage`), and follows
-:class:`drone_sim.outage.MasterWatch`:
+the master whether it is the master the node registered with and still knows the node (one multicall
+of ``getPid`` and ``lookupNode`` of its own name, with a short socket timeout: its cost does not grow
+with the graph, see :mod:`drone_sim.outage`), and follows :class:`drone_sim.outage.MasterWatch`. It
+asks over a connection it keeps open (:mod:`drone_sim.master_line`): a second after start, the instant the
+master's end closes that connection, once a second while the master is unreachable, and otherwise
+only every ``HEARTBEAT_S`` seconds, so a master that lives is almost never asked:
 
 - master unreachable: one warning for the whole outage; the node keeps running;
 - master answers but does not know the node, or has another pid (it restarted): the node's private
@@ -42,6 +44,7 @@ subscriptions (``get_param_cached``); nothing of ours relies on them.
 No ROS parameters, topics or services of its own.
 """
 import logging
+import socket
 import threading
 import time
 import xmlrpc.client
@@ -53,10 +56,14 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from rospy.impl import paramserver, registration
 from rospy.impl.tcpros_base import TCPROSTransport
 
+from drone_sim.master_line import MasterLine
 from drone_sim.outage import REREGISTER, UNREACHABLE, MasterWatch, classify
 
 #: Seconds between two polls of the master.
 POLL_PERIOD_S = 1.0
+#: Seconds between two polls while the master is up and the connection to it held (see
+#: :mod:`drone_sim.master_line`): only a master that hangs, its connection open, waits for one.
+HEARTBEAT_S = 5.0
 #: Socket timeout of every call to the master [s]: a master that hangs must not stop the polling.
 CALL_TIMEOUT_S = 2.0
 #: Caller id of the node's call to its own publisherUpdate (what a master would send).
@@ -106,7 +113,7 @@ def _value(call, what):
 class MasterLink(object):
     """The polling thread of one node; see the module docstring. Create it with :func:`start`."""
 
-    def __init__(self, poll_period=POLL_PERIOD_S):
+    def __init__(self, poll_period=POLL_PERIOD_S, heartbeat=HEARTBEAT_S):
         self._master_uri = rosgraph.get_master_uri()
         self._name = rospy.get_name()
         self._node_uri = rospy.get_node_uri()
@@ -120,6 +127,10 @@ class MasterLink(object):
         self._updater.setHardwareID(self._name)
         self._updater.add('master', self._fill_status)
         self._poll_period = poll_period
+        self._heartbeat = heartbeat
+        self._line = MasterLine(self._master_uri, CALL_TIMEOUT_S)
+        # stop() writes to one end to end the thread's wait at once.
+        self._wake_in, self._wake_out = socket.socketpair()
         # Held for a whole poll: stop() returns only once no poll runs, so that rospy's unregistration
         # at shutdown (which follows the on_shutdown hooks) is never undone by a re-registration.
         self._lock = threading.Lock()
@@ -135,32 +146,43 @@ class MasterLink(object):
 
     def stop(self):
         self._stopped.set()
+        try:
+            self._wake_out.send(b'!')
+        except OSError:  # the thread ended already and closed its end
+            pass
         with self._lock:
             pass
+        self._wake_out.close()
 
     def _run(self):
-        while not self._stopped.wait(self._poll_period):
-            with self._lock:
-                if self._stopped.is_set() or rospy.core.is_shutdown_requested():
-                    return
-                try:
-                    self._poll()
-                except Exception as err:  # this thread must outlive anything; say what went wrong
-                    rospy.logerr_throttle(60.0, 'master link: unexpected %s: %s'
-                                          % (type(err).__name__, err))
+        try:
+            delay = self._poll_period
+            while True:
+                # Returns early when the master's end closes the held connection: ask it at once.
+                self._line.wait(delay, self._wake_in)
+                with self._lock:
+                    if self._stopped.is_set() or rospy.core.is_shutdown_requested():
+                        return
+                    try:
+                        self._poll()
+                    except Exception as err:  # this thread must outlive anything; say what went wrong
+                        rospy.logerr_throttle(60.0, 'master link: unexpected %s: %s'
+                                              % (type(err).__name__, err))
+                # Up, on a held connection: its closing is the news, a heartbeat covers a hung master.
+                delay = self._heartbeat if self._line.held() else self._poll_period
+        finally:
+            self._line.close()
+            self._wake_in.close()
 
     def _poll(self):
-        master = _proxy(self._master_uri)
-        calls = xmlrpc.client.MultiCall(master)
-        calls.getPid(self._name)
-        calls.lookupNode(self._name, self._name)
         try:
-            pid, node = list(calls())
+            pid, node = self._line.multicall([('getPid', [self._name]),
+                                              ('lookupNode', [self._name, self._name])])
         except Exception as err:  # refused, reset, timeout, HTTP error: no usable master
             self._tell(self._watch.observe, UNREACHABLE, time.time(), _describe(err))
             return
-        pid = pid[2] if pid[0] == 1 else None
-        answer = classify(pid, node[2] if node[0] == 1 else None, self._known_pid)
+        pid = pid[2] if pid and pid[0] == 1 else None
+        answer = classify(pid, node[2] if node and node[0] == 1 else None, self._known_pid)
         action = self._tell(self._watch.observe, answer, time.time())
         if action != REREGISTER:
             if self._known_pid is None:
@@ -169,7 +191,7 @@ class MasterLink(object):
                 self._params = _private_params()
             return
         try:
-            counts = self._reregister(master)
+            counts = self._reregister(_proxy(self._master_uri))
         except Exception as err:
             self._tell(self._watch.reregister_failed, time.time(), _describe(err))
         else:

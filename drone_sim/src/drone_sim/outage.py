@@ -1,8 +1,9 @@
 """What a node does when its master goes away and comes back: the rules, without rospy.
 
 ROS 1 nodes register with the master once, at start-up; a master that is killed and started again on
-the same port knows none of them. :mod:`drone_sim.master_link` polls the master about once a second
-and feeds each answer to :class:`MasterWatch`, which says what to do and what to log: the pure part,
+the same port knows none of them. :mod:`drone_sim.master_link` asks the master when the connection it
+holds to it closes, once a second while it is down, every few seconds otherwise, and feeds each
+answer to :class:`MasterWatch`, which says what to do and what to log: the pure part,
 unit-tested with synthetic answers and times.
 
 An answer is one of:
