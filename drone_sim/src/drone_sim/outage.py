@@ -66,6 +66,7 @@ class MasterWatch(object):
         self._reregistered_at = None  # time of the last re-registration, None before the first
         self._reregistrations = 0
         self._counts = None  # what the last re-registration registered
+        self._answered_at = None  # time of the master's last answer, None before the first
 
     @property
     def up(self):
@@ -73,6 +74,8 @@ class MasterWatch(object):
 
     def observe(self, answer, now, error=''):
         """One poll's answer at time ``now`` [s]; ``error`` says why the master was unreachable."""
+        if answer != UNREACHABLE:
+            self._answered_at = now
         if answer == UNREACHABLE:
             if self._down_since is not None:
                 return None, None, ''
@@ -126,6 +129,8 @@ class MasterWatch(object):
                   ('state', 'up' if self.up else 'down'),
                   ('down since [s]', 'up' if self.up else '%.3f' % self._down_since),
                   ('down for [s]', '0' if self.up else '%.1f' % (now - self._down_since)),
+                  ('last answer at [s]',
+                   'never' if self._answered_at is None else '%.3f' % self._answered_at),
                   ('re-registrations', '%d' % self._reregistrations),
                   ('last re-registration at [s]',
                    'never' if self._reregistered_at is None else '%.3f' % self._reregistered_at)]

@@ -105,11 +105,15 @@ def test_status_up_down_and_re_registered():
     w = watch()
     assert w.status(5.0) == ('ok', 'master up, registered since the start', [
         ('master', URI), ('state', 'up'), ('down since [s]', 'up'), ('down for [s]', '0'),
-        ('re-registrations', '0'), ('last re-registration at [s]', 'never')])
+        ('last answer at [s]', 'never'), ('re-registrations', '0'),
+        ('last re-registration at [s]', 'never')])
+    w.observe(KNOWN, 6.0)
+    assert dict(w.status(7.0)[2])['last answer at [s]'] == '6.000'
     w.observe(UNREACHABLE, 10.0, 'refused')
     level, summary, values = w.status(12.5)
     assert (level, summary) == ('warn', 'master down for 2.5 s')
     assert dict(values)['down since [s]'] == '10.000' and dict(values)['state'] == 'down'
+    assert dict(values)['last answer at [s]'] == '6.000'
     w.reregister_failed(13.0, 'refused')
     assert w.status(13.0)[1] == 'master down for 3.0 s, re-registration failing'
     w.observe(UNKNOWN, 14.0)

@@ -21,9 +21,15 @@ up, the nodes are back on it again, and a new subscriber reads the LED GREEN.
 A watcher connected before the first fault times the whole flight (topics are peer to peer: its
 connections survive the master), and a ``rostopic echo /diagnostics`` connected before it records the
 statuses through both faults; every other check is a process started against the new master.
+
+A second test hangs the master (SIGSTOP) instead: its connections stay open, so only the master
+link's heartbeat can notice it (issue 19: the link waits for the master's connection to close rather
+than asking every second).
 """
 import json
+import os
 import re
+import signal
 import time
 
 from exam_lab.harness.supervisor import Supervisor
@@ -99,6 +105,25 @@ def statuses(output):
             message = re.match(r'\s*message: "(.*)"', lines[i + 1])
             if message:
                 found.append((match.group(1), level, message.group(1)))
+    return found
+
+
+def status_values(output, name):
+    """The key/values of each status ``name`` that ``rostopic echo /diagnostics`` printed: [dict]."""
+    found, current, key = [], None, None
+    for line in output.splitlines():
+        match = re.match(r'\s*(name|key|value): "(.*)"', line)
+        if not match:
+            continue
+        field, text = match.groups()
+        if field == 'name':
+            current = {} if text == name else None
+            if current is not None:
+                found.append(current)
+        elif current is not None and field == 'key':
+            key = text
+        elif current is not None:
+            current[key] = text
     return found
 
 
@@ -242,3 +267,44 @@ def test_master_killed_and_restarted_mid_flight(tmp_path):
         log = procs.output('launch')
         assert 'Traceback' not in log, log
         print('\n'.join(line for line in log.splitlines() if 'master' in line or 'connect' in line))
+
+
+#: A hung master keeps its connections open: only the master link's heartbeat (every 5 s, a call that
+#: times out after 2 s) notices it. Generous, but a link without a heartbeat never gets there.
+HUNG_NOTICED_BOUND = 30.0
+
+
+def test_a_hung_master_is_noticed_and_found_unchanged(tmp_path):
+    """A master that hangs (SIGSTOP) leaves the nodes' connections to it open, so no close tells of
+    it: each node says "unreachable" after its next heartbeat's call times out, and once the master
+    runs again, that it still knows the node: nothing re-registered, nothing died."""
+    with Supervisor(tmp_path) as procs:
+        master = procs.start_master()
+        launch = procs.start('launch', ['roslaunch', 'exam', 'exam.launch', 'profile:=calm'], master.env)
+        assert wait_until(lambda: registered(master) and all(
+            master.node_pid(name) for name in NODES), 60.0), procs.output('launch')
+        pids = {name: master.node_pid(name) for name in NODES}
+        # Each node's link has had its first answer, so it holds a connection that a hang keeps open.
+        procs.start('diag', ['rostopic', 'echo', '/diagnostics'], master.env)
+        assert wait_until(lambda: all(
+            any(v.get('last answer at [s]', 'never') != 'never'
+                for v in status_values(procs.output('diag'), node[1:] + ': master'))
+            for node in NODES), 30.0), procs.output('diag')[-3000:]
+        rosmaster = master.graph.getPid()
+        out = lambda: procs.output('launch')
+        os.kill(rosmaster, signal.SIGSTOP)
+        stopped = time.monotonic()
+        try:
+            noticed = wait_until(lambda: out().count('unreachable (TimeoutError') >= len(NODES),
+                                 HUNG_NOTICED_BOUND)
+            took = time.monotonic() - stopped
+        finally:
+            os.kill(rosmaster, signal.SIGCONT)
+        assert noticed, 'a hung master went unnoticed for %.0f s:\n%s' % (took, out()[-3000:])
+        assert wait_until(lambda: out().count('it still knows') >= len(NODES), 30.0), out()[-3000:]
+        print('a hung master noticed by both nodes %.1f s after SIGSTOP' % took)
+        assert 're-registered' not in out(), out()
+        assert {name: master.node_pid(name) for name in NODES} == pids
+        assert launch.poll() is None, out()
+        procs.stop(launch)
+        assert 'Traceback' not in out(), out()
