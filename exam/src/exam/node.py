@@ -18,7 +18,7 @@ How one reading travels (each step runs on the thread rospy gives it):
    input interrupts a pending excess.
 4. A 1 Hz timer publishes /diagnostics.
 5. A thread of :mod:`drone_sim.master_link` keeps the node registered across a master restart, and the
-   connection to the warning service (:class:`exam.warning_link.ServiceConnection`) is opened ahead
+   connection to the warning service (:func:`exam.warning_link.service_link`) is opened ahead
    of the first call and kept, so a state decided while the master is down still reaches the drone.
 
 Every timer and callback goes through :mod:`drone_sim.lifecycle`, so a stop at any moment ends them
@@ -51,6 +51,7 @@ Services called:
     altitude mode: altitude_warning (mydrone/AltitudeWarning) with "NORMAL" or "WARNING".
     depth mode: depth_warning (submarinedrone/DepthWarning) with "NORMAL" or "WARNING".
 """
+import collections
 import threading
 
 import rospy
@@ -61,7 +62,7 @@ from exam import diagnostics, messages
 from exam.debounce import Debouncer, excess_news
 from exam.inputs import InputCache
 from exam.modes import MODES
-from exam.warning_link import LED_STATES, ServiceConnection, WarningLink
+from exam.warning_link import LED_STATES, service_link
 
 #: Seconds between two identical warnings on a 10 Hz path, so a fault does not flood /rosout.
 THROTTLE_S = 5.0
@@ -72,10 +73,33 @@ LINK_STOP_S = 1.0
 #: Shortest timer rospy can arm [s] (a period of 0 divides by zero in rospy.Rate).
 MIN_TIMER_S = 0.001
 
+#: The node's parameters, checked (see the module docstring); ``mode`` is an :class:`exam.modes.Mode`.
+Params = collections.namedtuple('Params', 'mode threshold delay rate timeout')
+
 
 def _param(name, default):
     """(resolved name, value) of the private parameter ``name``, so an error names what was read."""
     return rospy.resolve_name('~' + name), rospy.get_param('~' + name, default)
+
+
+def read_params():
+    """Every parameter, checked before anything is created.
+
+    A value that is given but unusable stops the node: a typo in a launch file must not fly with a
+    threshold nobody chose. :raises drone_sim.params.ParamError: naming the parameter and the value.
+    """
+    mode = MODES[params.one_of(*_param('mode', 'altitude'), choices=MODES)]
+    return Params(mode=mode,
+                  threshold=params.finite_float(*_param('threshold', mode.default_threshold),
+                                                unit=mode.unit),
+                  delay=params.non_negative_float(*_param('delay', 5.0), unit='s'),
+                  rate=params.positive_float(*_param('rate', 10.0), unit='Hz'),
+                  timeout=params.positive_float(*_param('timeout', 5.0), unit='s'))
+
+
+def _names(caches):
+    """The resolved topic names of ``caches``, for a log line."""
+    return ', '.join(rospy.resolve_name(c.topic) for c in caches)
 
 
 class ExamNode(object):
@@ -85,64 +109,48 @@ class ExamNode(object):
     """
 
     def __init__(self):
-        # 1. Parameters, all checked before anything is created. A value that is given but unusable
-        #    stops the node: a typo in a launch file must not fly with a threshold nobody chose.
-        self._mode = mode = MODES[params.one_of(*_param('mode', 'altitude'), choices=MODES)]
-        threshold = params.finite_float(*_param('threshold', mode.default_threshold), unit=mode.unit)
-        delay = params.non_negative_float(*_param('delay', 5.0), unit='s')
-        rate = params.positive_float(*_param('rate', 10.0), unit='Hz')
-        self._timeout = params.positive_float(*_param('timeout', 5.0), unit='s')
-
+        p = read_params()
+        self._mode = mode = p.mode
+        self._timeout = p.timeout
         self._lock = threading.Lock()
         self._inputs = [InputCache(spec.topic, spec.why_unusable) for spec in mode.inputs]
-        self._debouncer = Debouncer(threshold, delay)
+        self._debouncer = Debouncer(p.threshold, p.delay)
         self._value = None
         self._armed_deadline = None
 
-        # 2. Outputs and the service link, before any callback can fire.
+        # Outputs and the service link first, inputs and timers last: no callback sees a half-built node.
         self._pub = rospy.Publisher(mode.output, Float32, queue_size=10)
+        self._output = rospy.resolve_name(mode.output)
         service = rospy.resolve_name(mode.service)
-        connection = ServiceConnection(service, lambda: master_link.open_persistent(
-            service, mode.service_type), rospy.loginfo)
-        self._link = WarningLink(
-            connection.call, connect=connection.open, retry_period=RETRY_PERIOD_S,
-            on_failure=lambda state, reason: rospy.logwarn_throttle(
-                THROTTLE_S, 'could not set %s to %s (retrying every %.0f s): %s'
-                % (service, state, RETRY_PERIOD_S, reason)),
-            on_delivered=lambda state: rospy.loginfo('%s: LED set to %s', service, state))
+        self._link = service_link(
+            service, lambda: master_link.open_persistent(service, mode.service_type), RETRY_PERIOD_S,
+            log=rospy.loginfo, warn=lambda text: rospy.logwarn_throttle(THROTTLE_S, text))
         self._link.start()
         lifecycle.on_stop(lambda: self._link.stop(timeout=LINK_STOP_S))
-
-        self._output = rospy.resolve_name(mode.output)
         rospy.loginfo('%s: mode %s, %s > %.1f %s for %.1f s -> WARNING via %s; publishing %s at %.1f Hz; '
-                      'inputs %s stale after %.1f s', rospy.get_name(), mode.name, mode.output, threshold,
-                      mode.unit, delay, service, self._output, rate, self._names(self._inputs),
-                      self._timeout)
+                      'inputs %s stale after %.1f s', rospy.get_name(), mode.name, mode.output,
+                      p.threshold, mode.unit, p.delay, service, self._output, p.rate,
+                      _names(self._inputs), p.timeout)
 
-        # 3. Inputs and timers last, so no callback sees a half-built node.
         for spec, cache in zip(mode.inputs, self._inputs):
             rospy.Subscriber(spec.topic, Float32, lifecycle.guarded(self._on_reading),
                              callback_args=(spec, cache), queue_size=10)
         rospy.Subscriber(mode.led_topic, String, lifecycle.guarded(self._on_led), queue_size=10)
-        lifecycle.timer(1.0 / rate, self._on_publish_tick)
-        diagnostics.start(self._snapshot, self._link.snapshot, mode, service, self._timeout)
-
-    # --- inputs -------------------------------------------------------------------------------------
+        lifecycle.timer(1.0 / p.rate, self._on_publish_tick)
+        diagnostics.start(self._snapshot, self._link.snapshot, mode, service, p.timeout)
 
     def _on_reading(self, msg, args):
         """A sensor reading: validate, cache, compute, and let the debouncer judge it at once."""
         spec, cache = args
         now = rospy.get_time()
-        change = news = None
+        change = news = value = None
         with self._lock:
             reason = cache.offer(msg.data, now)
-            if reason is None:
-                value = self._compute(now)
-                if value is not None:
-                    self._value = value
-                    before = self._debouncer.deadline
-                    change = self._debouncer.update(value, now)
-                    news = excess_news(before, self._debouncer.deadline, change)
+            if reason is None and not self._stale(now):
+                value = self._value = self._mode.compute(*(c.value for c in self._inputs))
+                before = self._debouncer.deadline
+                change = self._debouncer.update(value, now)
+                news = excess_news(before, self._debouncer.deadline, change)
         if reason is not None:
             # Never cached, never published, never seen by the debouncer: just reported.
             rospy.logwarn_throttle(THROTTLE_S, 'ignoring %s = %r %s: %s'
@@ -152,17 +160,19 @@ class ExamNode(object):
         if change is not None:
             self._announce(change, value)
 
-    def _compute(self, now):
-        """The value from the cached inputs, or None unless every input is fresh. Call under the lock."""
-        if not all(cache.is_fresh(now, self._timeout) for cache in self._inputs):
-            return None
-        return self._mode.compute(*(cache.value for cache in self._inputs))
-
-    def _stale_inputs(self, now):
-        """Topics whose latest value is older than ~timeout (or missing). Call under the lock."""
+    def _stale(self, now):
+        """The inputs older than ~timeout (or missing), or []. Call under the lock."""
         return [cache for cache in self._inputs if not cache.is_fresh(now, self._timeout)]
 
-    # --- warning ------------------------------------------------------------------------------------
+    def _interrupt_if_stale(self, now):
+        """(stale inputs, news): a stale input interrupts a pending excess, which was not observed
+        continuously. Call under the lock."""
+        stale = self._stale(now)
+        news = None
+        if stale:
+            news = excess_news(self._debouncer.deadline, None, None)
+            self._debouncer.interrupt()
+        return stale, news
 
     def _report(self, news, value, why):
         """Log an excess that began (and arm its deadline) or a pending WARNING cancelled (``why``)."""
@@ -187,19 +197,16 @@ class ExamNode(object):
         now = rospy.get_time()
         change = None
         with self._lock:
-            before = self._debouncer.deadline
-            stale = self._stale_inputs(now)
-            if stale:
-                # No data for longer than the timeout: the excess was not observed continuously.
-                self._debouncer.interrupt()
-            else:
+            stale, news = self._interrupt_if_stale(now)
+            if not stale:
+                before = self._debouncer.deadline
                 change = self._debouncer.poll(now)
+                news = excess_news(before, self._debouncer.deadline, change)
             deadline = self._debouncer.deadline
-            news = excess_news(before, deadline, change)
             value = self._value
             if change is None and deadline is not None:
                 self._armed_deadline = None  # a timer woke a little early: arm it again for the rest
-        self._report(news, value, 'no fresh reading of %s' % self._names(stale))
+        self._report(news, value, 'no fresh reading of %s' % _names(stale))
         if change is not None:
             self._announce(change, value)
         elif deadline is not None:
@@ -207,9 +214,8 @@ class ExamNode(object):
 
     def _announce(self, state, value):
         """Log a change of the warning state and hand it to the link, which calls the service."""
-        debouncer = self._debouncer
-        rospy.loginfo(messages.state_changed(self._mode, state, value, debouncer.threshold,
-                                             debouncer.delay))
+        rospy.loginfo(messages.state_changed(self._mode, state, value, self._debouncer.threshold,
+                                             self._debouncer.delay))
         self._link.want(state)
 
     def _on_led(self, msg):
@@ -221,33 +227,21 @@ class ExamNode(object):
             return
         self._link.led_reported(state)
 
-    # --- output -------------------------------------------------------------------------------------
-
     def _on_publish_tick(self, event):
         """Publish the latest value, unless an input is missing or stale (then say which, throttled)."""
         now = rospy.get_time()
         with self._lock:
-            stale = self._stale_inputs(now)
-            news = None
-            if stale:
-                news = excess_news(self._debouncer.deadline, None, None)
-                self._debouncer.interrupt()
+            stale, news = self._interrupt_if_stale(now)
             value = self._value
         if not stale:
             self._pub.publish(Float32(value))
             return
-        self._report(news, value, 'no fresh reading of %s' % self._names(stale))
+        self._report(news, value, 'no fresh reading of %s' % _names(stale))
         if all(cache.stamp is None for cache in stale):
-            rospy.loginfo_throttle(THROTTLE_S, 'waiting for the first reading of %s' % self._names(stale))
+            rospy.loginfo_throttle(THROTTLE_S, 'waiting for the first reading of %s' % _names(stale))
         else:
             rospy.logwarn_throttle(THROTTLE_S, 'not publishing %s: no fresh reading of %s for more than '
-                                   '%.1f s' % (self._output, self._names(stale), self._timeout))
-
-    @staticmethod
-    def _names(caches):
-        return ', '.join(rospy.resolve_name(c.topic) for c in caches)
-
-    # --- diagnostics --------------------------------------------------------------------------------
+                                   '%.1f s' % (self._output, _names(stale), self._timeout))
 
     def _snapshot(self):
         """A copy of the state /diagnostics shows, taken under the lock (see exam.diagnostics)."""

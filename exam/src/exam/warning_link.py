@@ -21,7 +21,7 @@ Rules:
   while it has nothing to deliver: at start, and again after a failed call, every ``retry_period``
   until it succeeds. A connection that is already open needs no name lookup, so a state decided while
   the ROS master is down still reaches the drone (issue 13). :class:`ServiceConnection` is that
-  connection: the link's ``connect`` and ``call``.
+  connection: the link's ``connect`` and ``call``; :func:`service_link` puts the two together.
 """
 import threading
 
@@ -204,3 +204,20 @@ class ServiceConnection(object):
             self._proxy = None
             raise
         return response.success, response.message
+
+
+def service_link(name, open_persistent, retry_period, log, warn):
+    """The node's link: a :class:`WarningLink` delivering over a :class:`ServiceConnection`.
+
+    :param name: the service's resolved name, for the log lines.
+    :param open_persistent: as for :class:`ServiceConnection`.
+    :param retry_period: seconds between attempts while the service is absent or failing.
+    :param log: function(message) for the info lines (connected, LED set).
+    :param warn: function(message) for a failed attempt (the node throttles it: one a second otherwise).
+    """
+    connection = ServiceConnection(name, open_persistent, log)
+    return WarningLink(
+        connection.call, connect=connection.open, retry_period=retry_period,
+        on_failure=lambda state, reason: warn('could not set %s to %s (retrying every %.0f s): %s'
+                                              % (name, state, retry_period, reason)),
+        on_delivered=lambda state: log('%s: LED set to %s' % (name, state)))

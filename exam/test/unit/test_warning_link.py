@@ -7,7 +7,7 @@ import threading
 import pytest
 
 from exam.debounce import NORMAL, WARNING
-from exam.warning_link import ServiceConnection, WarningLink
+from exam.warning_link import ServiceConnection, WarningLink, service_link
 
 WAIT_S = 5.0  # generous deadline for the worker thread to act
 
@@ -342,3 +342,42 @@ def test_a_call_without_a_connection_opens_one_and_a_failure_there_is_the_links_
     with pytest.raises(IOError, match='not found'):  # nothing left to open: the service is gone
         connection.call(WARNING)
     assert opener.opened == [broken]
+
+
+class Lines(object):
+    """A log function whose lines a test can wait for."""
+
+    def __init__(self):
+        self.lines = []
+        self.changed = threading.Condition()
+
+    def __call__(self, line):
+        with self.changed:
+            self.lines.append(line)
+            self.changed.notify_all()
+
+    def wait_for(self, count):
+        with self.changed:
+            assert self.changed.wait_for(lambda: len(self.lines) >= count, WAIT_S), self.lines
+            return list(self.lines)
+
+
+def test_the_service_link_connects_ahead_delivers_and_warns_of_a_failed_attempt_naming_the_service():
+    first = FakeProxy('first')
+    opener = Opener(first)
+    log, warn = Lines(), Lines()
+    link = service_link('/altitude_warning', opener, 0.01, log, warn)
+    link.start()
+    try:
+        # Connected while nothing is due: the call needs no lookup later.
+        assert log.wait_for(1) == ['/altitude_warning: connected to rosrpc://drone:40001; the '
+                                   'connection is kept for every call']
+        link.want(WARNING)
+        assert log.wait_for(2)[1] == '/altitude_warning: LED set to WARNING'
+        first.broken = True  # the drone went away, and nothing is left to open
+        link.want(NORMAL)
+        assert warn.wait_for(1)[0] == ('could not set /altitude_warning to NORMAL (retrying every 0 s): '
+                                       'OSError: service /altitude_warning not found')
+        assert first.calls == [WARNING] and first.closed
+    finally:
+        link.stop(timeout=WAIT_S)
