@@ -12,7 +12,7 @@ becomes readable at that instant. :meth:`MasterLine.wait` waits for exactly that
 
 So the node asks only when something happened: at start, when the connection closes, and (while the
 master is down) once a poll period until it answers again, which is as fast as polling once a second
-ever was. A slow heartbeat (a real call every few seconds) covers what leaves the connection open: a
+ever was. A slower heartbeat (a real call every 2 s) covers what leaves the connection open: a
 master that hangs. TCP keepalive on the connection covers a master host that vanished from the
 network, in the kernels, costing the master's process nothing.
 

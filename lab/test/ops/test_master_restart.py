@@ -269,7 +269,7 @@ def test_master_killed_and_restarted_mid_flight(tmp_path):
         print('\n'.join(line for line in log.splitlines() if 'master' in line or 'connect' in line))
 
 
-#: A hung master keeps its connections open: only the master link's heartbeat (every 5 s, a call that
+#: A hung master keeps its connections open: only the master link's heartbeat (every 2 s, a call that
 #: times out after 2 s) notices it. Generous, but a link without a heartbeat never gets there.
 HUNG_NOTICED_BOUND = 30.0
 
