@@ -1,5 +1,6 @@
 """Supervisor.stop and stop_all on plain processes, no master needed."""
 import os
+import signal
 import sys
 import time
 
@@ -28,6 +29,18 @@ def test_stop_all_lets_a_clean_exit_keep_its_status(tmp_path):
         quick.wait()
         polite = sup.start('polite', ['sleep', '60'])
         assert sup.stop_all([quick, polite], grace=5.0) == [3, -2]
+
+
+def test_ctrl_c_reaches_a_child_when_the_supervisor_itself_ignores_it(tmp_path):
+    """A supervisor started by nohup or as ``cmd &`` from a script ignores SIGINT, and an ignored
+    signal is inherited through exec: its children must still get the user's Ctrl-C."""
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        with Supervisor(tmp_path) as sup:
+            polite = sup.start('polite', ['sleep', '60'])
+            assert sup.stop_all([polite], grace=5.0) == [-signal.SIGINT]
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 def test_stop_lets_the_children_of_a_leader_that_is_gone_finish(tmp_path):

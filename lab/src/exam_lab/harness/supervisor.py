@@ -30,6 +30,11 @@ from exam_lab.harness.wait import wait_until
 
 #: Environment variable that marks every process of one supervised run.
 MARKER = 'EXAM_LAB_RUN'
+#: Run before a command when this process ignores SIGINT (started by nohup, as ``cmd &`` from a script,
+#: from cron): an ignored signal stays ignored through exec, so without it Ctrl-C would not reach a
+#: child that keeps the default (a ``sleep``, a student's shell script), which would sit out its grace
+#: period and be killed. coreutils' ``env`` resets it and execs the command (same pid).
+DEFAULT_SIGINT = ['env', '--default-signal=INT']
 
 
 def free_port():
@@ -270,6 +275,8 @@ class Supervisor(object):
         """
         env = dict(self.env if env is None else env)
         env[MARKER] = self.log_dir
+        if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+            argv = DEFAULT_SIGINT + list(argv)
         with open(self.log(name), 'ab') as out:
             proc = subprocess.Popen(list(argv), env=env, cwd=cwd, stdout=out, stderr=subprocess.STDOUT,
                                     stdin=subprocess.DEVNULL, start_new_session=True)
