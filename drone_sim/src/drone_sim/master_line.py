@@ -12,9 +12,9 @@ becomes readable at that instant. :meth:`MasterLine.wait` waits for exactly that
 
 So the node asks only when something happened: at start, when the connection closes, and (while the
 master is down) once a poll period until it answers again, which is as fast as polling once a second
-ever was. A slower heartbeat (a real call every 2 s) covers what leaves the connection open: a
-master that hangs. TCP keepalive on the connection covers a master host that vanished from the
-network, in the kernels, costing the master's process nothing.
+ever was. A heartbeat (a real call every ``HEARTBEAT_S`` of :mod:`drone_sim.master_link`) covers
+what leaves the connection open: a master that hangs. TCP keepalive on the connection covers a
+master host that vanished from the network, in the kernels, costing the master's process nothing.
 
 A master that closes every connection after its answer (HTTP/1.0: a Linux kernel older than 4.16)
 leaves nothing to wait on: :meth:`MasterLine.held` is then false and the caller polls as before.

@@ -213,7 +213,8 @@ def service_link(name, open_persistent, retry_period, log, warn):
     :param open_persistent: as for :class:`ServiceConnection`.
     :param retry_period: seconds between attempts while the service is absent or failing.
     :param log: function(message) for the info lines (connected, LED set).
-    :param warn: function(message) for a failed attempt (the node throttles it: one a second otherwise).
+    :param warn: function(message), called at every failed attempt (once per ``retry_period`` while the
+        service fails; the node throttles it).
     """
     connection = ServiceConnection(name, open_persistent, log)
     return WarningLink(
