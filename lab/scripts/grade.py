@@ -6,7 +6,7 @@
 
 Besides the grades, OUT/index.html (the page for the teacher), each student's results.json
 (Gradescope) and flight.png, for a class the similarity check and, with --worksheet, Moodle's
-offline grading worksheet filled (the teacher's desk: lab/src/exam_lab/grader/desk.py).
+offline grading worksheet filled (the teacher's desk: lab/src/exam_lab/grader/publish/desk.py).
 
 Prints the score table; exits 0 whenever grading completed, whatever the scores, and 1 when the
 grader itself could not run (a missing input, the simulators not building, no sandbox: student code
@@ -16,8 +16,12 @@ import argparse
 import os
 import sys
 
-from exam_lab.grader import desk, documents, progress, report, runner, unpack
-from exam_lab.grader.sheets import SHEETS
+from exam_lab.grader import runner
+
+from exam_lab.grader.boxed import documents, unpack
+
+from exam_lab.grader.publish import desk, progress, report
+from exam_lab.grader.score.sheets import SHEETS
 
 
 def main(argv=None):
@@ -68,7 +72,7 @@ def main(argv=None):
                     print('  ' + line)
             print('grades.csv and one folder per student in %s' % out)
             for line in desk.finish(out, records, similar=None if args.no_similarity else
-                                    desk.class_similarity(args.klass, out, records), worksheet=args.worksheet):
+                                    runner.class_similarity(args.klass, out, records), worksheet=args.worksheet):
                 print(line)
     except RuntimeError as err:
         sys.stderr.write('grade: %s\n' % err)

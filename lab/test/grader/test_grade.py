@@ -13,7 +13,7 @@ import zipfile
 import pytest
 
 from exam_lab.grader import runner
-from exam_lab.grader.sheets import ITEMS
+from exam_lab.grader.score.sheets import ITEMS
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SUBMISSIONS = os.path.join(HERE, 'submissions')

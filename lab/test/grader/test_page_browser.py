@@ -14,7 +14,9 @@ import subprocess
 
 import pytest
 
-from exam_lab.grader import desk, runner
+from exam_lab.grader import runner
+
+from exam_lab.grader.publish import desk
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SUBMISSIONS = os.path.join(HERE, 'submissions')
@@ -54,7 +56,7 @@ def graded(tmp_path_factory):
     _two_page_pdf(str(klass / 'Jane Doe_101_assignsubmission_file_' / 'report.pdf'))
     out = str(root / 'out')
     records = runner.grade_class(str(klass), out, jobs=2)
-    lines = desk.finish(out, records, similar=desk.class_similarity(str(klass), out, records))
+    lines = desk.finish(out, records, similar=runner.class_similarity(str(klass), out, records))
     return out, records, lines
 
 

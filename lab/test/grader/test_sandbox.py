@@ -17,8 +17,10 @@ import tempfile
 
 import pytest
 
-from exam_lab.grader import runner, sandbox
-from exam_lab.grader.sheets import ITEMS
+from exam_lab.grader import runner
+
+from exam_lab.grader.host import sandbox
+from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -182,7 +184,7 @@ def test_no_sandbox_no_grading_unless_the_risk_is_named(monkeypatch, tmp_path):
 
 
 def test_probe_results_must_belong_to_the_run():
-    from exam_lab.grader.session import probe_problem
+    from exam_lab.grader.judge.session import probe_problem
     plan = {'kind': 'main', 'delay': 5.0}
     real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0}}
     assert probe_problem(real, plan, 99.0, 131.0) is None

@@ -8,7 +8,7 @@ import pytest
 from catkin_pkg.packages import find_packages
 
 from exam_lab.grader import runner
-from exam_lab.grader.sheets import ITEMS
+from exam_lab.grader.score.sheets import ITEMS
 
 REPO = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..'))
 SIMPLE = os.path.join(REPO, 'docs', 'simple_answer', 'exam')

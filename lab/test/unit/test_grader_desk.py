@@ -10,8 +10,10 @@ from html.parser import HTMLParser
 
 import pytest
 
-from exam_lab.grader import desk, documents, flightplot, gradescope, page, progress, report
-from exam_lab.grader.sheets import ITEMS
+from exam_lab.grader.boxed import documents
+
+from exam_lab.grader.publish import desk, flightplot, gradescope, page, progress, report
+from exam_lab.grader.score.sheets import ITEMS
 
 T0 = 1000.0
 
@@ -246,7 +248,7 @@ def test_steps_seen_in_the_log_folder(tmp_path):
 
 
 def test_the_probe_trace_is_compact():
-    from exam_lab.grader import probe
+    from exam_lab.grader.judge import probe
     samples = [(T0 + 0.01 * i, float(i)) for i in range(1000)] + [(T0 + 11.0, float('nan'))]
     got = probe.trace(samples, [[T0, 1170.0], [T0 + 3.0, 1430.123456]])
     assert 100 <= len(got['published']) <= 112

@@ -2,7 +2,13 @@
 leg check and the status on synthetic measurements (the stale-reading case included)."""
 import pytest
 
-from exam_lab.grader import launch, probe, report, rubric, session, source
+from exam_lab.grader.boxed import launch, source
+
+from exam_lab.grader.judge import probe, session
+
+from exam_lab.grader.score import rubric
+
+from exam_lab.grader.publish import report
 
 from test_grader_rubric import STATIC, SCHEDULE, lost, measured, points
 

@@ -8,7 +8,7 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader import source, unpack
+from exam_lab.grader.boxed import source, unpack
 
 PACKAGE_XML = '<package format="2"><name>%s</name></package>'
 

@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from exam_lab.grader import launch
+from exam_lab.grader.boxed import launch
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SUBMISSIONS = os.path.join(HERE, '..', 'grader', 'submissions')

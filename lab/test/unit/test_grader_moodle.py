@@ -6,8 +6,8 @@ import io
 
 import pytest
 
-from exam_lab.grader import moodle
-from exam_lab.grader.sheets import ITEMS
+from exam_lab.grader.publish import moodle
+from exam_lab.grader.score.sheets import ITEMS
 
 HEADER = ['Identifier', 'Full name', 'Email address', 'Status', 'Grade', 'Maximum grade',
           'Grade can be changed', 'Last modified (submission)', 'Online text', 'Last modified (grade)',

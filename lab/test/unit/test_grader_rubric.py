@@ -1,8 +1,8 @@
 """The rubric on synthetic measurements: each flaw costs exactly its points, with the numbers."""
 import pytest
 
-from exam_lab.grader import rubric
-from exam_lab.grader.sheets import ITEMS
+from exam_lab.grader.score import rubric
+from exam_lab.grader.score.sheets import ITEMS
 
 #: The main run's flight (s): rest 0, short excursion 3-6, long excursion 8.5-16, end 18.5.
 SCHEDULE = {'rest': 0.0, 'short_up': 3.0, 'short_down': 6.0, 'long_up': 8.5, 'long_down': 16.0, 'end': 18.5}

@@ -1,5 +1,5 @@
 """What the session reads in roslaunch's output, and when it runs the threshold check."""
-from exam_lab.grader import session
+from exam_lab.grader.judge import session
 
 DIED = ('\x1b[1mprocess[exam-1]: started with pid [17908]\x1b[0m\n'
         'Traceback (most recent call last):\n'
@@ -36,7 +36,8 @@ def test_threshold_run_only_after_a_warning_in_the_long_excursion():
 
 
 def test_sheet_detection(tmp_path):
-    from exam_lab.grader import launch, runner
+    from exam_lab.grader import runner
+    from exam_lab.grader.boxed import launch
     pkg = tmp_path / 'exam'
     (pkg / 'launch').mkdir(parents=True)
     (pkg / 'package.xml').write_text('<package><name>exam</name><depend>mydrone</depend>'

@@ -12,7 +12,7 @@ import subprocess
 
 import pytest
 
-from exam_lab.grader import similarity
+from exam_lab.grader.boxed import similarity
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ORIGINAL = os.path.join(HERE, '..', 'grader', 'submissions', 'good_student', 'exam')

@@ -2,7 +2,9 @@
 import os
 import stat
 
-from exam_lab.grader import report, source
+from exam_lab.grader.boxed import source
+
+from exam_lab.grader.publish import report
 
 
 def write(path, text, mode=0o644):

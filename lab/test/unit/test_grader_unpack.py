@@ -5,7 +5,7 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader import unpack
+from exam_lab.grader.boxed import unpack
 
 PACKAGE_XML = '<package format="2"><name>exam</name></package>'
 

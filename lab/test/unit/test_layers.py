@@ -110,3 +110,33 @@ def test_no_import_cycles():
 def test_the_oracle_is_independent_of_the_answer():
     path = source_modules()['exam_lab.harness.oracle']
     assert sorted(m for m in imports(path) if m.split('.')[0] in ANSWER) == []
+
+
+#: The grader's folders by trust level (exam_lab.grader's docstring): what runs as a box's uid on the
+#: student's bytes (boxed), the judge (not root), root's side (host), pure scoring, and what the teacher
+#: reads (publish).
+GRADER = 'exam_lab.grader'
+#: Folders that must never import what reads student bytes or runs the student's nodes.
+NEVER_IMPORT = {'host': ('boxed', 'judge'), 'score': ('boxed', 'judge', 'host', 'publish'),
+                'publish': ('boxed', 'judge', 'host')}
+
+
+def grader_modules(folder):
+    prefix = '%s.%s' % (GRADER, folder)
+    return sorted(name for name in source_modules() if name == prefix or name.startswith(prefix + '.'))
+
+
+@pytest.mark.parametrize('folder', sorted(NEVER_IMPORT))
+def test_the_grader_layers_keep_to_their_trust_level(folder):
+    modules = grader_modules(folder)
+    assert modules, 'no modules under %s.%s' % (GRADER, folder)
+    forbidden = tuple('%s.%s' % (GRADER, f) for f in NEVER_IMPORT[folder])
+    offending = ['%s imports %s' % (name, m) for name in modules for m in sorted(imports(source_modules()[name]))
+                 if m.startswith(forbidden)]
+    assert offending == []
+
+
+def test_every_grader_module_lives_in_a_trust_folder():
+    """Only the package itself and the runner (the pipeline) sit at the grader's top level."""
+    top = [name for name in source_modules() if name.startswith(GRADER + '.') and name.count('.') == 2]
+    assert sorted(top) == ['%s.%s' % (GRADER, f) for f in sorted(set(NEVER_IMPORT) | {'boxed', 'judge', 'runner'})]

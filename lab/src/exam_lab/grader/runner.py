@@ -1,13 +1,13 @@
 """Grading a submission or a class: prepare, run the session (sandboxed), score, write.
 
-The runner itself never runs a student's code: it unpacks and reads (:mod:`~exam_lab.grader.unpack`,
-:mod:`~exam_lab.grader.launch`, :mod:`~exam_lab.grader.source`) a copy of the package that no
+The runner itself never runs a student's code: it unpacks and reads (:mod:`~exam_lab.grader.boxed.unpack`,
+:mod:`~exam_lab.grader.boxed.launch`, :mod:`~exam_lab.grader.boxed.source`) a copy of the package that no
 student code can write, writes the derived launch files and the job, opens the submission's
-:class:`~exam_lab.grader.sandbox.Box`, and starts :mod:`exam_lab.grader.session` as root inside
+:class:`~exam_lab.grader.host.sandbox.Box`, and starts :mod:`exam_lab.grader.judge.session` as root inside
 ``unshare --net`` (only loopback), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an
-overall time limit. Then :mod:`~exam_lab.grader.rubric` scores and :mod:`~exam_lab.grader.report`
+overall time limit. Then :mod:`~exam_lab.grader.score.rubric` scores and :mod:`~exam_lab.grader.publish.report`
 writes; what reaches the results from the session's folder is copied as data (regular files only,
-each capped: :func:`~exam_lab.grader.sandbox.copy_results`).
+each capped: :func:`~exam_lab.grader.host.sandbox.copy_results`).
 
 The simulators (``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
 workspace (cached under ``$EXAM_WS/grader/underlay``, rebuilt when their sources change); each student's
@@ -28,8 +28,15 @@ import threading
 import time
 import traceback
 
-from exam_lab.grader import documents, launch, progress, report, rubric, sandbox, source, unpack
-from exam_lab.grader.sheets import DELAY, LATE_WARNING_S, PACKAGE, SHEETS
+from exam_lab.grader import workspace
+from exam_lab.grader.boxed import documents, launch, similarity, source, unpack
+
+from exam_lab.grader.host import sandbox
+
+from exam_lab.grader.score import rubric
+
+from exam_lab.grader.publish import progress, report
+from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, PACKAGE, SHEETS
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
 #: Time limits, s: the student's catkin_make, the node's start (to registering with the master),
@@ -230,7 +237,7 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
     why it could not).
 
     :param isolate: in a network namespace of its own with only loopback (needs root).
-    :param on_step: called with each step's name as the session starts it (:mod:`~exam_lab.grader.progress`).
+    :param on_step: called with each step's name as the session starts it (:mod:`~exam_lab.grader.publish.progress`).
     """
     log_dir = os.path.join(work, 'logs')
     judge_home = os.path.join(work, 'judge')
@@ -244,7 +251,7 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
     job_path = os.path.join(work, 'job.json')
     with open(job_path, 'w') as f:
         json.dump(job, f, indent=1, sort_keys=True)
-    argv = [sys.executable, '-m', 'exam_lab.grader.session', job_path]
+    argv = [sys.executable, '-m', 'exam_lab.grader.judge.session', job_path]
     if isolate:
         argv = ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + argv
     with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
@@ -356,9 +363,9 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
 
     :param on_step: called with each step's name as it starts (unpack, build, main flight...).
-    :param extra: added to the record (:func:`exam_lab.grader.documents.submission_facts`).
+    :param extra: added to the record (:func:`exam_lab.grader.boxed.documents.submission_facts`).
     :param unsandboxed: run it even where no sandbox can be made (the teacher's flag that names the
-        risk); otherwise :class:`~exam_lab.grader.sandbox.SandboxUnavailable` is raised there.
+        risk); otherwise :class:`~exam_lab.grader.host.sandbox.SandboxUnavailable` is raised there.
     """
     start = time.monotonic()
     student = student or unpack.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
@@ -411,9 +418,19 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             shutil.rmtree(work, ignore_errors=True)
 
 
-def workspace():
-    """The project's build workspace ($EXAM_WS, set by tools/env.sh; .ws/ by default)."""
-    return os.environ.get('EXAM_WS', os.path.join(os.getcwd(), '.ws'))
+def class_similarity(klass, out, records):
+    """The similarity check over a class's submissions (unpacked anew, as the runner did), each
+    named as its grade record names it; ``{"error"}`` when it could not run (the grades stand)."""
+    scratch = os.path.join(out, '.similarity-class')
+    try:
+        by_folder = {r.get('folder'): r['student'] for r in records}
+        submissions = [(by_folder.get(os.path.basename(folder), name), folder)
+                       for name, folder in unpack.list_students(klass, scratch)]
+        return similarity.check(submissions, out)
+    except Exception as err:  # a bug of the check must not cost the class its page
+        return {'error': repr(err)}
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
 
 
 def default_underlay():
@@ -424,7 +441,7 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
     """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv.
     One student the grader cannot grade is that student's row ("could not grade"), never the class's.
 
-    :param progress: told of the run as it goes (:class:`exam_lab.grader.progress.ClassProgress`).
+    :param progress: told of the run as it goes (:class:`exam_lab.grader.publish.progress.ClassProgress`).
     """
     refusal = sandbox_refusal(unsandboxed)
     if refusal:

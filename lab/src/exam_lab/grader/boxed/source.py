@@ -9,7 +9,7 @@ import stat
 import tokenize
 import xml.etree.ElementTree as ET
 
-from exam_lab.grader.sheets import SHEETS
+from exam_lab.grader.score.sheets import SHEETS
 
 _INIT_NODE = re.compile(r'\binit_node\s*\(')
 _GET_PARAM = re.compile(r'get_param\s*\(\s*[\'"]([^\'"]+)[\'"]')

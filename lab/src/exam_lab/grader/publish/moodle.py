@@ -21,7 +21,7 @@ feedback already in the worksheet as it was (a teacher's grade wins over the mac
 import html
 import re
 
-from exam_lab.grader.sheets import ITEMS
+from exam_lab.grader.score.sheets import ITEMS
 
 #: The participant's number in a "download all submissions" name (folder or flat file).
 _FOLDER_NUMBER = re.compile(r'_(\d+)_assign(?:submission|feedback)_')

@@ -2,27 +2,12 @@
 
 After grading, :func:`finish` writes, in ``OUT``: each student's Gradescope ``results.json`` and
 flight plot, the similarity check across the class, the Moodle worksheet filled (when one is given),
-and ``index.html`` (:mod:`exam_lab.grader.page`).
+and ``index.html`` (:mod:`exam_lab.grader.publish.page`).
 """
 import json
 import os
-import shutil
 
-from exam_lab.grader import flightplot, gradescope, moodle, page, similarity, unpack
-
-def class_similarity(klass, out, records):
-    """The similarity check over a class's submissions (unpacked anew, as the runner did), each
-    named as its grade record names it; ``{"error"}`` when it could not run (the grades stand)."""
-    scratch = os.path.join(out, '.similarity-class')
-    try:
-        by_folder = {r.get('folder'): r['student'] for r in records}
-        submissions = [(by_folder.get(os.path.basename(folder), name), folder)
-                       for name, folder in unpack.list_students(klass, scratch)]
-        return similarity.check(submissions, out)
-    except Exception as err:  # a bug of the check must not cost the class its page
-        return {'error': repr(err)}
-    finally:
-        shutil.rmtree(scratch, ignore_errors=True)
+from exam_lab.grader.publish import flightplot, gradescope, moodle, page
 
 
 def _grade_md(folder, record):
@@ -35,7 +20,7 @@ def finish(out, records, single=False, similar=None, worksheet=None):
     """Write the desk's files for ``records`` graded into ``out``; return lines for the terminal.
 
     :param single: one submission (its results are in ``out`` itself, not ``out/<student>``).
-    :param similar: the similarity check's result (:func:`exam_lab.grader.similarity.check`) or None.
+    :param similar: the similarity check's result (:func:`exam_lab.grader.boxed.similarity.check`) or None.
     :param worksheet: the Moodle worksheet to fill, or None.
     """
     lines, notes, entries = [], [], {}

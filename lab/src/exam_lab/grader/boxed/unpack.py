@@ -17,7 +17,7 @@ import tarfile
 import xml.etree.ElementTree as ET
 import zipfile
 
-from exam_lab.grader.sheets import PACKAGE, drone_packages
+from exam_lab.grader.score.sheets import PACKAGE, drone_packages
 
 #: Most files one submission may unpack, all its archives together (a package has tens).
 MAX_FILES = 5000

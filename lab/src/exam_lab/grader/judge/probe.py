@@ -1,12 +1,12 @@
 """The grader's probe: plays the drone for a student's node and measures what the rubric asks.
 
-Run inside its own rospy process, on the master of one submission, by :mod:`exam_lab.grader.session`::
+Run inside its own rospy process, on the master of one submission, by :mod:`exam_lab.grader.judge.session`::
 
-    python3 -m exam_lab.grader.probe PLAN.json RESULT.json
+    python3 -m exam_lab.grader.judge.probe PLAN.json RESULT.json
 
 The drone is the harness's :class:`~exam_lab.harness.fake_drone.Drone`, driven by a script with
 noise-free values from the oracle, so the same package gets the same measurements. The probe only
-measures; the points are given by :mod:`exam_lab.grader.rubric` from the JSON it writes.
+measures; the points are given by :mod:`exam_lab.grader.score.rubric` from the JSON it writes.
 
 Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of question 14a), ``sheet``,
 ``threshold`` (student units), ``margin`` (how far beyond the threshold to fly), ``delay`` (s), ``start_timeout``
@@ -37,7 +37,7 @@ import rosgraph
 import rospy
 from std_msgs import msg as std_msgs
 
-from exam_lab.grader.sheets import LATE_WARNING_S
+from exam_lab.grader.score.sheets import LATE_WARNING_S
 from exam_lab.harness import oracle
 from exam_lab.harness.fake_drone import Drone, TopicRecorder
 from exam_lab.harness.wait import wait_until
@@ -404,7 +404,7 @@ def main(argv):
     """Measure, write the result (atomically), then keep the fake drone serving until stopped
     (SIGINT) or LINGER_S: the student's node must not lose its drone before the grader stops it."""
     if len(argv) != 2:
-        sys.stderr.write('usage: python3 -m exam_lab.grader.probe PLAN.json RESULT.json\n')
+        sys.stderr.write('usage: python3 -m exam_lab.grader.judge.probe PLAN.json RESULT.json\n')
         return 2
     with open(argv[0]) as f:
         plan = json.load(f)

@@ -5,7 +5,7 @@ import csv
 import json
 import os
 
-from exam_lab.grader.sheets import ITEMS, SHEETS
+from exam_lab.grader.score.sheets import ITEMS, SHEETS
 
 #: What no machine scores, with the rubric's points (sheet 000's notes).
 NOT_SCORED = ('comments (4 points), code quality (2 points), and the report: questions 1-9 and the '

@@ -4,7 +4,7 @@ The detector is copydetect (PyPI, pinned :data:`VERSION`): winnowing over the to
 the style of MOSS, with names, strings and comments normalised away (renaming variables or rewording
 comments does not hide a copy) and a boilerplate set whose fingerprints never count. It is installed
 on first use into a virtual environment of its own (``$EXAM_WS/similarity-venv``, seeing Debian's
-packages), and runs there as ``python -m exam_lab.grader.similarity JOB.json``; the grader's own
+packages), and runs there as ``python -m exam_lab.grader.boxed.similarity JOB.json``; the grader's own
 Python needs nothing new.
 
 What every student got is boilerplate: ``catkin_create_pkg``'s CMakeLists.txt and package.xml (made
@@ -22,7 +22,8 @@ import subprocess
 import sys
 import tempfile
 
-from exam_lab.grader import unpack
+from exam_lab.grader import workspace
+from exam_lab.grader.boxed import unpack
 
 VERSION = '0.5.0'
 #: copydetect's noise threshold (k, characters of normalised code) and window.
@@ -70,8 +71,7 @@ class SimilarityError(Exception):
 
 
 def venv_dir():
-    from exam_lab.grader import runner
-    return os.path.join(runner.workspace(), 'similarity-venv')
+    return os.path.join(workspace(), 'similarity-venv')
 
 
 def ensure_venv(path=None):
@@ -183,7 +183,7 @@ def check(submissions, out_dir, python=None):
             env = dict(os.environ, PYTHONPATH=os.pathsep.join(
                 [os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))] +
                 [p for p in os.environ.get('PYTHONPATH', '').split(os.pathsep) if p]))
-            done = subprocess.run([python, '-m', 'exam_lab.grader.similarity', os.path.join(scratch, 'job.json')],
+            done = subprocess.run([python, '-m', 'exam_lab.grader.boxed.similarity', os.path.join(scratch, 'job.json')],
                                   env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=900)
             if done.returncode != 0 or not os.path.isfile(job['result']):
                 raise SimilarityError('the detector failed (exit %d): %s' % (
@@ -276,7 +276,7 @@ def compare(job):
 
 def main(argv):
     if len(argv) != 1:
-        sys.stderr.write('usage: python -m exam_lab.grader.similarity JOB.json\n')
+        sys.stderr.write('usage: python -m exam_lab.grader.boxed.similarity JOB.json\n')
         return 2
     with open(argv[0]) as f:
         job = json.load(f)

@@ -1,16 +1,16 @@
 """The rubric: points for each item from what was measured, and why. Pure functions, no rospy.
 
 Input: ``static`` (what the runner read in the package: the launch file, the threshold parameter,
-the parameters the code reads) and ``session`` (what :mod:`exam_lab.grader.session` measured: the
+the parameters the code reads) and ``session`` (what :mod:`exam_lab.grader.judge.session` measured: the
 build, the main run and the threshold run, each with the probe's result). Output: one
-``{"id", "points", "max", "evidence"}`` per item of :data:`exam_lab.grader.sheets.ITEMS`.
+``{"id", "points", "max", "evidence"}`` per item of :data:`exam_lab.grader.score.sheets.ITEMS`.
 
 Each tolerance is a constant below; docs/grading.md says why each is what it is.
 """
 import math
 import re
 
-from exam_lab.grader.sheets import DELAY, ITEMS, SHEETS
+from exam_lab.grader.score.sheets import DELAY, ITEMS, SHEETS
 
 #: Question 11: the rate the sheet asks for, and the accepted relative deviation.
 RATE_HZ = 10.0

@@ -23,7 +23,7 @@ import xml.etree.ElementTree as ET
 
 import yaml
 
-from exam_lab.grader.sheets import PACKAGE, SHEETS, sheet_of_drone
+from exam_lab.grader.score.sheets import PACKAGE, SHEETS, sheet_of_drone
 
 #: Substitution pattern of roslaunch: ``$(command args)``.
 _SUBST = re.compile(r'\$\((\w+)((?:\s+[^)]*)?)\)')

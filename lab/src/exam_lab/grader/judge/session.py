@@ -2,18 +2,18 @@
 
 The runner starts this module as root, alone in a network namespace that has only loopback::
 
-    python3 -m exam_lab.grader.session JOB.json
+    python3 -m exam_lab.grader.judge.session JOB.json
 
 Here the grader's side (a master per run, the probe with its fake drone) runs as the grader, under a
 :class:`~exam_lab.harness.supervisor.Supervisor` whose log folder the student's code cannot see; every
 step that runs the student's code (``catkin_make``, ``roslaunch`` and the nodes) runs in the
-submission's :class:`~exam_lab.grader.sandbox.Box`, another user in namespaces of its own that shares
+submission's :class:`~exam_lab.grader.host.sandbox.Box`, another user in namespaces of its own that shares
 only this network namespace. The box's environment starts empty: the underlay's, ROS's, a fresh HOME;
 the student's own ``devel/setup.bash`` is sourced inside the box, never here. After each step, the box's
 uid must have no process left (they die with its PID namespace); any found is killed and reported.
 
 Job (JSON, written by :mod:`exam_lab.grader.runner`): ``workspace`` (the student's catkin workspace as
-the box sees it), ``box`` (:meth:`~exam_lab.grader.sandbox.Box.describe`), ``underlay`` (setup.bash of
+the box sees it), ``box`` (:meth:`~exam_lab.grader.host.sandbox.Box.describe`), ``underlay`` (setup.bash of
 the simulators' workspace), ``log_dir``, ``namespace`` (the drone's), ``build_timeout`` /
 ``run_timeout`` (s), ``runs``: the main run and, when the launch file has a threshold the grader can
 change, the threshold run: each ``{"tag", "launch" (derived launch file, as the box sees it), "plan"
@@ -26,7 +26,7 @@ import re
 import sys
 import time
 
-from exam_lab.grader.sandbox import Box
+from exam_lab.grader.host.sandbox import Box
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
 from exam_lab.harness.wait import wait_until
 
@@ -129,7 +129,7 @@ def run_one(sup, job, run, base_env, box):
     probe_env = ros_env(master.env, master.uri, os.path.join(log_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')
     probe_env['ROS_NAMESPACE'] = job.get('namespace', '/')
     started, started_wall = time.monotonic(), time.time()
-    probe = sup.start('probe-%s' % tag, [sys.executable, '-m', 'exam_lab.grader.probe', plan_path, result_path],
+    probe = sup.start('probe-%s' % tag, [sys.executable, '-m', 'exam_lab.grader.judge.probe', plan_path, result_path],
                       probe_env)
     # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
     # nothing it does when its drone goes away (a failed service call, a crash) is counted.
@@ -188,7 +188,7 @@ def session(job):
 
 def main(argv):
     if len(argv) != 1:
-        sys.stderr.write('usage: python3 -m exam_lab.grader.session JOB.json\n')
+        sys.stderr.write('usage: python3 -m exam_lab.grader.judge.session JOB.json\n')
         return 2
     with open(argv[0]) as f:
         job = json.load(f)

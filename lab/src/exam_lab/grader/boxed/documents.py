@@ -6,7 +6,7 @@ import os
 import re
 import zlib
 
-from exam_lab.grader import moodle
+from exam_lab.grader.publish import moodle
 
 #: Bytes of a PDF read to count its pages (and inflated from its streams, all together), and most
 #: bytes one of its streams may inflate to.

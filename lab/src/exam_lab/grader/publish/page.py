@@ -10,8 +10,8 @@ import html
 import os
 import re
 
-from exam_lab.grader import report
-from exam_lab.grader.sheets import ITEMS
+from exam_lab.grader.publish import report
+from exam_lab.grader.score.sheets import ITEMS
 
 #: Flagged pairs shown with their fragments; the rest are listed by name and score.
 SHOWN_PAIRS = 20
@@ -70,7 +70,7 @@ def _inline(text):
 
 
 def markdown_html(text):
-    """grade.md as HTML: the subset :func:`exam_lab.grader.report.markdown` writes (headings,
+    """grade.md as HTML: the subset :func:`exam_lab.grader.publish.report.markdown` writes (headings,
     paragraphs, tables, lists, code blocks, bold, code). Everything is escaped first."""
     out, lines, i = [], text.splitlines(), 0
     while i < len(lines):
@@ -153,7 +153,7 @@ def render(records, title, entries, pairs=None, notes=None):
     :param records: the grade records (grade.json), in the table's order.
     :param entries: per student: ``{"plot": relative path of the PNG or None, "grade_md": text,
         "documents": [{"name", "pages"}], "folder": relative path of its results}``.
-    :param pairs: the similarity check's flagged pairs (see :mod:`exam_lab.grader.similarity`), or
+    :param pairs: the similarity check's flagged pairs (see :mod:`exam_lab.grader.boxed.similarity`), or
         None when it did not run.
     :param notes: lines for the top of the page (the worksheet's summary, the similarity's limits).
     """

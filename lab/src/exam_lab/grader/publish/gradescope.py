@@ -8,7 +8,7 @@ copies this file; a class graded here gets one per student, to upload with Grade
 import json
 import os
 
-from exam_lab.grader.sheets import ITEMS
+from exam_lab.grader.score.sheets import ITEMS
 
 #: Statuses whose score is the grade; the others are shown to the teacher only until a hand grade.
 GRADED = ('graded', 'graded with fixes')
