@@ -44,11 +44,12 @@ def test_the_state_line_counts_pending_running_and_done():
 
 class ScriptedSlurm(object):
     """sbatch gives job ids 100, 101...; a task is in the queue for one look, then ends as ``ends``
-    says for that attempt (``'record'``: it leaves its grade, as a good task does)."""
+    says for that attempt (``'record'``: it leaves its grade, as a good task does; ``'queued'``: it
+    waits in the queue for ever)."""
 
     def __init__(self, base, ends):
         self.base, self.ends = base, ends
-        self.calls, self.queued, self.attempt = [], {}, {}
+        self.calls, self.queued, self.attempt = [], set(), {}
         self.next_job = 100
 
     def __call__(self, argv):
@@ -58,14 +59,18 @@ class ScriptedSlurm(object):
             self.next_job += 1
             for index in slurm._indices(argv[argv.index('--array') + 1]):
                 self.attempt[index] = self.attempt.get(index, 0) + 1
-                self.queued[(job, index)] = 1
+                self.queued.add((job, index))
             return 0, '%s\n' % job, ''
         if argv[0] == 'squeue':
-            lines = ['%s %d RUNNING None' % key for key in sorted(self.queued)]
-            for key in list(self.queued):
+            lines = []
+            for key in sorted(self.queued):
                 job, index = key
-                del self.queued[key]
-                if self.ends[index][self.attempt[index] - 1] == 'record':
+                end = self.ends[index][self.attempt[index] - 1]
+                lines.append('%s %d %s' % (job, index, 'PENDING Resources' if end == 'queued' else 'RUNNING None'))
+                if end == 'queued':
+                    continue
+                self.queued.discard(key)
+                if end == 'record':
                     with open(os.path.join(self.base, 'results', '%d.json' % index), 'w') as f:
                         json.dump({'student': 's%d' % index, 'status': 'graded'}, f)
             return 0, '\n'.join(lines), ''
@@ -112,3 +117,26 @@ def test_a_completed_task_is_given_time_for_its_grade_to_arrive(array):
     assert run.records == [None] and run.attempts[0] == 1
     run.look(1.0 + slurm.RESULT_GRACE_S)
     assert run.attempts[0] == 2, 'after the grace period, it is submitted again'
+
+
+def test_ctrl_c_cancels_the_class_jobs(array, monkeypatch):
+    run, fake, _ = array([['record'], ['record']])
+
+    def interrupted(now):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(run, 'look', interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        slurm._follow(run, 0.0, None, lambda line: None)
+    assert fake.calls[-1] == ['scancel', '100']
+
+
+def test_out_of_time_cancels_and_says_where_each_student_was(array, monkeypatch):
+    run, fake, _ = array([['record'], ['queued']])
+    monkeypatch.setattr(slurm.time, 'sleep', lambda seconds: None)
+    clock = iter([0.0, 5.0, 11.0])
+    monkeypatch.setattr(slurm.time, 'monotonic', lambda: next(clock))
+    records = slurm._follow(run, 0.0, 10.0, lambda line: None)
+    assert records[0]['status'] == 'graded'
+    assert records[1]['status_reason'] == \
+        'could not grade: Slurm said: no grade within 10 s; last seen PENDING, Resources'
+    assert ['scancel', '100'] in fake.calls
