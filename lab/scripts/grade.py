@@ -3,6 +3,7 @@
 
     grade.py --submission DIR_OR_ZIP [--sheet altitude|depth] [--out DIR]
     grade.py --class DIR_OR_ZIP [--sheet altitude|depth] [--out DIR] [--jobs N] [--worksheet CSV]
+             [--engine local|slurm [--slurm-args '--partition=... --account=...']]
 
 Besides the grades, OUT/index.html (the page for the teacher), each student's results.json
 (Gradescope) and flight.png, for a class the similarity check and, with --worksheet, Moodle's
@@ -14,11 +15,13 @@ runs only in its sandbox, unless --unsandboxed-student-code-can-read-and-damage-
 """
 import argparse
 import os
+import shlex
 import sys
 
 from exam_lab.grader import runner
 
 from exam_lab.grader.boxed import documents, unpack
+from exam_lab.grader.engine import slurm
 
 from exam_lab.grader.publish import desk, progress, report
 from exam_lab.grader.score.sheets import SHEETS
@@ -37,7 +40,13 @@ def main(argv=None):
                         'as root the code runs as a user of its own, with limits)')
     parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV) to fill")
     parser.add_argument('--no-similarity', action='store_true', help='skip the similarity check (class)')
+    parser.add_argument('--engine', choices=['local', 'slurm'], default='local',
+                        help='where a class is graded: here, JOBS at a time, or one Slurm array task per student')
+    parser.add_argument('--slurm-args', default='', help="sbatch's options for the cluster, e.g. "
+                        "'--partition=short --account=ros101' (with --engine slurm)")
     args = parser.parse_args(argv)
+    if args.engine == 'slurm' and not args.klass:
+        parser.error('--engine slurm grades a class (--class): one array task per student')
     target = args.submission or args.klass
     if not os.path.exists(target):
         sys.stderr.write('grade: %s does not exist\n' % target)
@@ -60,8 +69,12 @@ def main(argv=None):
         else:
             shown = progress.ClassProgress(args.jobs)
             try:
-                records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=shown,
-                                             unsandboxed=args.unsandboxed)
+                if args.engine == 'slurm':
+                    records = slurm.grade_class(args.klass, out, args.sheet, progress=shown,
+                                                unsandboxed=args.unsandboxed, sbatch_args=shlex.split(args.slurm_args))
+                else:
+                    records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=shown,
+                                                 unsandboxed=args.unsandboxed)
             finally:
                 shown.close()
             print(report.table(records))

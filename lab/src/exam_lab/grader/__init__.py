@@ -23,6 +23,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   (k of n, the time left; a run's steps).
 - :mod:`~exam_lab.grader.runner` -- one submission or a class, top to bottom: inspect, box, judge,
   score, publish.
+- ``engine/`` -- the host, as the teacher: where else a class is graded, each student by the runner
+  (:mod:`~.engine.slurm`: an array job on a Slurm cluster).
 """
 import os
 

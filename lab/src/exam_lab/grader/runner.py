@@ -437,6 +437,38 @@ def default_underlay():
     return os.path.join(workspace(), 'grader', 'underlay')
 
 
+def class_students(class_path, scratch):
+    """``[(name, folder or archive)]`` of a class, each name unique (``Jane Doe``, ``Jane Doe_2``): the
+    students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`). A class
+    archive is unpacked below ``scratch``."""
+    names, seen = [], set()
+    for name, folder in unpack.list_students(class_path, scratch):
+        unique, n = name, 2
+        while unique in seen:
+            unique, n = '%s_%d' % (name, n), n + 1
+        seen.add(unique)
+        names.append((unique, folder))
+    return names
+
+
+def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
+                  unsandboxed=False):
+    """Grade one student of a class into ``out_dir/name``; return the record. Anything the grader
+    raises is this student's record ("could not grade"), never the class's. Both engines grade a
+    student with it: a local pool's thread and a Slurm task."""
+    try:
+        return grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
+                                on_step=on_step, extra=documents.submission_facts(folder), unsandboxed=unsandboxed)
+    except Exception as err:  # anything: this student's row says so, the class goes on
+        record = could_not_grade(name, sheet, '%r' % err,
+                                 ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
+        try:
+            report.write_grade(os.path.join(out_dir, name), record)
+        except OSError:
+            pass
+        return record
+
+
 def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=None, unsandboxed=False):
     """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv.
     One student the grader cannot grade is that student's row ("could not grade"), never the class's.
@@ -449,36 +481,19 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
     os.makedirs(out_dir, exist_ok=True)
     scratch = tempfile.mkdtemp(prefix='class-', dir=out_dir)
     try:
-        students = unpack.list_students(class_path, scratch)
+        students = class_students(class_path, scratch)
         underlay = ensure_underlay(default_underlay())
         isolate = can_isolate() if isolate is None else isolate
-        names, seen = [], set()
-        for name, _ in students:
-            unique, n = name, 2
-            while unique in seen:
-                unique, n = '%s_%d' % (name, n), n + 1
-            seen.add(unique)
-            names.append(unique)
         records = [None] * len(students)
         if progress:
-            progress.begin(names)
+            progress.begin([name for name, _ in students])
 
         def one(index):
-            name, folder = names[index], students[index][1]
+            name, folder = students[index]
             if progress:
                 progress.started(name)
-            try:
-                record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
-                                          on_step=(lambda step: progress.step(name, step)) if progress else None,
-                                          extra=documents.submission_facts(folder), unsandboxed=unsandboxed)
-            except Exception as err:  # anything: this student's row says so, the class goes on
-                record = could_not_grade(name, sheet, '%r' % err,
-                                         ['grader error, please report: %s'
-                                          % traceback.format_exc().replace('\n', ' | ')])
-                try:
-                    report.write_grade(os.path.join(out_dir, name), record)
-                except OSError:
-                    pass
+            record = grade_student(name, folder, out_dir, sheet, underlay, isolate,
+                                   (lambda step: progress.step(name, step)) if progress else None, unsandboxed)
             if progress:
                 progress.finished(record)
             return record

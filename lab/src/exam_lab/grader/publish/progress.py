@@ -119,6 +119,14 @@ class ClassProgress(object):
             self._draw()
             self.stream.flush()
 
+    def say(self, line):
+        """One line of news about the run (the Slurm engine's array state), above the status line."""
+        with self.lock:
+            self._clear()
+            self.stream.write(line + '\n')
+            self._draw()
+            self.stream.flush()
+
     def close(self):
         self.stop.set()
         if self.ticker is not None:
