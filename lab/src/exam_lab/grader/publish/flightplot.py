@@ -17,8 +17,9 @@ FEW_CALLS = 10
 _CALL_COLOUR = {'WARNING': '#cc0000', 'NORMAL': '#2a9d2a'}
 #: Values are drawn within +-LIMIT (student units; the drones fly within a few thousand): a node that
 #: published +-1.7e308 once made matplotlib's scaling overflow (LinAlgError) and stopped the desk.
-#: A value beyond is drawn at the limit, a time or value that is not a number is left out, and the
-#: panel says how many of each.
+#: A value beyond is clamped to the limit (a published one is drawn as an arrow at the panel's edge,
+#: so the node's other values keep their scale), a time or value that is not a number is left out,
+#: and the panel says how many of each.
 LIMIT = 1e6
 
 
@@ -118,7 +119,7 @@ class Clamp(object):
         """What the panel says of the numbers changed, or ''."""
         parts = []
         if self.clamped:
-            parts.append('%d value(s) beyond ±%g drawn at that limit' % (self.clamped, self.limit))
+            parts.append('%d value(s) beyond ±%g (published ones: arrows at the edge)' % (self.clamped, self.limit))
         if self.dropped:
             parts.append('%d time(s) or value(s) not a number or out of range, not drawn' % self.dropped)
         return '; '.join(parts)
@@ -147,10 +148,12 @@ def _panel(ax, tag, probe):
     t0 = t0 if isinstance(t0, (int, float)) and math.isfinite(t0) else 0.0
     trace = probe.get('trace') or {}
     published = clamp.pairs(trace.get('published'), t0)
+    beyond = [(t, v) for t, v in published if abs(v) >= clamp.limit]
+    published = [(t, v) for t, v in published if abs(v) < clamp.limit]
     oracle = clamp.pairs(trace.get('oracle'), t0)
     schedule = {k: clamp.time(v, t0) for k, v in (probe.get('schedule') or {}).items()}
     schedule = {k: v for k, v in schedule.items() if v is not None}  # seconds from the probe's start
-    end = max([t for t, _ in published] + [t for t, _ in oracle] + [schedule.get('end', 0.0)])
+    end = max([t for t, _ in published + beyond] + [t for t, _ in oracle] + [schedule.get('end', 0.0)])
     for name, start, stop, side in legs(schedule):
         ax.axvspan(start, stop, color=_SIDE_COLOUR[side], alpha=0.6, lw=0)
         ax.text((start + stop) / 2, 1.0, name.replace('_', ' '), transform=ax.get_xaxis_transform(),
@@ -159,12 +162,18 @@ def _panel(ax, tag, probe):
         xs = [t for t, _ in oracle] + [end]
         ys = [v for _, v in oracle] + [oracle[-1][1]]
         ax.step(xs, ys, where='post', color='#888888', lw=1.5, label='oracle (equation 1)')
-    if not published:
+    if not published and not beyond:
         ax.text(0.5, 0.5, 'the node published no value the probe could read', transform=ax.transAxes,
                 ha='center', fontsize=10, color='#b00000')
     if published:
         ax.plot([t for t, _ in published], [v for _, v in published], '.', ms=2.5, color='#1f5fa8',
                 label='published by the node')
+    for sign, edge, marker in ((1, 0.98, '^'), (-1, 0.02, 'v')):
+        times = [t for t, v in beyond if v * sign > 0]
+        if times:
+            ax.plot(times, [edge] * len(times), marker, color='#1f5fa8', ms=7, clip_on=False,
+                    transform=ax.get_xaxis_transform(), label='published beyond %s%g (%d)' % (
+                        '+' if sign > 0 else '-', clamp.limit, len(times)))
     threshold = probe.get('threshold')
     threshold = clamp.value(threshold) if threshold is not None else None
     if threshold is not None:
