@@ -279,6 +279,7 @@ def test_the_desk_survives_one_student_whose_part_fails(part, tmp_path, monkeypa
     assert 'src="Ada/flight.png"' in html and 'src="Eve/flight.png"' in html
     bob = html[html.index('id="student-Bob"'):html.index('id="student-Eve"')]
     assert 'a bug on Bob' in bob  # the note is in Bob's own section
+    assert 'never ran against the probe' not in bob  # its flight was flown: drawn, or its plot failed
     if part != 'section':  # made before the page: the terminal says so too
         assert [l for l in lines if l.startswith('Bob: ') and 'a bug on Bob' in l]
     assert [l for l in lines if CONTROL.search(l)] == [] and CONTROL.search(html) is None

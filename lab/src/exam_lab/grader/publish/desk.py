@@ -48,6 +48,7 @@ def _student(out, record, single):
             entry['plot'] = os.path.join(relative, 'flight.png')
     except Exception as err:
         entry['problems'].append('flight plot not drawn: %s' % _failure(err))
+        entry['plot_failed'] = True
     try:
         entry['grade_md'] = _grade_md(folder, record)
     except Exception as err:  # the page makes it from the record instead

@@ -155,7 +155,7 @@ def render(records, title, entries, pairs=None, notes=None):
     :param records: the grade records (grade.json), in the table's order.
     :param entries: per student: ``{"plot": relative path of the PNG or None, "grade_md": text,
         "documents": [{"name", "pages"}], "folder": relative path of its results, "problems": what the
-        desk could not make for it}``.
+        desk could not make for it, "plot_failed": its plot was not drawn for one of those}``.
     :param pairs: the similarity check's flagged pairs (see :mod:`exam_lab.grader.boxed.similarity`), or
         None when it did not run.
     :param notes: lines for the top of the page (the worksheet's summary, the similarity's limits).
@@ -270,7 +270,7 @@ def _section(record, entry):
     if entry.get('plot'):
         parts.append('<p><img class="flight" src="%s" alt="flight of %s: value published against the '
                      'oracle, threshold, warning calls, legs"></p>' % (_e(entry['plot']), _e(record['student'])))
-    else:
+    elif not entry.get('plot_failed'):  # a plot that failed is said with the problems above
         parts.append('<p>No flight to plot: the node never ran against the probe.</p>')
     parts.append(markdown_html(entry.get('grade_md') or report.markdown(record)))
     parts.append('<p><a href="#table">back to the table</a></p></section>')
