@@ -9,7 +9,8 @@ Besides the grades, OUT/index.html (the page for the teacher), each student's re
 (Gradescope) and flight.png, for a class the similarity check and, with --worksheet, Moodle's
 offline grading worksheet filled (the teacher's desk: lab/src/exam_lab/grader/publish/desk.py).
 
-Prints the score table; exits 0 whenever grading completed, whatever the scores, and 1 when the
+Prints the score table (every line cleaned of control characters: it carries students' text);
+exits 0 whenever grading completed, whatever the scores, and 1 when the
 grader itself could not run (a missing input, the simulators not building, no sandbox: student code
 runs only in its sandbox, unless --unsandboxed-student-code-can-read-and-damage-my-files is given).
 """
@@ -24,7 +25,14 @@ from exam_lab.grader.boxed import documents, unpack
 from exam_lab.grader.engine import slurm
 
 from exam_lab.grader.publish import desk, progress, report
+from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import SHEETS
+
+
+def say(line, stream=None):
+    """Print ``line`` for the teacher with no control character in it (a student's escape sequence
+    could move the cursor and rewrite the summary above)."""
+    (stream or sys.stdout).write(safe_text.clean(line) + '\n')
 
 
 def main(argv=None):
@@ -49,7 +57,7 @@ def main(argv=None):
         parser.error('--engine slurm grades a class (--class): one array task per student')
     target = args.submission or args.klass
     if not os.path.exists(target):
-        sys.stderr.write('grade: %s does not exist\n' % target)
+        say('grade: %s does not exist' % target, sys.stderr)
         return 1
     name = os.path.basename(os.path.abspath(target).rstrip('/'))
     out = os.path.abspath(args.out or os.path.join(runner.workspace(), 'grades', name))
@@ -58,14 +66,14 @@ def main(argv=None):
             record = runner.grade_submission(args.submission, out, args.sheet, on_step=progress.StepProgress(),
                                              extra=documents.submission_facts(args.submission),
                                              unsandboxed=args.unsandboxed)
-            print(report.table([record]))
+            say(report.table([record]))
             if record.get('status_reason'):
-                print('%s: %s' % (record['status'], record['status_reason']))
+                say('%s: %s' % (record['status'], record['status_reason']))
             for line in report.evidence_lines(record):
-                print('  ' + line)
-            print('grade.json and grade.md in %s' % out)
+                say('  ' + line)
+            say('grade.json and grade.md in %s' % out)
             for line in desk.finish(out, [record], single=True, worksheet=args.worksheet):
-                print(line)
+                say(line)
         else:
             shown = progress.ClassProgress(args.jobs)
             try:
@@ -77,21 +85,21 @@ def main(argv=None):
                                                  unsandboxed=args.unsandboxed)
             finally:
                 shown.close()
-            print(report.table(records))
+            say(report.table(records))
             waiting = report.needing_the_teacher(records)
             if waiting:
-                print('\n%d student(s) need the teacher (their points are not a grade yet):' % len(waiting))
+                say('\n%d student(s) need the teacher (their points are not a grade yet):' % len(waiting))
                 for line in waiting:
-                    print('  ' + line)
-            print('grades.csv and one folder per student in %s' % out)
+                    say('  ' + line)
+            say('grades.csv and one folder per student in %s' % out)
             for line in desk.finish(out, records, similar=None if args.no_similarity else
                                     runner.class_similarity(args.klass, out, records), worksheet=args.worksheet):
-                print(line)
+                say(line)
     except RuntimeError as err:
-        sys.stderr.write('grade: %s\n' % err)
+        say('grade: %s' % err, sys.stderr)
         return 1
     except unpack.UnpackError as err:  # the class archive itself (one student's upload never gets here)
-        sys.stderr.write('grade: the class archive cannot be opened safely: %s\n' % err)
+        say('grade: the class archive cannot be opened safely: %s' % err, sys.stderr)
         return 1
     return 0
 

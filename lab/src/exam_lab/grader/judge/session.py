@@ -27,11 +27,10 @@ import sys
 import time
 
 from exam_lab.grader.host.sandbox import Box
+from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
 from exam_lab.harness.wait import wait_until
 
-#: Terminal colour and title sequences roslaunch writes even into a file.
-_ANSI = re.compile(r'\x1b\[[0-9;]*m|\x1b?\]2;[^\n\x07]*\x07?')
 #: roslaunch's words for a node that ended: "[exam-1] process has died [pid 12, exit code 1, ...]";
 #: a required node's death is announced as "REQUIRED process [exam-1] has died!" first.
 _ENDED = re.compile(r'(?:\[([^\]\s]+)\] )?process has (died|finished cleanly)(?: \[pid \d+, (exit code -?\d+))?')
@@ -51,10 +50,10 @@ def tail(text, lines=TAIL_LINES):
 
 
 def clean(output):
-    """roslaunch's output without colours and without its own chatter: what the nodes printed, and
-    roslaunch's words about them."""
+    """roslaunch's output without control characters (its colours and titles, a node's escape
+    sequences) and without its own chatter: what the nodes printed, and roslaunch's words about them."""
     kept = []
-    for line in _ANSI.sub('', output).splitlines():
+    for line in clean_text(output).splitlines():
         if not _CHATTER.match(line.strip('=')) or 'process has' in line:
             kept.append(line.strip('=') if line.startswith('=') else line)
     return '\n'.join(kept)
@@ -65,7 +64,7 @@ def launch_outcome(output, workspace=None):
     Paths inside ``workspace`` are shown relative to its src/ (``exam/scripts/...``)."""
     if workspace:
         output = output.replace(workspace.rstrip('/') + '/src/', '').replace(workspace.rstrip('/'), '<ws>')
-    text = _ANSI.sub('', output)
+    text = clean_text(output)
     ended, required = [], None
     for line in text.splitlines():
         match = _REQUIRED.search(line)

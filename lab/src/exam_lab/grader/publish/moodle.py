@@ -21,6 +21,7 @@ feedback already in the worksheet as it was (a teacher's grade wins over the mac
 import html
 import re
 
+from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 
 #: The participant's number in a "download all submissions" name (folder or flat file).
@@ -158,7 +159,7 @@ def feedback(record):
     for entry in record['items']:
         line = '%s %s/%s' % (entry['id'], _points(entry['points']), _points(entry['max']))
         if entry['points'] < entry['max'] and entry.get('evidence'):
-            why = entry['evidence'].split('\n', 1)[0]
+            why = safe_text.clean(entry['evidence']).split('\n', 1)[0]
             line += ': ' + (why if len(why) <= 200 else why[:197] + '...')
         lines.append(line)
     head = ('Machine-graded by running the package: %s / %s points (%s). Not scored by the machine: '
@@ -268,4 +269,4 @@ def summary_lines(summary, target):
         lines.append('  NOT MATCHED: %s (%s)' % (student, why))
     if summary['no_submission']:
         lines.append('  in the worksheet, no graded submission: %s' % ', '.join(summary['no_submission']))
-    return lines
+    return [safe_text.one_line(line) for line in lines]
