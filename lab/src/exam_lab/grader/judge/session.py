@@ -27,6 +27,7 @@ import sys
 import time
 
 from exam_lab.grader.host.sandbox import Box
+from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
 from exam_lab.harness.wait import wait_until
 
@@ -83,7 +84,7 @@ def warned_in_long_excursion(probe):
     schedule = (probe or {}).get('schedule') or {}
     if 'long_up' not in schedule:
         return False
-    return any(status == 'WARNING' and schedule['long_up'] <= t <= schedule['long_down']
+    return any(request_meaning(status) == 'WARNING' and schedule['long_up'] <= t <= schedule['long_down']
                for t, status in probe.get('calls', []))
 
 
@@ -108,9 +109,41 @@ def probe_problem(result, plan, started, finished):
 def warning_latency(probe):
     """Seconds from the long excursion's start to the main run's first WARNING in it, or None."""
     schedule = (probe or {}).get('schedule') or {}
-    times = [t for t, status in (probe or {}).get('calls', []) if status == 'WARNING'
+    times = [t for t, status in (probe or {}).get('calls', []) if request_meaning(status) == 'WARNING'
              and schedule.get('long_up', float('inf')) <= t <= schedule.get('long_down', 0.0)]
     return min(times) - schedule['long_up'] if times else None
+
+
+#: roslaunch's own check of the launch file as handed in: s at most, lines of its words kept.
+LAUNCH_CHECK_TIMEOUT = 30.0
+LAUNCH_CHECK_LINES = 8
+#: What roslaunch prints that is a warning about the file rather than the list of its nodes.
+_LAUNCH_WARNING = re.compile(r'^(?:\[?WARN(?:ING)?\]?|.*\bwarning\b|.*deprecated)', re.I)
+
+
+def launch_verdict(sup, job, base_env, box):
+    """roslaunch's verdict on the student's launch file as handed in (``job["handed_in_launch"]``, in
+    the workspace's src/): ``roslaunch --nodes`` run in the box with the student's workspace sourced
+    loads the file as ``roslaunch exam exam.launch`` would (every include, argument and node name)
+    without starting anything. ``{"file", "status" (exit code, None when it did not finish), "refused"
+    (roslaunch's words, '' when accepted), "warnings" [lines], "nodes" [names]}``; None without a file."""
+    relative = job.get('handed_in_launch')
+    if not relative:
+        return None
+    path = os.path.join(job['workspace'], 'src', relative)
+    status, output, _ = sup.run('launch-check', box.argv(
+        ['bash', '-c', 'source "$1/devel/setup.bash" && exec roslaunch --nodes "$2"', 'bash',
+         job['workspace'], path], dict(base_env, ROS_HOME=os.path.join(box.home, 'ros-check'))),
+        timeout=LAUNCH_CHECK_TIMEOUT)
+    lines = [l.strip()[:300] for l in _ANSI.sub('', output).replace(job['workspace'].rstrip('/') + '/src/', '')
+             .splitlines() if l.strip()]
+    words = [l for l in lines if not l.startswith('/')]
+    return {'file': relative.split('/', 1)[-1], 'status': status,
+            'refused': '' if status == 0 else ' '.join(words[-LAUNCH_CHECK_LINES:]) or
+            ('roslaunch did not finish within %.0f s' % LAUNCH_CHECK_TIMEOUT if status is None
+             else 'roslaunch exit %s' % status),
+            'warnings': [l for l in words if _LAUNCH_WARNING.match(l)][:LAUNCH_CHECK_LINES] if status == 0 else [],
+            'nodes': [l for l in lines if l.startswith('/')][:20]}
 
 
 def run_one(sup, job, run, base_env, box):
@@ -173,6 +206,8 @@ def session(job):
                            'timeout': job['build_timeout']}
         if status != 0:
             return result
+        result['launch_check'] = launch_verdict(sup, job, base_env, box)
+        result['survivors'] += box.end()
         for run in job['runs']:
             if run['tag'] == 'threshold':
                 main = result['runs'][0]['probe'] if result['runs'] else None
