@@ -20,7 +20,7 @@ from exam_lab.grader import runner
 
 from exam_lab.grader.boxed import documents, unpack
 
-from exam_lab.grader.publish import desk, progress, report
+from exam_lab.grader.publish import desk, moodle, progress, report
 from exam_lab.grader.score.sheets import SHEETS
 
 
@@ -36,6 +36,9 @@ def main(argv=None):
                         action='store_true', help='grade even where no sandbox can be made (never as root: '
                         'as root the code runs as a user of its own, with limits)')
     parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV) to fill")
+    parser.add_argument('--worksheet-scale', action='store_true',
+                        help="scale the grades to the worksheet's maximum grade (default: the machine's points "
+                        "out of 17, said on the terminal and in each comment)")
     parser.add_argument('--no-similarity', action='store_true', help='skip the similarity check (class)')
     args = parser.parse_args(argv)
     target = args.submission or args.klass
@@ -55,7 +58,8 @@ def main(argv=None):
             for line in report.evidence_lines(record):
                 print('  ' + line)
             print('grade.json and grade.md in %s' % out)
-            for line in desk.finish(out, [record], single=True, worksheet=args.worksheet):
+            for line in desk.finish(out, [record], single=True, worksheet=args.worksheet,
+                                    scale=args.worksheet_scale):
                 print(line)
         else:
             shown = progress.ClassProgress(args.jobs)
@@ -72,7 +76,8 @@ def main(argv=None):
                     print('  ' + line)
             print('grades.csv and one folder per student in %s' % out)
             for line in desk.finish(out, records, similar=None if args.no_similarity else
-                                    runner.class_similarity(args.klass, out, records), worksheet=args.worksheet):
+                                    runner.class_similarity(args.klass, out, records), worksheet=args.worksheet,
+                                    scale=args.worksheet_scale, title=moodle.class_name(args.klass)):
                 print(line)
     except RuntimeError as err:
         sys.stderr.write('grade: %s\n' % err)

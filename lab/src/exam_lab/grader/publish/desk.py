@@ -16,12 +16,14 @@ def _grade_md(folder, record):
     return '\n'.join(l for l in text.splitlines() if not l.startswith('# ')) if text else ''
 
 
-def finish(out, records, single=False, similar=None, worksheet=None):
+def finish(out, records, single=False, similar=None, worksheet=None, scale=False, title=None):
     """Write the desk's files for ``records`` graded into ``out``; return lines for the terminal.
 
     :param single: one submission (its results are in ``out`` itself, not ``out/<student>``).
     :param similar: the similarity check's result (:func:`exam_lab.grader.boxed.similarity.check`) or None.
     :param worksheet: the Moodle worksheet to fill, or None.
+    :param scale: scale the grades to the worksheet's maximum grade (:func:`moodle.fill`).
+    :param title: the class's name (:func:`moodle.class_name`); the output folder's name when None.
     """
     lines, notes, entries = [], [], {}
     for record in records:
@@ -37,7 +39,7 @@ def finish(out, records, single=False, similar=None, worksheet=None):
         base = os.path.splitext(os.path.basename(worksheet))[0]
         target = os.path.join(out, '%s-filled.csv' % base)
         try:
-            summary = moodle.fill_file(worksheet, target, records)
+            summary = moodle.fill_file(worksheet, target, records, scale)
             lines += moodle.summary_lines(summary, target)
             with open(os.path.join(out, 'worksheet.json'), 'w') as f:
                 json.dump(summary, f, indent=1, sort_keys=True)
@@ -54,7 +56,7 @@ def finish(out, records, single=False, similar=None, worksheet=None):
         else:
             lines.append('similarity: %d pair(s) flagged of %d student(s) (%s)'
                          % (len(pairs), similar.get('students', 0), os.path.join(out, 'index.html#similarity')))
-    title = 'Exam grades: %s' % (records[0]['student'] if single and records else os.path.basename(out))
+    title = 'Exam grades: %s' % (records[0]['student'] if single and records else title or os.path.basename(out))
     with open(os.path.join(out, 'index.html'), 'w') as f:
         f.write(page.render(records, title, entries, pairs, notes))
     lines.append('page: %s' % os.path.join(out, 'index.html'))

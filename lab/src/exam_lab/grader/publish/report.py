@@ -98,9 +98,11 @@ def table(records):
 
 def needing_the_teacher(records):
     """Lines for the terminal: each student whose grade the teacher must look at, and why (all but
-    'graded' and 'graded with fixes')."""
-    return ['%s: %s - %s' % (r['student'], r.get('status'), r.get('status_reason', ''))
-            for r in records if r.get('status') not in ('graded', 'graded with fixes')]
+    'graded' and 'graded with fixes', and any grade with a doubt: refused calls, a launch file roslaunch
+    refuses, several uploads...)."""
+    return ['%s: %s%s%s' % (r['student'], r.get('status'), ' - %s' % r['status_reason'] if r.get('status_reason') else '',
+                            ''.join('; %s' % d for d in r.get('doubts') or []))
+            for r in records if r.get('status') not in ('graded', 'graded with fixes') or r.get('doubts')]
 
 
 def evidence_lines(record):
