@@ -55,6 +55,8 @@ def main(argv=None):
             print(report.table([record]))
             if record.get('status_reason'):
                 print('%s: %s' % (record['status'], record['status_reason']))
+            for doubt in record.get('doubts') or []:
+                print('look at: %s' % doubt)
             for line in report.evidence_lines(record):
                 print('  ' + line)
             print('grade.json and grade.md in %s' % out)

@@ -177,3 +177,43 @@ def test_refused_calls_on_the_plot(tmp_path, monkeypatch):
     monkeypatch.setattr(Axes, 'plot', plot)
     assert flightplot.draw([('main', probe)], str(tmp_path / 'flight.png'))
     assert 'REFUSED "warning" call (1)' in labels and 'REFUSED "normal" call (1)' in labels, labels
+
+
+def test_grade_md_says_what_to_look_at():
+    items = [{'id': 'runs', 'points': 2.0, 'max': 2.0, 'evidence': ''}]
+    text = report.markdown(report.grade_record('x', 'altitude', items, [], {'doubts': ['several uploads: graded y']}))
+    assert '**Look at:** several uploads: graded y' in text
+    assert '**Look at:**' not in report.markdown(report.grade_record('x', 'altitude', items, []))
+
+
+class _Here(object):
+    """A stand-in for the box and the supervisor: the check runs here, as the test's user."""
+    home = '/tmp'
+
+    def argv(self, argv, env):
+        return argv
+
+    def run(self, name, argv, timeout, env=None):
+        import subprocess
+        done = subprocess.run(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=timeout, env=env)
+        return done.returncode, done.stdout.decode(), 0.0
+
+
+def test_roslaunch_verdict_on_the_file_as_handed_in(tmp_path):
+    from exam_lab.grader.judge import session
+    launch = tmp_path / 'src' / 'exam' / 'launch'
+    launch.mkdir(parents=True)
+    (launch / 'dup.launch').write_text('<launch><node pkg="mydrone" name="mydrone" type="mydrone_node.py"/>'
+                                       '<node pkg="exam" name="mydrone" type="exam_node.py"/></launch>')
+    (launch / 'odd.launch').write_text('<launch><node pkg="exam" name="exam" type="exam_node.py">'
+                                       '<parm name="threshold" value="1"/></node></launch>')
+    (tmp_path / 'devel').mkdir()  # the student's workspace, sourced before the check: ours is sourced already
+    (tmp_path / 'devel' / 'setup.bash').write_text('true\n')
+    here, env = _Here(), dict(os.environ)
+    job = {'workspace': str(tmp_path), 'handed_in_launch': 'exam/launch/dup.launch'}
+    refused = session.launch_verdict(here, job, env, here)
+    assert refused['status'] == 1 and refused['file'] == 'launch/dup.launch'
+    assert 'multiple nodes named [/mydrone]' in refused['refused'], refused
+    odd = session.launch_verdict(here, dict(job, handed_in_launch='exam/launch/odd.launch'), env, here)
+    assert odd['status'] == 0 and odd['refused'] == '' and odd['nodes'] == ['/exam'], odd
+    assert any("unrecognized 'parm'" in w for w in odd['warnings']), odd

@@ -117,23 +117,38 @@ def warning_latency(probe):
 #: roslaunch's own check of the launch file as handed in: s at most, lines of its words kept.
 LAUNCH_CHECK_TIMEOUT = 30.0
 LAUNCH_CHECK_LINES = 8
-#: What roslaunch prints that is a warning about the file rather than the list of its nodes.
-_LAUNCH_WARNING = re.compile(r'^(?:\[?WARN(?:ING)?\]?|.*\bwarning\b|.*deprecated)', re.I)
+#: Run in the box by the system's python3: roslaunch's loader reads the file as ``roslaunch exam
+#: exam.launch`` would (every include, argument, node name: ``roslaunch --nodes`` does the same) without
+#: starting anything, and says what roslaunch would print as errors before launching (unknown tags and
+#: attributes), which ``roslaunch --nodes`` keeps to itself.
+_LAUNCH_CHECK = '''
+import sys
+from roslaunch.config import load_config_default
+try:
+    config = load_config_default([sys.argv[1]], None, verbose=False, assign_machines=False)
+except Exception as err:
+    print('%s: %s' % (type(err).__name__, ' '.join(str(err).split())))
+    sys.exit(1)
+for error in config.config_errors:
+    print('WARNING: %s' % ' '.join(str(error).split())[:200])
+for node in config.nodes:
+    print('/' + (node.namespace + node.name).strip('/'))
+'''
 
 
 def launch_verdict(sup, job, base_env, box):
     """roslaunch's verdict on the student's launch file as handed in (``job["handed_in_launch"]``, in
-    the workspace's src/): ``roslaunch --nodes`` run in the box with the student's workspace sourced
-    loads the file as ``roslaunch exam exam.launch`` would (every include, argument and node name)
-    without starting anything. ``{"file", "status" (exit code, None when it did not finish), "refused"
-    (roslaunch's words, '' when accepted), "warnings" [lines], "nodes" [names]}``; None without a file."""
+    the workspace's src/), read by roslaunch's own loader in the box with the student's workspace
+    sourced (:data:`_LAUNCH_CHECK`). ``{"file" (in the package), "status" (exit code, None when it did
+    not finish), "refused" (roslaunch's words, '' when accepted), "warnings" [lines], "nodes" [names]}``;
+    None without a launch file. The output comes from the box: capped, read as text."""
     relative = job.get('handed_in_launch')
     if not relative:
         return None
     path = os.path.join(job['workspace'], 'src', relative)
     status, output, _ = sup.run('launch-check', box.argv(
-        ['bash', '-c', 'source "$1/devel/setup.bash" && exec roslaunch --nodes "$2"', 'bash',
-         job['workspace'], path], dict(base_env, ROS_HOME=os.path.join(box.home, 'ros-check'))),
+        ['bash', '-c', 'source "$1/devel/setup.bash" && exec /usr/bin/python3 -c "$2" "$3"', 'bash',
+         job['workspace'], _LAUNCH_CHECK, path], dict(base_env, ROS_HOME=os.path.join(box.home, 'ros-check'))),
         timeout=LAUNCH_CHECK_TIMEOUT)
     lines = [l.strip()[:300] for l in _ANSI.sub('', output).replace(job['workspace'].rstrip('/') + '/src/', '')
              .splitlines() if l.strip()]
@@ -142,7 +157,8 @@ def launch_verdict(sup, job, base_env, box):
             'refused': '' if status == 0 else ' '.join(words[-LAUNCH_CHECK_LINES:]) or
             ('roslaunch did not finish within %.0f s' % LAUNCH_CHECK_TIMEOUT if status is None
              else 'roslaunch exit %s' % status),
-            'warnings': [l for l in words if _LAUNCH_WARNING.match(l)][:LAUNCH_CHECK_LINES] if status == 0 else [],
+            'warnings': [l[len('WARNING: '):] for l in words if l.startswith('WARNING: ')][:LAUNCH_CHECK_LINES]
+            if status == 0 else [],
             'nodes': [l for l in lines if l.startswith('/')][:20]}
 
 

@@ -43,11 +43,13 @@ def markdown(record):
     lines = ['# %s: %s / %s' % (record['student'], _points(record['total']), _points(record['max'])),
              '',
              _status_line(record),
-             '',
-             how,
-             '',
-             '| item | what is checked | points | evidence |',
-             '|---|---|---|---|']
+             '']
+    if record.get('doubts'):
+        lines += ['**Look at:** %s' % '; '.join(d.replace('\n', ' ') for d in record['doubts']), '']
+    lines += [how,
+              '',
+              '| item | what is checked | points | evidence |',
+              '|---|---|---|---|']
     for entry in record['items']:
         what = ITEMS[entry['id']][1]
         evidence = entry['evidence'].split('\n', 1)[0].replace('|', '\\|')
