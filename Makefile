@@ -19,7 +19,7 @@ help:
 	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
 	@echo "make mutation       mutation testing of the nodes' code against its tests (about 30 min)"
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
-	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv>] [ENGINE=local|slurm] [SLURM_ARGS='...']"
+	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv> [WORKSHEET_SCALE=1]] [ENGINE=local|slurm] [SLURM_ARGS='...']"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
 
@@ -58,8 +58,8 @@ grade: build
 	@$(ENV) && exec python3 lab/scripts/grade.py \
 	  $(if $(SUBMISSION),--submission "$(SUBMISSION)") $(if $(CLASS),--class "$(CLASS)") \
 	  $(if $(SHEET),--sheet "$(SHEET)") $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)") \
-	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") $(if $(ENGINE),--engine "$(ENGINE)") \
-	  $(if $(SLURM_ARGS),--slurm-args "$(SLURM_ARGS)")
+	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") $(if $(WORKSHEET_SCALE),--worksheet-scale) \
+	  $(if $(ENGINE),--engine "$(ENGINE)") $(if $(SLURM_ARGS),--slurm-args "$(SLURM_ARGS)")
 
 clean:
 	rm -rf .ws

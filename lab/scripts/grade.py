@@ -24,7 +24,7 @@ from exam_lab.grader import runner
 from exam_lab.grader.boxed import documents, unpack
 from exam_lab.grader.engine import slurm
 
-from exam_lab.grader.publish import desk, progress, report
+from exam_lab.grader.publish import desk, moodle, progress, report
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import SHEETS
 
@@ -47,6 +47,9 @@ def main(argv=None):
                         action='store_true', help='grade even where no sandbox can be made (never as root: '
                         'as root the code runs as a user of its own, with limits)')
     parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV) to fill")
+    parser.add_argument('--worksheet-scale', action='store_true',
+                        help="scale the grades to the worksheet's maximum grade (default: the machine's points "
+                        "out of 17, said on the terminal and in each comment)")
     parser.add_argument('--no-similarity', action='store_true', help='skip the similarity check (class)')
     parser.add_argument('--engine', choices=['local', 'slurm'], default='local',
                         help='where a class is graded: here, JOBS at a time, or one Slurm array task per student')
@@ -69,10 +72,13 @@ def main(argv=None):
             say(report.table([record]))
             if record.get('status_reason'):
                 say('%s: %s' % (record['status'], record['status_reason']))
+            for doubt in record.get('doubts') or []:
+                say('look at: %s' % doubt)
             for line in report.evidence_lines(record):
                 say('  ' + line)
             say('grade.json and grade.md in %s' % out)
-            for line in desk.finish(out, [record], single=True, worksheet=args.worksheet):
+            for line in desk.finish(out, [record], single=True, worksheet=args.worksheet,
+                                    scale=args.worksheet_scale):
                 say(line)
         else:
             shown = progress.ClassProgress(args.jobs)
@@ -93,7 +99,8 @@ def main(argv=None):
                     say('  ' + line)
             say('grades.csv and one folder per student in %s' % out)
             for line in desk.finish(out, records, similar=None if args.no_similarity else
-                                    runner.class_similarity(args.klass, out, records), worksheet=args.worksheet):
+                                    runner.class_similarity(args.klass, out, records), worksheet=args.worksheet,
+                                    scale=args.worksheet_scale, title=moodle.class_name(args.klass)):
                 say(line)
     except RuntimeError as err:
         say('grade: %s' % err, sys.stderr)

@@ -159,7 +159,8 @@ def prepare(submission, work, wanted_sheet, notes, fixes=None):
     :returns: ``(sheet, static, job)``; ``job`` is None when nothing can be run (no node script).
     """
     fixes = notes if fixes is None else fixes
-    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes, fixes)
+    uploads = []
+    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes, fixes, uploads=uploads)
     name = unpack.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
     workspace = os.path.join(work, 'ws')
     pkg = os.path.join(workspace, 'src', name if re.match(r'^[A-Za-z][\w-]*$', name) else PACKAGE)
@@ -174,7 +175,8 @@ def prepare(submission, work, wanted_sheet, notes, fixes=None):
     fixes.extend(source.make_runnable(pkg, launched))
     static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses], 'package': name,
               'package_dir': pkg, 'python2': source.python2_evidence(pkg),
-              'params_in_code': source.param_names(pkg), 'launch': None, 'threshold': None}
+              'params_in_code': source.param_names(pkg), 'launch': None, 'threshold': None,
+              'uploads': uploads}
     if static['python2']:
         notes.append('Python 2 code, which ROS Noetic cannot run: %s' % ', '.join(static['python2']))
     for analysis in analyses:
@@ -221,7 +223,8 @@ def prepare(submission, work, wanted_sheet, notes, fixes=None):
     elif param is not None:
         static['threshold']['not_rewritable'] = 'its value comes from no literal the grader can change'
     job = {'workspace': workspace, 'namespace': namespace, 'build_timeout': BUILD_TIMEOUT,
-           'run_timeout': RUN_TIMEOUT, 'runs': runs}
+           'run_timeout': RUN_TIMEOUT, 'runs': runs,
+           'handed_in_launch': os.path.relpath(chosen.path, os.path.join(workspace, 'src')) if chosen else None}
     return sheet, static, job
 
 
@@ -409,7 +412,8 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                 notes.append('not copied to logs/ (not a regular file): %s' % ', '.join(skipped))
         record = report.grade_record(student, chosen_sheet, items,
                                      hints(static, session, notes + fixes, pkg, isolate, how_run),
-                                     dict(extra or {}, seconds=round(time.monotonic() - start, 1)),
+                                     dict(extra or {}, seconds=round(time.monotonic() - start, 1),
+                                          doubts=rubric.doubts(static, session)),
                                      rubric.status(static, session, fixes))
         report.write_grade(out_dir, record)
         return record

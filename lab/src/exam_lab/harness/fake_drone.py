@@ -75,6 +75,11 @@ class SensorFeeder(object):
         """True when every input topic has a subscriber (the node under test is up and connected)."""
         return all(pub.get_num_connections() > 0 for pub in self._pubs.values())
 
+    def connections(self, topic):
+        """How many subscribers ``topic``'s publisher is connected to (rospy refuses one that asked
+        for another message type: the master lists it, but it has no connection)."""
+        return self._pubs[topic].get_num_connections()
+
     def wait_for_subscribers(self, timeout):
         return wait_until(self.connected, timeout, alive=_alive)
 
@@ -146,6 +151,7 @@ class FakeWarningService(object):
         self._on_call = on_call
         self._lock = threading.Lock()
         self._calls = []
+        self._answers = []
         self._attempts = []
         self._delay = 0.0
         self._failing = False
@@ -198,6 +204,15 @@ class FakeWarningService(object):
         with self._lock:
             return list(self._calls)
 
+    def answers(self):
+        """Every answered call with the drone's answer: (ROS time of arrival, request, success, message).
+
+        A refused request (a status the drone does not know, or a scripted refusal) is a call all the
+        same: the grader judges when the node called, and says what the drone answered.
+        """
+        with self._lock:
+            return list(self._answers)
+
     def statuses(self):
         return [status for _, status in self.calls()]
 
@@ -209,6 +224,7 @@ class FakeWarningService(object):
     def clear(self):
         with self._lock:
             del self._calls[:]
+            del self._answers[:]
             del self._attempts[:]
 
     def wait_for_calls(self, count, timeout):
@@ -240,6 +256,8 @@ class FakeWarningService(object):
             message = 'LED driver fault (scripted)'
         else:
             message = 'LED set' if colour is not None else 'unknown status'
+        with self._lock:
+            self._answers.append((now, request.status, colour is not None, message))
         return self._srv_class._response_class(colour is not None, message)
 
 

@@ -27,17 +27,21 @@ The main scenario (times are the script's, all recorded as ROS time of the event
    and every leg is checked on the node's own values (``legs``): the rubric judges nothing on a leg the
    node's value did not reach.
 """
+import ast
 import json
+import logging
 import math
 import os
+import re
 import sys
+import threading
 import time
 
 import rosgraph
 import rospy
 from std_msgs import msg as std_msgs
 
-from exam_lab.grader.score.sheets import LATE_WARNING_S
+from exam_lab.grader.score.sheets import LATE_WARNING_S, request_meaning
 from exam_lab.harness import oracle
 from exam_lab.harness.fake_drone import Drone, TopicRecorder
 from exam_lab.harness.wait import wait_until
@@ -65,6 +69,39 @@ NUMERIC_TYPES = ('Float32', 'Float64', 'Int8', 'Int16', 'Int32', 'Int64', 'UInt8
 VALUE_TYPES = {'std_msgs/%s' % name: getattr(std_msgs, name) for name in NUMERIC_TYPES}
 #: Topics every node has or that are never an answer.
 IGNORED_TOPICS = ('/rosout', '/rosout_agg', '/diagnostics')
+
+
+#: rospy's words, in the probe's own log, when a subscriber asks for another type than the drone
+#: publishes (the md5sums differ): "Could not process inbound connection: topic types do not match:
+#: [std_msgs/Float64] vs. [std_msgs/Float32]{'callerid': '/exam', 'topic': '/temperature', ...}".
+_TYPE_REFUSAL = re.compile(r'topic types do not match: \[([^\]]*)\] vs\. \[([^\]]*)\](\{.*\})')
+
+
+class RefusedConnections(logging.Handler):
+    """The subscriptions the probe's publishers refused, read from rospy's own warning: which node
+    asked for which topic with which type. The master lists such a node as a subscriber, yet it never
+    gets a message (rospy drops the connection), so only this says what the node subscribed with."""
+
+    def __init__(self):
+        logging.Handler.__init__(self, logging.WARNING)
+        self._lock_refused = threading.Lock()
+        self._refused = {}
+
+    def emit(self, record):
+        try:
+            match = _TYPE_REFUSAL.search(record.getMessage())
+            header = ast.literal_eval(match.group(3)) if match else None
+        except (ValueError, SyntaxError):
+            return
+        if isinstance(header, dict) and header.get('topic'):
+            with self._lock_refused:
+                self._refused[str(header['topic'])] = {'node': str(header.get('callerid', '?')),
+                                                       'wanted': match.group(1), 'published': match.group(2)}
+
+    def refused(self):
+        """{topic: {"node", "wanted" (the subscriber's type), "published" (the drone's)}}."""
+        with self._lock_refused:
+            return dict(self._refused)
 
 
 class Graph(object):
@@ -157,6 +194,8 @@ class Probe(object):
         self.result = {'kind': plan['kind'], 'sheet': self.sheet, 'threshold': plan['threshold'],
                        'margin': plan['margin'], 'delay': plan['delay'], 'start_timeout': plan['start_timeout']}
         self.graph = Graph()
+        self.refusals = RefusedConnections()
+        logging.getLogger('rosout').addHandler(self.refusals)
         self.drone = Drone(self.sheet)
         self.recorder = self.drone.output
         self.t0 = rospy.get_time()
@@ -189,7 +228,34 @@ class Probe(object):
         inputs = [self.resolved(t) for t in (self.drone.fixed_topic, self.drone.moving_topic)]
         wait_until(lambda: all(self.graph.subscribers(t) for t in inputs), SUBSCRIBE_S, period=0.1)
         self.result['subscribed'] = {t: self.graph.subscribers(t) for t in inputs}
+        self.result['input_types'] = self.input_types(
+            dict(zip(inputs, (self.drone.fixed_topic, self.drone.moving_topic))))
         return True
+
+    def input_types(self, inputs, timeout=3.0):
+        """{input topic: {"type" the node subscribed with, "connected", "refused"}}: a subscription
+        rospy refused (another type than the drone's) shows as no connection and a refusal in our log.
+        Waits up to ``timeout`` s for each subscribed input to connect or be refused.
+
+        :param inputs: {resolved input topic: the feeder's name of it}."""
+        feeder = self.drone.feeder
+
+        def settled():
+            return all(not self.graph.subscribers(t) or feeder.connections(name) > 0 or t in self.refusals.refused()
+                       for t, name in inputs.items())
+        wait_until(settled, timeout, period=0.1)
+        refused = self.refusals.refused()
+        out = {}
+        for topic, name in sorted(inputs.items()):
+            if topic in refused:
+                out[topic] = {'type': refused[topic]['wanted'], 'connected': feeder.connections(name) > 0,
+                              'refused': 'rospy refused the connection: the node asked for %s, the drone '
+                                         'publishes %s' % (refused[topic]['wanted'], refused[topic]['published'])}
+            elif self.graph.subscribers(topic):
+                connected = feeder.connections(name) > 0
+                out[topic] = {'type': 'std_msgs/Float32' if connected else None, 'connected': connected,
+                              'refused': None}
+        return out
 
     def find_output(self):
         expected = self.resolved(self.plan['output'])
@@ -302,7 +368,7 @@ class Probe(object):
             start = reached if reached is not None else since
         time.sleep(max(0.0, start + hold - rospy.get_time()))
         if late > hold:
-            wait_until(lambda: any(t >= since and s == 'WARNING' for t, s in self.drone.service.calls())
+            wait_until(lambda: any(t >= since and request_meaning(s) == 'WARNING' for t, s in self.drone.service.calls())
                        or not self.graph.student_nodes(), start + late - rospy.get_time(), period=0.1)
         return since
 
@@ -373,7 +439,14 @@ class Probe(object):
                 self.find_output()  # the node's own values, to check the legs on
                 self.threshold_check()
         self.result['calls'] = [[t, s] for t, s in self.drone.service.calls()]
+        self.result['answers'] = [[t, s, ok, message] for t, s, ok, message in self.drone.service.answers()]
         self.result['graph'] = self.graph.summary()
+        seen = self.result.get('input_types') or {}
+        for info in self.result['graph'].values():  # the master gives the publisher's type, not the subscriber's
+            for entry in info['subscribes']:
+                if entry[0] in seen:
+                    entry[1] = '%s%s' % (seen[entry[0]]['type'] or 'type unknown: no connection',
+                                         ', refused by rospy' if seen[entry[0]]['refused'] else '')
         self.result['alive_at_end'] = bool(self.graph.student_nodes())
         self.result['t0'] = self.t0
         self.result['trace'] = trace(self.recorder.samples(self.t0) if self.recorder is not None else [], self.flown)

@@ -28,6 +28,7 @@ import time
 
 from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.score.safe_text import clean as clean_text
+from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
 from exam_lab.harness.wait import wait_until
 
@@ -82,7 +83,7 @@ def warned_in_long_excursion(probe):
     schedule = (probe or {}).get('schedule') or {}
     if 'long_up' not in schedule:
         return False
-    return any(status == 'WARNING' and schedule['long_up'] <= t <= schedule['long_down']
+    return any(request_meaning(status) == 'WARNING' and schedule['long_up'] <= t <= schedule['long_down']
                for t, status in probe.get('calls', []))
 
 
@@ -107,9 +108,57 @@ def probe_problem(result, plan, started, finished):
 def warning_latency(probe):
     """Seconds from the long excursion's start to the main run's first WARNING in it, or None."""
     schedule = (probe or {}).get('schedule') or {}
-    times = [t for t, status in (probe or {}).get('calls', []) if status == 'WARNING'
+    times = [t for t, status in (probe or {}).get('calls', []) if request_meaning(status) == 'WARNING'
              and schedule.get('long_up', float('inf')) <= t <= schedule.get('long_down', 0.0)]
     return min(times) - schedule['long_up'] if times else None
+
+
+#: roslaunch's own check of the launch file as handed in: s at most, lines of its words kept.
+LAUNCH_CHECK_TIMEOUT = 30.0
+LAUNCH_CHECK_LINES = 8
+#: Run in the box by the system's python3: roslaunch's loader reads the file as ``roslaunch exam
+#: exam.launch`` would (every include, argument, node name: ``roslaunch --nodes`` does the same) without
+#: starting anything, and says what roslaunch would print as errors before launching (unknown tags and
+#: attributes), which ``roslaunch --nodes`` keeps to itself.
+_LAUNCH_CHECK = '''
+import sys
+from roslaunch.config import load_config_default
+try:
+    config = load_config_default([sys.argv[1]], None, verbose=False, assign_machines=False)
+except Exception as err:
+    print('%s: %s' % (type(err).__name__, ' '.join(str(err).split())))
+    sys.exit(1)
+for error in config.config_errors:
+    print('WARNING: %s' % ' '.join(str(error).split())[:200])
+for node in config.nodes:
+    print('/' + (node.namespace + node.name).strip('/'))
+'''
+
+
+def launch_verdict(sup, job, base_env, box):
+    """roslaunch's verdict on the student's launch file as handed in (``job["handed_in_launch"]``, in
+    the workspace's src/), read by roslaunch's own loader in the box with the student's workspace
+    sourced (:data:`_LAUNCH_CHECK`). ``{"file" (in the package), "status" (exit code, None when it did
+    not finish), "refused" (roslaunch's words, '' when accepted), "warnings" [lines], "nodes" [names]}``;
+    None without a launch file. The output comes from the box: capped, read as text."""
+    relative = job.get('handed_in_launch')
+    if not relative:
+        return None
+    path = os.path.join(job['workspace'], 'src', relative)
+    status, output, _ = sup.run('launch-check', box.argv(
+        ['bash', '-c', 'source "$1/devel/setup.bash" && exec /usr/bin/python3 -c "$2" "$3"', 'bash',
+         job['workspace'], _LAUNCH_CHECK, path], dict(base_env, ROS_HOME=os.path.join(box.home, 'ros-check'))),
+        timeout=LAUNCH_CHECK_TIMEOUT)
+    lines = [l.strip()[:300] for l in clean_text(output).replace(job['workspace'].rstrip('/') + '/src/', '')
+             .splitlines() if l.strip()]
+    words = [l for l in lines if not l.startswith('/')]
+    return {'file': relative.split('/', 1)[-1], 'status': status,
+            'refused': '' if status == 0 else ' '.join(words[-LAUNCH_CHECK_LINES:]) or
+            ('roslaunch did not finish within %.0f s' % LAUNCH_CHECK_TIMEOUT if status is None
+             else 'roslaunch exit %s' % status),
+            'warnings': [l[len('WARNING: '):] for l in words if l.startswith('WARNING: ')][:LAUNCH_CHECK_LINES]
+            if status == 0 else [],
+            'nodes': [l for l in lines if l.startswith('/')][:20]}
 
 
 def run_one(sup, job, run, base_env, box):
@@ -172,6 +221,8 @@ def session(job):
                            'timeout': job['build_timeout']}
         if status != 0:
             return result
+        result['launch_check'] = launch_verdict(sup, job, base_env, box)
+        result['survivors'] += box.end()
         for run in job['runs']:
             if run['tag'] == 'threshold':
                 main = result['runs'][0]['probe'] if result['runs'] else None

@@ -56,12 +56,14 @@ def _student(out, record, single):
     return entry
 
 
-def finish(out, records, single=False, similar=None, worksheet=None):
+def finish(out, records, single=False, similar=None, worksheet=None, scale=False, title=None):
     """Write the desk's files for ``records`` graded into ``out``; return lines for the terminal.
 
     :param single: one submission (its results are in ``out`` itself, not ``out/<student>``).
     :param similar: the similarity check's result (:func:`exam_lab.grader.boxed.similarity.check`) or None.
     :param worksheet: the Moodle worksheet to fill, or None.
+    :param scale: scale the grades to the worksheet's maximum grade (:func:`moodle.fill`).
+    :param title: the class's name (:func:`moodle.class_name`); the output folder's name when None.
     """
     lines, notes, entries = [], [], {}
     for record in records:
@@ -71,7 +73,7 @@ def finish(out, records, single=False, similar=None, worksheet=None):
         base = os.path.splitext(os.path.basename(worksheet))[0]
         target = os.path.join(out, '%s-filled.csv' % base)
         try:
-            summary = moodle.fill_file(worksheet, target, records)
+            summary = moodle.fill_file(worksheet, target, records, scale)
             lines += moodle.summary_lines(summary, target)
             with open(os.path.join(out, 'worksheet.json'), 'w') as f:
                 json.dump(summary, f, indent=1, sort_keys=True)
@@ -90,7 +92,7 @@ def finish(out, records, single=False, similar=None, worksheet=None):
         else:
             lines.append('similarity: %d pair(s) flagged of %d student(s) (%s)'
                          % (len(pairs), similar.get('students', 0), os.path.join(out, 'index.html#similarity')))
-    title = 'Exam grades: %s' % (records[0]['student'] if single and records else os.path.basename(out))
+    title = 'Exam grades: %s' % (records[0]['student'] if single and records else title or os.path.basename(out))
     try:
         content = page.render(records, title, entries, pairs, notes)
     except Exception as err:  # not one student's: the page shrinks to what cannot fail, and says why

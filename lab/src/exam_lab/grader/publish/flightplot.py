@@ -8,6 +8,8 @@ import json
 import math
 import os
 
+from exam_lab.grader.score.rubric import calls
+
 #: Legs of each run, in order, and the side of the threshold each is flown on.
 LEGS = {'rest': 'below', 'short_up': 'above', 'short_down': 'below', 'long_up': 'above', 'long_down': 'below',
         'start': 'below', 'step': 'above'}
@@ -178,15 +180,25 @@ def _panel(ax, tag, probe):
     threshold = clamp.value(threshold) if threshold is not None else None
     if threshold is not None:
         ax.axhline(threshold, color='#cc0000', ls='--', lw=1, label='threshold %g' % threshold)
+    made = calls(probe)
     for kind in ('WARNING', 'NORMAL'):
-        times = [clamp.time(t, t0) for t, status in probe.get('calls') or [] if status == kind]
-        times = [t for t in times if t is not None]
-        if len(times) <= FEW_CALLS:
-            for t in times:
-                ax.axvline(t, color=_CALL_COLOUR[kind], lw=1, alpha=0.8)
-        if times:
-            ax.plot(times, [0.96] * len(times), 'v', color=_CALL_COLOUR[kind], ms=6, clip_on=False,
-                    transform=ax.get_xaxis_transform(), label='%s call (%d)' % (kind, len(times)))
+        for accepted in (True, False):
+            times = [clamp.time(t, t0) for t, meaning, _, ok in made if meaning == kind and ok == accepted]
+            times = [t for t in times if t is not None]
+            requests = sorted(set(r for _, meaning, r, ok in made if meaning == kind and ok == accepted))
+            if len(times) <= FEW_CALLS:
+                for t in times:
+                    ax.axvline(t, color=_CALL_COLOUR[kind], lw=1, alpha=0.8, ls='-' if accepted else ':')
+            if times:
+                ax.plot(times, [0.96] * len(times), 'v', color=_CALL_COLOUR[kind], ms=6, clip_on=False,
+                        mfc=_CALL_COLOUR[kind] if accepted else 'white', transform=ax.get_xaxis_transform(),
+                        label='%s call (%d)' % (kind, len(times)) if accepted else
+                        'REFUSED %s call (%d)' % (' / '.join('"%s"' % r[:12] for r in requests[:2]), len(times)))
+    other = [(clamp.time(t, t0), r) for t, meaning, r, _ in made if meaning not in _CALL_COLOUR]
+    other = [(t, r) for t, r in other if t is not None]
+    if other:
+        ax.plot([t for t, _ in other], [0.96] * len(other), 'x', color='#7a4a00', ms=6, clip_on=False,
+                transform=ax.get_xaxis_transform(), label='REFUSED other call (%d)' % len(other))
     _limits(ax, [v for _, v in published], [v for _, v in oracle], threshold)
     if clamp.note():
         ax.text(0.99, 0.04, clamp.note(), transform=ax.transAxes, fontsize=8, color='#b00000', ha='right',

@@ -174,12 +174,15 @@ def render(records, title, entries, pairs=None, notes=None):
     parts.append('<p>%d student(s); mean %.1f / %s; machine-scored items only (not the comments, the '
                  'code quality, the report).</p>' % (len(records), sum(totals) / max(len(totals), 1),
                                                       report._points(maximum)))
-    first = [r for r in records if _status(r) not in GRADED]
+    first = [r for r in records if _status(r) not in GRADED or r.get('doubts')]
     parts.append('<h2 id="first">Needs the teacher first</h2>')
     if first:
         parts.append('<div class="first"><ul>%s</ul></div>' % ''.join(
-            '<li><a href="#%s">%s</a>: %s - %s</li>' % (anchor(r['student']), _e(r['student']), _status_cell(r),
-                                                       _e(r.get('status_reason', ''))) for r in first))
+            '<li><a href="#%s">%s</a>: %s%s%s</li>' % (
+                anchor(r['student']), _e(r['student']), _status_cell(r),
+                ' - %s' % _e(r['status_reason']) if r.get('status_reason') else '',
+                '<ul>%s</ul>' % ''.join('<li>%s</li>' % _e(d) for d in r.get('doubts') or [])
+                if r.get('doubts') else '') for r in first))
     else:
         parts.append('<p>Nobody: every submission was graded by the machine.</p>')
     if notes:

@@ -49,11 +49,13 @@ def markdown(record):
     lines = ['# %s: %s / %s' % (record['student'], _points(record['total']), _points(record['max'])),
              '',
              _status_line(record),
-             '',
-             how,
-             '',
-             '| item | what is checked | points | evidence |',
-             '|---|---|---|---|']
+             '']
+    if record.get('doubts'):
+        lines += ['**Look at:** %s' % '; '.join(d.replace('\n', ' ') for d in record['doubts']), '']
+    lines += [how,
+              '',
+              '| item | what is checked | points | evidence |',
+              '|---|---|---|---|']
     for entry in record['items']:
         what = ITEMS[entry['id']][1]
         evidence = entry['evidence'].split('\n', 1)[0].replace('|', '\\|')
@@ -107,9 +109,12 @@ def table(records):
 
 def needing_the_teacher(records):
     """Lines for the terminal: each student whose grade the teacher must look at, and why (all but
-    'graded' and 'graded with fixes')."""
-    return [safe_text.one_line('%s: %s - %s' % (r['student'], r.get('status'), r.get('status_reason', '')))
-            for r in records if r.get('status') not in ('graded', 'graded with fixes')]
+    'graded' and 'graded with fixes', and any grade with a doubt: refused calls, a launch file roslaunch
+    refuses, several uploads...)."""
+    return [safe_text.one_line('%s: %s%s%s' % (r['student'], r.get('status'),
+                                                ' - %s' % r['status_reason'] if r.get('status_reason') else '',
+                                                ''.join('; %s' % d for d in r.get('doubts') or [])))
+            for r in records if r.get('status') not in ('graded', 'graded with fixes') or r.get('doubts')]
 
 
 def evidence_lines(record):
