@@ -359,13 +359,14 @@ def could_not_grade(student, sheet, why, notes=()):
 
 
 def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False,
-                     on_step=None, extra=None, unsandboxed=False):
+                     on_step=None, extra=None, unsandboxed=False, jobs=1):
     """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
 
     :param on_step: called with each step's name as it starts (unpack, build, main flight...).
     :param extra: added to the record (:func:`exam_lab.grader.boxed.documents.submission_facts`).
     :param unsandboxed: run it even where no sandbox can be made (the teacher's flag that names the
         risk); otherwise :class:`~exam_lab.grader.host.sandbox.SandboxUnavailable` is raised there.
+    :param jobs: how many submissions are graded side by side: the box's part of the CPU.
     """
     start = time.monotonic()
     student = student or unpack.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
@@ -390,7 +391,8 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                            'error': 'no script of the package starts a ROS node'}
             else:
                 _prepare_workspace(work)
-                with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None) as box:
+                with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None,
+                                 cpus=sandbox.box_cpus(jobs)) as box:
                     notes.extend(box.notes)
                     how_run = _how_run(box)
                     session = run_session(job, work, underlay, isolate, box, on_step)
@@ -470,7 +472,8 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
             try:
                 record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
                                           on_step=(lambda step: progress.step(name, step)) if progress else None,
-                                          extra=documents.submission_facts(folder), unsandboxed=unsandboxed)
+                                          extra=documents.submission_facts(folder), unsandboxed=unsandboxed,
+                                          jobs=jobs)
             except Exception as err:  # anything: this student's row says so, the class goes on
                 record = could_not_grade(name, sheet, '%r' % err,
                                          ['grader error, please report: %s'
