@@ -112,17 +112,17 @@ def clock_problem(clock):
 
 
 def probe_problem(result, plan, started, finished):
-    """Why the probe's ``result`` cannot be this run's measurement, or None: nobody set the time
-    (:func:`clock_problem`), every time it records (wall clock) must lie between the probe's start
-    and the result's arrival, and the flight must have lasted its schedule (the long excursion at
+    """Why the probe's ``result`` cannot be this run's measurement, or None: it has times, nobody set
+    the time (:func:`clock_problem`), every time it records (wall clock) must lie between the probe's
+    start and the result's arrival, and the flight must have lasted its schedule (the long excursion at
     least the delay)."""
-    problem = clock_problem(result.get('clock'))
-    if problem:
-        return problem
     schedule = result.get('schedule') or {}
     times = [t for t in [result.get('t0')] + list(schedule.values()) if isinstance(t, (int, float))]
     if not times:
         return 'the probe\'s result has no times'
+    problem = clock_problem(result.get('clock'))
+    if problem:
+        return problem
     if min(times) < started - 1.0 or max(times) > finished + 1.0:
         return 'the probe\'s times (%.1f to %.1f) are not within its run (%.1f to %.1f)' % (
             min(times), max(times), started, finished)
@@ -139,6 +139,12 @@ def warning_latency(probe):
     times = [t for t, status in (probe or {}).get('calls', []) if status == 'WARNING'
              and schedule.get('long_up', float('inf')) <= t <= schedule.get('long_down', 0.0)]
     return min(times) - schedule['long_up'] if times else None
+
+
+def capped_log(sup, name):
+    """What a process of the box printed, its middle cut beyond twice LOG_PART (:func:`read_capped`):
+    the orchestrator never reads more of what the student wrote."""
+    return read_capped(sup.log(name)) or ''
 
 
 def uid_of(pid):
@@ -192,7 +198,7 @@ def run_one(sup, job, run, base_env, box):
     record['launch_running'] = launch.poll() is None
     master_died = master.proc.poll() is not None
     # Read before stopping: what the nodes print when the grader stops them is not their doing.
-    record['launch'] = launch_outcome(sup.output('launch-%s' % tag), job['workspace'])
+    record['launch'] = launch_outcome(capped_log(sup, 'launch-%s' % tag), job['workspace'])
     sup.stop(launch)
     record['survivors'] = box.end()
     text = read_capped(result_path, FILE_CAP) if os.path.isfile(result_path) else None
@@ -238,13 +244,13 @@ def session(job):
     with Supervisor(job['log_dir'], env=judge_env) as sup:
         base_env = workspace_env(job['underlay'], {'PATH': os.environ.get('PATH', '/usr/bin:/bin'),
                                                    'LANG': 'C.UTF-8'})
-        status, output, seconds = sup.run(
+        status, _, seconds = sup.run(
             'build', box.argv(['catkin_make', '--directory', job['workspace'],
                                '-DPYTHON_EXECUTABLE=/usr/bin/python3', '-DCATKIN_ENABLE_TESTING=OFF'],
                               dict(base_env, ROS_HOME=os.path.join(box.home, 'ros'))),
             timeout=job['build_timeout'])
         result['survivors'] += box.end()
-        result['build'] = {'status': status, 'seconds': seconds, 'tail': tail(output),
+        result['build'] = {'status': status, 'seconds': seconds, 'tail': tail(capped_log(sup, 'build')),
                            'timeout': job['build_timeout']}
         if status != 0:
             return result
