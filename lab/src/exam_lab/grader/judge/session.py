@@ -173,6 +173,7 @@ def run_one(sup, job, run, base_env, box):
     tag = run['tag']
     log_dir, judge_dir = sup.log_dir, job['judge_home']
     reset_memory_peak(box.judge_cgroups.get('master', []))
+    killed_before = (memory_use(box.judge_cgroups.get('master', [])) or {}).get('oom_kills', 0)
     master = sup.start_master(name='master-%s' % tag, wrap=box.judge_argv([], 'master'))
     record = {'tag': tag, 'probe': None, 'master': {'uid': uid_of(master.proc.pid)}}
     launch_env = ros_env(base_env, master.uri, os.path.join(box.home, 'ros-%s' % tag), ip='127.0.0.1')
@@ -223,6 +224,8 @@ def run_one(sup, job, run, base_env, box):
     record['probe_status'] = sup.stop(probe, grace=5.0)
     sup.stop(master.proc)
     record['master']['memory'] = memory_use(box.judge_cgroups.get('master', []))
+    if record['master']['memory']:  # this run's kills: the slot's master cgroup serves every run
+        record['master']['memory']['oom_kills'] -= killed_before
     problem = master_problem(record['master'], master_died)
     if problem:
         record['probe'], record['probe_refused'] = None, problem
