@@ -362,13 +362,14 @@ def could_not_grade(student, sheet, why, notes=()):
 
 
 def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False,
-                     on_step=None, extra=None, unsandboxed=False):
+                     on_step=None, extra=None, unsandboxed=False, jobs=1):
     """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
 
     :param on_step: called with each step's name as it starts (unpack, build, main flight...).
     :param extra: added to the record (:func:`exam_lab.grader.boxed.documents.submission_facts`).
     :param unsandboxed: run it even where no sandbox can be made (the teacher's flag that names the
         risk); otherwise :class:`~exam_lab.grader.host.sandbox.SandboxUnavailable` is raised there.
+    :param jobs: how many submissions are graded side by side: the box's part of the CPU.
     """
     start = time.monotonic()
     student = student or unpack.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
@@ -393,7 +394,8 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                            'error': 'no script of the package starts a ROS node'}
             else:
                 _prepare_workspace(work)
-                with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None) as box:
+                with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None,
+                                 cpus=sandbox.box_cpus(jobs)) as box:
                     notes.extend(box.notes)
                     how_run = _how_run(box)
                     session = run_session(job, work, underlay, isolate, box, on_step)
@@ -456,13 +458,14 @@ def class_students(class_path, scratch):
 
 
 def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
-                  unsandboxed=False):
+                  unsandboxed=False, jobs=1):
     """Grade one student of a class into ``out_dir/name``; return the record. Anything the grader
     raises is this student's record ("could not grade"), never the class's. Both engines grade a
     student with it: a local pool's thread and a Slurm task."""
     try:
         return grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
-                                on_step=on_step, extra=documents.submission_facts(folder), unsandboxed=unsandboxed)
+                                on_step=on_step, extra=documents.submission_facts(folder), unsandboxed=unsandboxed,
+                                jobs=jobs)
     except Exception as err:  # anything: this student's row says so, the class goes on
         record = could_not_grade(name, sheet, '%r' % err,
                                  ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
@@ -497,7 +500,8 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
             if progress:
                 progress.started(name)
             record = grade_student(name, folder, out_dir, sheet, underlay, isolate,
-                                   (lambda step: progress.step(name, step)) if progress else None, unsandboxed)
+                                   (lambda step: progress.step(name, step)) if progress else None, unsandboxed,
+                                   jobs=jobs)
             if progress:
                 progress.finished(record)
             return record

@@ -14,7 +14,12 @@ Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of que
 "threshold" also ``fit`` (the main run's calibration), ``targets`` and ``warn_after`` (s the main
 run's WARNING took).
 
-The main scenario (times are the script's, all recorded as ROS time of the events):
+Every time is the wall clock's (``time.time()``), never rospy's ROS time: a student's node can set
+``/use_sim_time`` on the master before the probe's ``init_node`` and publish ``/clock``, and rospy would
+follow. The probe watches for both (a subscriber on ``/clock``, the parameter read at its start and
+end: ``clock`` in its result), and the session refuses such a run.
+
+The main scenario (times are the script's, all recorded as wall-clock times of the events):
 
 1. wait for the student's node; note which inputs it subscribes to and what it publishes;
 2. question 11: a few input pairs (one with another temperature / remote pressure), the value the node
@@ -39,6 +44,7 @@ import time
 
 import rosgraph
 import rospy
+from rosgraph_msgs.msg import Clock
 from std_msgs import msg as std_msgs
 
 from exam_lab.grader.score.sheets import LATE_WARNING_S, request_meaning
@@ -103,6 +109,35 @@ class RefusedConnections(logging.Handler):
         with self._lock_refused:
             return dict(self._refused)
 
+class ClockWatch(object):
+    """Whether anyone set ``/use_sim_time`` or published ``/clock`` during the run: the parameter as
+    rospy's ``init_node`` read it and as it is at the end, the ``/clock`` messages received and the
+    nodes that publish it. Built right after ``init_node``."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._messages = 0
+        self._at_start = self._use_sim_time()
+        self._sub = rospy.Subscriber('/clock', Clock, self._count, queue_size=1)
+
+    @staticmethod
+    def _use_sim_time():
+        try:
+            return rospy.get_param('/use_sim_time', None)
+        except Exception:  # the master answers; a failure is a transient of the XML-RPC call
+            return None
+
+    def _count(self, _msg):
+        with self._lock:
+            self._messages += 1
+
+    def seen(self, graph):
+        """``{"use_sim_time": [at start, at end], "messages", "publishers", "ros_time_is_wall"}``."""
+        with self._lock:
+            messages = self._messages
+        return {'use_sim_time': [self._at_start, self._use_sim_time()], 'messages': messages,
+                'publishers': graph.publishers('/clock'), 'ros_time_is_wall': rospy.rostime.is_wallclock()}
+
 
 class Graph(object):
     """The master's view, restricted to the student's nodes (everyone but this probe and rosout)."""
@@ -142,6 +177,10 @@ class Graph(object):
                     nodes[name]['services'].append(service)
         return nodes
 
+    def publishers(self, topic):
+        """Every node that publishes ``topic``, this probe included."""
+        return sorted(dict(self._state()[0]).get(topic, []))
+
     def subscribers(self, topic):
         names = dict(self._state()[1]).get(topic, [])
         return sorted(n for n in names if n in self.student_nodes())
@@ -156,7 +195,7 @@ def _last_value(recorder, since):
 def _settled(recorder, since, before=None):
     """The node's value after an input change at ``since``: read SETTLE_S later; when it is still the
     ``before`` value, waited for until it moves, up to STALE_S (a node that blocks in a callback)."""
-    time.sleep(max(0.0, since + SETTLE_S - rospy.get_time()))
+    time.sleep(max(0.0, since + SETTLE_S - time.time()))
     if before is not None:
         wait_until(lambda: _last_value(recorder, since)[0] not in (None, before), STALE_S - SETTLE_S,
                    period=0.1)
@@ -196,9 +235,10 @@ class Probe(object):
         self.graph = Graph()
         self.refusals = RefusedConnections()
         logging.getLogger('rosout').addHandler(self.refusals)
-        self.drone = Drone(self.sheet)
+        self.clock = ClockWatch()
+        self.drone = Drone(self.sheet, clock=time.time)
         self.recorder = self.drone.output
-        self.t0 = rospy.get_time()
+        self.t0 = time.time()
         self.flown = []  # [time, oracle value] at every input change, for the flight plot's trace
 
     # --- helpers ------------------------------------------------------------------------------------
@@ -222,7 +262,7 @@ class Probe(object):
     def wait_for_node(self):
         nodes = wait_until(lambda: self.graph.student_nodes() or None, self.plan['start_timeout'], period=0.1)
         self.result['nodes'] = nodes or []
-        self.result['node_seen_s'] = None if not nodes else rospy.get_time() - self.t0
+        self.result['node_seen_s'] = None if not nodes else time.time() - self.t0
         if not nodes:
             return False
         inputs = [self.resolved(t) for t in (self.drone.fixed_topic, self.drone.moving_topic)]
@@ -274,7 +314,7 @@ class Probe(object):
         topic, kind = output['topic'], output['type']
         if topic is not None and (topic != expected or kind != 'std_msgs/Float32') and kind in VALUE_TYPES:
             self.recorder.close()
-            self.recorder = TopicRecorder(topic, msg_type=VALUE_TYPES[kind])
+            self.recorder = TopicRecorder(topic, msg_type=VALUE_TYPES[kind], clock=time.time)
         elif topic is not None and kind not in VALUE_TYPES:
             self.recorder = None  # a type the probe cannot read values from
         return topic is not None and self.recorder is not None
@@ -366,10 +406,10 @@ class Probe(object):
             reached = wait_until(lambda: next((t for t, v in self.recorder.samples(since)
                                                if on_side(v, threshold, side)), None), REACH_S, period=0.05)
             start = reached if reached is not None else since
-        time.sleep(max(0.0, start + hold - rospy.get_time()))
+        time.sleep(max(0.0, start + hold - time.time()))
         if late > hold:
             wait_until(lambda: any(t >= since and request_meaning(s) == 'WARNING' for t, s in self.drone.service.calls())
-                       or not self.graph.student_nodes(), start + late - rospy.get_time(), period=0.1)
+                       or not self.graph.student_nodes(), start + late - time.time(), period=0.1)
         return since
 
     def flight(self, lo, hi):
@@ -381,7 +421,7 @@ class Probe(object):
         schedule['short_down'] = self.leg(lo, 'below', GAP_S)
         schedule['long_up'] = self.leg(hi, 'above', delay + AFTER_S, late)
         schedule['long_down'] = self.leg(lo, 'below', AFTER_S)
-        schedule['end'] = rospy.get_time()
+        schedule['end'] = time.time()
         self.result['schedule'] = schedule
         self.result['legs'] = self.legs(schedule, ('rest', 'short_up', 'short_down', 'long_up', 'long_down'))
         if self.recorder is not None:
@@ -415,7 +455,7 @@ class Probe(object):
         schedule = {'start': self.leg(self.x_of(self.plan['targets']['start']), 'below', REST_S)}
         hold = max(self.plan['delay'], min(self.plan.get('warn_after') or 0.0, LATE_WARNING_S)) + AFTER_S
         schedule['step'] = self.leg(self.x_of(self.plan['targets']['step']), 'above', hold)
-        schedule['end'] = rospy.get_time()
+        schedule['end'] = time.time()
         self.result['schedule'] = schedule
         self.result['legs'] = self.legs(schedule, ('start', 'step'))
 
@@ -449,6 +489,8 @@ class Probe(object):
                                          ', refused by rospy' if seen[entry[0]]['refused'] else '')
         self.result['alive_at_end'] = bool(self.graph.student_nodes())
         self.result['t0'] = self.t0
+        self.result['clock'] = self.clock.seen(self.graph)
+        self.result['judge_uid'] = os.getuid()
         self.result['trace'] = trace(self.recorder.samples(self.t0) if self.recorder is not None else [], self.flown)
         return self.result
 
@@ -460,7 +502,7 @@ TRACE_PERIOD_S = 0.09
 def trace(samples, flown, period=TRACE_PERIOD_S):
     """The flight for the teacher's plot (not for scoring): ``{"published": [[t, value]] at most one
     sample per ``period`` (non-finite values as None), "oracle": [[t, value]] (the oracle's value from t
-    on)}``, ROS times like the calls and the schedule."""
+    on)}``, wall-clock times like the calls and the schedule."""
     kept, last = [], None
     for t, v in samples:
         if last is None or t - last >= period:

@@ -505,8 +505,8 @@ def status(static, session, fixes=()):
 
     Not graded: the upload was refused or unreadable, or the grader could not run it. Needs a hand
     grade: the package has no node, does not build, its node does not start or dies (the traceback's
-    last line and file:line; Python 2 named), or a leg of a flight was not reached (nothing judged
-    there). Graded with fixes: the grader made a teacher's fix (each in for_the_teacher).
+    last line and file:line; Python 2 named), a run's measurement was refused (the node set the time,
+    its master went over its memory bound), or a leg of a flight was not reached (nothing judged there). Graded with fixes: the grader made a teacher's fix (each in for_the_teacher).
     """
     static, session = static or {}, session or {}
     build = session.get('build')
@@ -523,6 +523,9 @@ def status(static, session, fixes=()):
         last = [l for l in (build.get('tail') or '').splitlines() if l.strip()]
         return HAND_GRADE, _one_line('the package does not build%s' % (': %s' % last[-1] if last else ''))
     runs = session.get('runs', [])
+    refused = [r for r in runs if r.get('probe_refused')]
+    if refused:
+        return HAND_GRADE, _one_line('the %s run was not measured: %s' % (refused[0]['tag'], refused[0]['probe_refused']))
     tails = '\n'.join(r.get('launch', {}).get('tail', '') for r in runs)
     if not node_ran(session) or not stayed_up(session):
         if python2:
