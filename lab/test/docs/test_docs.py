@@ -344,3 +344,30 @@ def test_the_page_check_catches_a_questions_part_too_long():
                (1, 12, 'Appendices')]
     last, top = questions_and_appendices(outline)
     assert last == 11 and last > QUESTION_PAGES and top == ['Model report', 'Questions 1 to 14', 'Appendices']
+
+
+# --- docs/grading.md: its example grades are a grader's output, not typed ---------------------------
+
+def test_grading_examples_are_the_generators_output_with_every_item_of_the_rubric():
+    import grading_examples  # lab/report/grading_examples.py
+    from exam_lab.grader.score.sheets import ITEMS
+    text = read(grading_examples.GRADING)
+    for name, submission in grading_examples.EXAMPLES:
+        assert os.path.isdir(os.path.join(REPO, submission)), submission
+        found = re.search(r'%s\n```markdown\n(.*?)\n```\n%s' % (re.escape(grading_examples.BEGIN % name),
+                                                               re.escape(grading_examples.END % name)), text, re.S)
+        assert found, 'docs/grading.md: no generated example %r between its markers' % name
+        grade = found.group(1)
+        assert grade.startswith('# %s: ' % os.path.basename(submission)), grade[:80]
+        for item, (points, _) in ITEMS.items():
+            assert re.search(r'^\| %s \| .* \| [0-9.]+ / %g \|' % (item, points), grade, re.M), item
+
+
+def test_grading_examples_splice_replaces_only_the_block_between_its_markers():
+    import grading_examples
+    text = 'before\n%s\nold\n%s\nafter\n' % (grading_examples.BEGIN % 'x', grading_examples.END % 'x')
+    assert grading_examples.splice(text, 'x', '# x: 17 / 17\n') == (
+        'before\n%s\n```markdown\n# x: 17 / 17\n```\n%s\nafter\n' % (grading_examples.BEGIN % 'x',
+                                                                    grading_examples.END % 'x'))
+    with pytest.raises(ValueError):
+        grading_examples.splice(text, 'y', '')
