@@ -5,6 +5,7 @@ next to the table that prints them, so a reader can check each verdict against i
 """
 
 import os
+import re
 
 import stats
 
@@ -38,6 +39,16 @@ def _mib(mib):
 #: The memory goal: the exam node within this many MiB of the bare rospy node (lab/bench/floor_node.py)
 #: measured in the same run. An absolute goal would measure rospy's and numpy's imports, not the node.
 RSS_MARGIN_MIB = 1.0
+
+
+#: The first line of lab/bench/analysis.md: the date of the run its numbers come from.
+ANALYSIS_RUN = re.compile(r'^<!-- run: (\d{4}-\d\d-\d\d \d\d:\d\d)[^\n]*-->\n')
+
+
+def analysis_run(text):
+    """The date (``YYYY-MM-DD HH:MM``, as results.json's ``date``) of the run ``text`` was written from."""
+    found = ANALYSIS_RUN.match(text)
+    return found.group(1) if found else None
 
 
 def _verdict(met):
@@ -161,8 +172,14 @@ def render(r, figure_rel):
     out += _fleet(r, figure_rel)
     out += _errors(r)
     if r.get('analysis'):
-        out += ['## What bounds each result (hand-written: lab/bench/analysis.md)', '',
-                r['analysis'].strip(), '']
+        out += ['## What bounds each result (hand-written: lab/bench/analysis.md)', '']
+        written_from = analysis_run(r['analysis'])
+        if written_from != r['date']:
+            # A new run rewrites every table, but not the hand-written text: say which run it quotes.
+            out += ['**Written from the run of %s, not from this one (%s): its numbers are that run\'s '
+                    'until lab/bench/analysis.md is read again against the tables above.**'
+                    % (written_from or 'an unknown date', r['date']), '']
+        out += [ANALYSIS_RUN.sub('', r['analysis']).strip(), '']
     if r.get('profile'):
         out += _profile(r['profile'])
     # The grader's section, measured apart by lab/bench/grader_bench.py --record (it takes 20 minutes).

@@ -59,3 +59,13 @@ def test_the_fleet_table_has_the_master_cpu_and_skips_fleet_sizes_not_flown():
     assert 'fleet of 100' not in text  # this run flew no 100 pairs: no row of n/a
     r['ours']['fleet']['100'] = dict(r['ours']['fleet']['20'], master_cpu_percent=5.5)
     assert row(report.render(r, 'f.png'), 'fleet of 100: master CPU')[1] == '5.5'
+
+
+def test_the_hand_written_analysis_says_when_it_quotes_another_run():
+    r = results()
+    r['analysis'] = '<!-- run: %s (note) -->\nText.\n' % r['date']
+    text = report.render(r, 'f.png')
+    assert 'Text.' in text and 'Written from the run of' not in text and '<!-- run:' not in text
+    r['date'] = '2026-12-01 10:00'
+    assert 'Written from the run of %s, not from this one (2026-12-01 10:00)' % results()['date'] in \
+        report.render(r, 'f.png')
