@@ -246,7 +246,7 @@ def facts(work, repo, outputs):
     v['custom.delay'] = '%g' % param_value(outputs, 'custom.param_delay')
     v['custom.calls'] = str(len(custom['changes']))
     # The 1200 m example on the drone's clock: from its first log line (the flight's time 0), which
-    # comes after roslaunch's own start-up (a few seconds, varying); README and architecture.md use it.
+    # comes after roslaunch's own start-up (about 1.5 s, varying); README and architecture.md use it.
     first = console_lines(outputs['custom.launch']['output'], r'\]: /mydrone: profile')
     if not first:
         raise RuntimeError('custom.launch: no start line of the drone')
