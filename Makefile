@@ -8,11 +8,12 @@ ENV := source tools/env.sh
 # `make test TESTS=run_tests_exam` runs one catkin test target instead of all of them.
 TESTS ?= run_tests
 
-.PHONY: help deps build run run-submarine test report bench soak mutation grade clean
+.PHONY: help deps build run run-submarine run-simple test report bench soak mutation grade clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
 	@echo "make run-submarine  the same with the underwater drone"
+	@echo "make run-simple [SHEET=altitude|depth]  the simple answer of docs/report.md, built on its own"
 	@echo "make test           install, build, and run every unit and rostest test"
 	@echo "make report         regenerate docs/ (command outputs, figures, PDF) from a live run"
 	@echo "make bench          benchmarks of the exam node against the naive baseline"
@@ -35,6 +36,11 @@ run: build
 
 run-submarine: build
 	@tools/run_launch.sh exam_submarine.launch $(ARGS)
+
+# `make run-simple [SHEET=altitude|depth] [ARGS='threshold:=1200']`: the simple answer (docs/simple_answer/exam),
+# a second package named exam, in a workspace of its own (.ws/simple_answer).
+run-simple: deps
+	@docs/simple_answer/run.sh $(or $(SHEET),altitude) $(ARGS)
 
 test: build
 	@tools/run_tests.sh $(TESTS)
