@@ -40,12 +40,18 @@ EXPECTED = {
     'sleep_in_callback': {'Q14b': 2.0},                # sleep(5) in the callback: WARNING after a 3 s excursion
     'float64_depth': {},                               # /depth as std_msgs/Float64: the sheet names no type
     'python2_prints': {'runs': 1.0, 'Q10': 0.0, 'Q11': 0.0, 'Q13': 0.0, 'Q14a': 0.0, 'Q14b': 0.0},
+    'yaml_threshold': {},                              # limit in config/params.yaml loaded in the node's tag, the
+                                                       # drone by its launch file (issue 27: 15 when the derived
+                                                       # launch named the grader's path of the YAML)
+    'type_without_py': {'Q12': 0.5},                   # type="exam_node" for scripts/exam_node.py: run as fixed;
+                                                       # Q12 judges the file handed in (it starts no executable)
     'refused_upload': {item: 0.0 for item in FULL},    # an entry climbing out of the folder: not graded
 }
-SHEETS = {'wrong_topic': 'depth', 'one_subscriber': 'depth', 'float64_depth': 'depth'}
+SHEETS = {'wrong_topic': 'depth', 'one_subscriber': 'depth', 'float64_depth': 'depth', 'yaml_threshold': 'depth'}
 #: Each student's status (graded unless named): what the teacher must do with the grade.
 STATUS = {'no_kelvin': 'graded with fixes', 'windows_zip': 'graded with fixes', 'workspace_tgz': 'graded with fixes',
-          'renamed_package': 'graded with fixes', 'crash_at_start': 'needs a hand grade',
+          'renamed_package': 'graded with fixes', 'type_without_py': 'graded with fixes',
+          'crash_at_start': 'needs a hand grade',
           'python2_prints': 'needs a hand grade', 'refused_upload': 'not graded'}
 #: The folder in submissions/ each upload is made from, when not its own.
 MADE_FROM = {'windows_zip': 'good_student', 'workspace_tgz': 'hard_threshold', 'refused_upload': 'good_student'}

@@ -166,12 +166,16 @@ def prepare(submission, work, wanted_sheet, notes, fixes=None):
     pkg = os.path.join(workspace, 'src', name if re.match(r'^[A-Za-z][\w-]*$', name) else PACKAGE)
     unpack.copy_package(pkg_source, pkg, fixes)
     fixes.extend(source.fix_text(pkg))
-    analyses = [launch.analyse(path, pkg, name) for path in launch.launch_files(pkg)]
+    box_env = sandbox.box_env({'PATH': os.environ.get('PATH', '/usr/bin:/bin')})  # $(env) sees the box's, not ours
+    analyses = [launch.analyse(path, pkg, name, box_env) for path in launch.launch_files(pkg)]
     sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
     notes.insert(0, how)
     chosen = launch.choose(analyses, sheet)
     scripts = source.node_scripts(pkg)
-    launched = [n.type for n in chosen.exam_nodes] if chosen else [os.path.basename(p) for p in scripts[:1]]
+    types, type_fixes = source.node_type_fixes(pkg, chosen.exam_nodes if chosen else [])
+    fixes.extend(type_fixes)
+    launched = [types.get(n.type_origin, n.type) for n in chosen.exam_nodes] if chosen \
+        else [os.path.basename(p) for p in scripts[:1]]
     fixes.extend(source.make_runnable(pkg, launched))
     static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses], 'package': name,
               'package_dir': pkg, 'python2': source.python2_evidence(pkg),
@@ -196,7 +200,7 @@ def prepare(submission, work, wanted_sheet, notes, fixes=None):
             static['threshold'] = {'name': param.name, 'value': param.value,
                                    'where': param.origin.describe(pkg) if param.origin else '?'}
             notes.append('threshold parameter: %s, set in %s' % (why, static['threshold']['where']))
-        main_launch = launch.derive(chosen, 'main')
+        main_launch = launch.derive(chosen, 'main', types)
         namespace = chosen.drone_namespace(sheet)
     else:
         static['threshold_reason'] = 'no launch file starts an exam node, so no parameter'
@@ -217,7 +221,9 @@ def prepare(submission, work, wanted_sheet, notes, fixes=None):
     runs.append({'tag': 'main', 'launch': main_launch, 'plan': plan})
     if param is not None and param.origin is not None:
         lowered = threshold_value - 2 * margin
-        runs.append({'tag': 'threshold', 'launch': launch.derive(chosen, 'threshold', {param.origin: lowered}),
+        threshold_changes = dict(types)
+        threshold_changes[param.origin] = lowered
+        runs.append({'tag': 'threshold', 'launch': launch.derive(chosen, 'threshold', threshold_changes),
                      'plan': dict(plan, kind='threshold', threshold=lowered,
                                   targets={'start': lowered - margin, 'step': threshold_value - margin})})
     elif param is not None:
