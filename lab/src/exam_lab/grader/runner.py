@@ -339,8 +339,12 @@ def _how_run(box):
                 'and file size' % box.uid)
     if box.slot is not None:
         return 'ran WITHOUT its sandbox (the teacher\'s flag) as uid %d, with resource limits only' % box.uid
+    try:
+        user = pwd.getpwuid(os.geteuid()).pw_name
+    except KeyError:  # a uid without an account (a container's, a test's)
+        user = 'uid %d' % os.geteuid()
     return ('ran WITHOUT its sandbox (the teacher\'s flag) as the grading user %s: it could read and change '
-            'that user\'s files' % pwd.getpwuid(os.geteuid()).pw_name)
+            'that user\'s files' % user)
 
 
 def _box_binds(underlay):
