@@ -7,13 +7,16 @@ The user gets a folder of its own (0700): a HOME holding a secret file (0600), t
 the repository (a checkout may be private to root, and the check's setting is changed in the copy).
 Then, as that user:
 
-- the teacher's command grades the good student in the box without root: 17/17, and the grade says
-  each bound that differs from root's box;
+- the teacher's command grades a class of two side by side (``JOBS=2``) in boxes without root: the
+  saboteur of test_sandbox.py, whose boxes now share the teacher's uid with its classmate's, cannot
+  kill, read or write its classmate (PID namespaces and mounts alone keep them apart); the classmate,
+  the good student, gets 17/17, and its grade says each bound that differs from root's box;
 - ``make check`` prints the items and points, with the evidence when the setting says so, never the
   threshold run's hidden value nor its words; without the evidence when the setting says points;
 - inside a box without root, the teacher's HOME, processes, variables and network are out of reach.
 
-About 3 minutes on two cores (two graded runs of about 45 s, a build that fails at once, the builds).
+About 3 minutes on two cores (a class of two, one more graded run, a build that fails at once, the
+builds).
 """
 import json
 import os
@@ -34,6 +37,7 @@ from exam_lab.harness.wait import wait_until
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 GOOD = os.path.join('lab', 'test', 'grader', 'submissions', 'good_student', 'exam')
+SABOTEUR = os.path.join('lab', 'test', 'grader', 'hostile', 'saboteur', 'exam')
 FULL = {item: points for item, (points, _) in ITEMS.items()}
 #: Uids tried for the user, first unused one taken (the boxes of root's grader use 61000-61063).
 UIDS = range(65000, 65100)
@@ -57,8 +61,9 @@ class User(object):
         self.home, self.ws, self.repo = (os.path.join(root, name) for name in ('home', 'ws', 'repo'))
         self.secret = 'teacher-secret-%s' % secrets.token_hex(8)
         self.secret_file = os.path.join(self.home, 'secret.txt')
+        # EXAM_HOSTILE_CLASS marks the grader's processes for the saboteur, as in test_sandbox.py.
         self.env = {'PATH': '/usr/local/bin:/usr/bin:/bin', 'HOME': self.home, 'LANG': 'C.UTF-8',
-                    'EXAM_WS': self.ws, 'TEACHER_SECRET': self.secret}
+                    'EXAM_WS': self.ws, 'TEACHER_SECRET': self.secret, 'EXAM_HOSTILE_CLASS': '1'}
 
     def run(self, argv, timeout, cwd=None):
         """``argv`` as the user (in the copy of the repository); ``(exit code, output)``. Nothing of the
@@ -118,17 +123,33 @@ def user():
         shutil.rmtree(root, ignore_errors=True)
 
 
+def files_under(folder):
+    for dirpath, _, filenames in os.walk(folder):
+        for name in filenames:
+            path = os.path.join(dirpath, name)
+            if os.path.isfile(path) and not os.path.islink(path):
+                with open(path, 'rb') as f:
+                    yield path, f.read().decode('utf-8', 'replace')
+
+
 @pytest.fixture(scope='module')
 def graded(user):
-    """The teacher's command, as the user: the good student's grade.json and the threshold run's plan."""
-    out = os.path.join(user.root, 'out')
-    status, output = user.sourced(['python3', 'lab/scripts/grade.py', '--submission', GOOD, '--out', out], 900)
+    """The teacher's command, as the user: a class of the saboteur and the good student with JOBS=2;
+    each one's folder of results, the good student's record and its threshold run's plan."""
+    klass, out = os.path.join(user.root, 'class'), os.path.join(user.root, 'out')
+    for name, package in (('a_saboteur', SABOTEUR), ('b_victim', GOOD)):
+        shutil.copytree(os.path.join(user.repo, package), os.path.join(klass, name, 'exam'))
+    if os.geteuid() == 0:
+        _chown_tree(klass, user.uid)
+    status, output = user.sourced(['python3', 'lab/scripts/grade.py', '--class', klass, '--out', out, '--jobs', '2',
+                                   '--no-similarity'], 900)
     assert status == 0, output[-3000:]
-    with open(os.path.join(out, 'grade.json')) as f:
+    with open(os.path.join(out, 'b_victim', 'grade.json')) as f:
         record = json.load(f)
-    with open(os.path.join(out, 'logs', 'plan-threshold.json')) as f:
+    with open(os.path.join(out, 'b_victim', 'logs', 'plan-threshold.json')) as f:
         plan = json.load(f)
-    return {'record': record, 'hidden': '%g' % plan['threshold'], 'output': output}
+    return {'record': record, 'hidden': '%g' % plan['threshold'], 'output': output,
+            'victim': os.path.join(out, 'b_victim'), 'saboteur': os.path.join(out, 'a_saboteur')}
 
 
 def test_graded_without_root_full_points_and_the_bounds_that_differ(graded, user):
@@ -144,6 +165,18 @@ def test_graded_without_root_full_points_and_the_bounds_that_differ(graded, user
     assert 'ran in a network namespace with only loopback' in hints
     assert [h for h in hints if h.startswith('without root, no cgroup')], hints
     assert user.secret not in json.dumps(record)
+
+
+def test_boxes_without_root_keep_classmates_apart(graded, user):
+    """Both boxes run as the teacher's uid: only their PID namespaces and mounts keep the saboteur
+    from killing its classmate's processes, reading its code and writing into its logs."""
+    with open(os.path.join(user.repo, GOOD, 'scripts', 'exam_node.py')) as f:
+        victim_line = f.read().splitlines()[2]
+    with open(os.path.join(graded['saboteur'], 'grade.json')) as f:
+        assert json.load(f)['items'][0]['points'] == 2.0, 'the saboteur built and its node ran: its payload too'
+    saboteur = dict(files_under(graded['saboteur']))
+    assert not [p for p, text in saboteur.items() if victim_line in text or 'KILLED' in text]
+    assert not [p for p, text in files_under(graded['victim']) if 'HACKED' in text]
 
 
 def test_make_check_shows_the_evidence_never_the_threshold_run(graded, user):
