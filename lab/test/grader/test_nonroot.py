@@ -33,6 +33,7 @@ from exam_lab.grader.host import sandbox
 from exam_lab.grader.publish import student_view
 from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
+from test_sandbox import files_under  # this folder's: the files of a student's results, as text
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
@@ -121,15 +122,6 @@ def user():
                 except OSError:
                     pass
         shutil.rmtree(root, ignore_errors=True)
-
-
-def files_under(folder):
-    for dirpath, _, filenames in os.walk(folder):
-        for name in filenames:
-            path = os.path.join(dirpath, name)
-            if os.path.isfile(path) and not os.path.islink(path):
-                with open(path, 'rb') as f:
-                    yield path, f.read().decode('utf-8', 'replace')
 
 
 @pytest.fixture(scope='module')
