@@ -15,8 +15,8 @@ Then, as that user:
   threshold run's hidden value nor its words; without the evidence when the setting says points;
 - inside a box without root, the teacher's HOME, processes, variables and network are out of reach.
 
-About 3 minutes on two cores (a class of two, one more graded run, a build that fails at once, the
-builds).
+About 2.5 minutes on two cores (151 s measured: a class of two side by side, one more graded run, a
+build that fails at once, the workspace and the simulators built).
 """
 import json
 import os
