@@ -8,7 +8,7 @@ ENV := source tools/env.sh
 # `make test TESTS=run_tests_exam` runs one catkin test target instead of all of them.
 TESTS ?= run_tests
 
-.PHONY: help deps build run run-submarine run-simple test report bench soak mutation grade clean
+.PHONY: help deps build run run-submarine run-simple test report bench soak mutation grade check clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
@@ -22,6 +22,8 @@ help:
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
 	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv> [WORKSHEET_SCALE=1]] [ENGINE=local|slurm] [SLURM_ARGS='...']"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
+	@echo "make check PACKAGE=<dir|zip> [SHEET=altitude|depth]"
+	@echo "                    a student's own check of their package, as an ordinary user (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
 
 deps:
@@ -66,6 +68,13 @@ grade: build
 	  $(if $(SHEET),--sheet "$(SHEET)") $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)") \
 	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") $(if $(WORKSHEET_SCALE),--worksheet-scale) \
 	  $(if $(ENGINE),--engine "$(ENGINE)") $(if $(SLURM_ARGS),--slurm-args "$(SLURM_ARGS)")
+
+# make check PACKAGE=<dir or zip> [SHEET=altitude|depth]: a student's own check, without root or sudo.
+# It builds the workspace but installs nothing: a student's machine has ROS already, not the teacher's tools.
+check:
+	@$(if $(PACKAGE),,$(error make check needs PACKAGE=<your exam package: its folder or its zip>))
+	@tools/build_ws.sh
+	@$(ENV) && exec python3 lab/scripts/check.py --package "$(PACKAGE)" $(if $(SHEET),--sheet "$(SHEET)")
 
 clean:
 	rm -rf .ws

@@ -3,8 +3,9 @@
 The runner itself never runs a student's code: it unpacks and reads (:mod:`~exam_lab.grader.boxed.unpack`,
 :mod:`~exam_lab.grader.boxed.launch`, :mod:`~exam_lab.grader.boxed.source`) a copy of the package that no
 student code can write, writes the derived launch files and the job, opens the submission's
-:class:`~exam_lab.grader.host.sandbox.Box`, and starts :mod:`exam_lab.grader.judge.session` as root inside
-``unshare --net`` (only loopback), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an
+:class:`~exam_lab.grader.host.sandbox.Box`, and starts :mod:`exam_lab.grader.judge.session` in a network
+namespace with only loopback (:func:`~exam_lab.grader.host.sandbox.network_namespace`: ``unshare --net``
+as root, a user namespace of its own too otherwise), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an
 overall time limit. Then :mod:`~exam_lab.grader.score.rubric` scores and :mod:`~exam_lab.grader.publish.report`
 writes; what reaches the results from the session's folder is copied as data (regular files only,
 each capped: :func:`~exam_lab.grader.host.sandbox.copy_results`).
@@ -57,7 +58,8 @@ _underlay_lock = threading.Lock()
 
 
 def can_isolate():
-    """True when this process may run a session in a network namespace of its own (root, unshare)."""
+    """True when this process may run a session in a network namespace of its own (as root with
+    unshare, otherwise with bubblewrap where ordinary users may make user namespaces)."""
     with _isolation_lock:
         return _can_isolate()
 
@@ -65,8 +67,8 @@ def can_isolate():
 def _can_isolate():
     if 'ok' not in _isolation:
         try:
-            _isolation['ok'] = os.geteuid() == 0 and shutil.which('unshare') is not None and \
-                subprocess.run(['unshare', '--net', 'true'], timeout=10).returncode == 0
+            _isolation['ok'] = subprocess.run(sandbox.network_namespace(['true']), stdout=subprocess.DEVNULL,
+                                              stderr=subprocess.DEVNULL, timeout=10).returncode == 0
         except (OSError, subprocess.SubprocessError):
             _isolation['ok'] = False
     return _isolation['ok']
@@ -78,9 +80,10 @@ def sandbox_refusal(unsandboxed=False):
     why = sandbox.check()
     if why is None or unsandboxed:
         return None
-    return ('refusing to run student code without its sandbox: %s. Run the grader as root on a machine '
-            'with bubblewrap and unprivileged user namespaces (docs/grading.md, "Isolation"), or pass '
-            '--unsandboxed-student-code-can-read-and-damage-my-files to accept that risk' % why)
+    return ('refusing to run student code without its sandbox: %s. Run the grader on a machine with '
+            'bubblewrap and unprivileged user namespaces, as root or as yourself (docs/grading.md, '
+            '"Isolation" and "Without root"), or pass --unsandboxed-student-code-can-read-and-damage-my-files '
+            'to accept that risk' % why)
 
 
 def _package_path(name):
@@ -245,7 +248,8 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
     """Run the session of one submission, its student steps in ``box``; return what it measured (or
     why it could not).
 
-    :param isolate: in a network namespace of its own with only loopback (needs root).
+    :param isolate: in a network namespace of its own with only loopback
+        (:func:`~exam_lab.grader.host.sandbox.network_namespace`).
     :param on_step: called with each step's name as the session starts it (:mod:`~exam_lab.grader.publish.progress`).
     """
     log_dir = os.path.join(work, 'logs')
@@ -262,7 +266,7 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
         json.dump(job, f, indent=1, sort_keys=True)
     argv = [sys.executable, '-m', 'exam_lab.grader.judge.session', job_path]
     if isolate:
-        argv = ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + argv
+        argv = sandbox.network_namespace(argv)
     with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
         status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT, env=dict(os.environ, HOME=judge_home))
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
@@ -319,7 +323,8 @@ def hints(static, session, notes, pkg, isolate, how_run=None):
         out.append('launch file graded: %s (of %s)' % (static['launch']['file'], ', '.join(static['launch_files'])))
     if (session or {}).get('build') is not None:  # something of the student's ran
         out.append('ran in a network namespace with only loopback' if isolate else
-                   'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
+                   'ran WITHOUT network isolation (no network namespace could be made): the student code could '
+                   'reach the network')
         out.append(how_run or 'not run')
     if (session or {}).get('survivors'):
         out.append('%d processes of the student were still alive after its steps ended: killed'
@@ -329,14 +334,26 @@ def hints(static, session, notes, pkg, isolate, how_run=None):
 
 
 def _how_run(box):
+    if box.rootless:
+        return ('ran in a bubblewrap sandbox WITHOUT ROOT, as the grading user (uid %d): its own user, PID, '
+                'mount, IPC and UTS namespaces, a clean environment, only its workspace writable, none of '
+                'that user\'s files visible; limited per process in memory, CPU time and file size. Unlike '
+                'a box made by root: no uid of its own (boxes told apart by their PID namespaces and mounts), '
+                '%s, no size limit on its work folder (docs/grading.md, "Without root")'
+                % (box.uid, 'a cgroup delegated to the user' if box.cgroups else
+                   'no memory or process cgroup (processes counted in the session\'s user namespace)'))
     if box.bwrap:
         return ('ran in a bubblewrap sandbox as uid %d: its own user, PID, mount, IPC and UTS namespaces, '
                 'a clean environment, only its workspace writable; limited in memory, processes, CPU time '
                 'and file size' % box.uid)
     if box.slot is not None:
         return 'ran WITHOUT its sandbox (the teacher\'s flag) as uid %d, with resource limits only' % box.uid
+    try:
+        user = pwd.getpwuid(os.geteuid()).pw_name
+    except KeyError:  # a uid without an account (a container's, a test's)
+        user = 'uid %d' % os.geteuid()
     return ('ran WITHOUT its sandbox (the teacher\'s flag) as the grading user %s: it could read and change '
-            'that user\'s files' % pwd.getpwuid(os.geteuid()).pw_name)
+            'that user\'s files' % user)
 
 
 def _box_binds(underlay):
