@@ -18,7 +18,7 @@ import sys
 
 from exam_lab.grader import runner
 
-from exam_lab.grader.boxed import documents, unpack
+from exam_lab.grader.boxed import unpack
 
 from exam_lab.grader.publish import desk, progress, report
 from exam_lab.grader.score.sheets import SHEETS
@@ -47,7 +47,6 @@ def main(argv=None):
     try:
         if args.submission:
             record = runner.grade_submission(args.submission, out, args.sheet, on_step=progress.StepProgress(),
-                                             extra=documents.submission_facts(args.submission),
                                              unsandboxed=args.unsandboxed)
             print(report.table([record]))
             if record.get('status_reason'):
