@@ -58,7 +58,7 @@ SIMULATORS = ('drone_sim', 'mydrone', 'submarinedrone')
 #: inspection (measured: 0.3 s for a package); a class archive's intake; the class's similarity check.
 INSPECT_BOUNDS = (60.0, 60, 1 << 30)
 INTAKE_BOUNDS = (300.0, 300, 1 << 30)
-SIMILARITY_BOUNDS = (900.0, 900, 3 << 30)
+SIMILARITY_BOUNDS = (900.0, 300, 3 << 30)
 
 #: Log lines worth the teacher's eye: warnings, errors, tracebacks.
 _ODD = re.compile(r'\[(WARN|ERROR|FATAL)\]|Traceback|Error\b|Exception\b')
@@ -187,6 +187,8 @@ class Boxed(object):
         :raises InspectionFailed: with the reason and the end of its log.
         """
         timeout, cpu, memory = bounds
+        # Only lowered: a box's process cannot raise its hard limits (sandbox.Box.argv's prlimit).
+        cpu, memory = min(cpu, sandbox.CPU_SECONDS), min(memory, sandbox.ADDRESS_SPACE_BYTES)
         command = ['prlimit', '--as=%d' % memory, '--cpu=%d' % cpu, '--', python, '-m', module] + list(args)
         env = {'PATH': '/usr/bin:/bin', 'PYTHONPATH': self.source, 'PYTHONDONTWRITEBYTECODE': '1'}
         log = os.path.join(self.work, '%s.log' % module.rsplit('.', 1)[-1])
@@ -491,7 +493,8 @@ def class_similarity(klass, out, records_):
         similarity.boilerplate(os.path.join(work, 'upload', 'boilerplate'))
         venv = os.path.dirname(os.path.dirname(python))
         with sandbox.Box(work, [venv], bwrap=sandbox.check() is None) as box:
-            boxed = Boxed(box, work)
+            # copydetect imports matplotlib, which wants Debian's /etc/matplotlibrc
+            boxed = Boxed(box, work, [(path, None, False) for path in ('/etc/matplotlibrc',) if os.path.isfile(path)])
             job = {'submissions': [[name, boxed.path(path)] for (name, _), path in zip(submissions, staged)],
                    'boilerplate': boxed.path(os.path.join(work, 'upload', 'boilerplate')), 'python': python,
                    'out': boxed.path(boxed.out)}
