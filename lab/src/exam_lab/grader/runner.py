@@ -199,8 +199,12 @@ class Boxed(object):
                 return egress.read_record(os.path.join(self.out, record.FILE), record, record.MAX_BYTES)
             except records.RecordError as err:
                 why = 'its record was refused: %s' % err
+        elif why is None:  # bwrap reports its child's death by signal N as exit 128 + N
+            signum = -status if status < 0 else status - 128 if status > 128 else None
+            why = 'it failed (exit %d)' % status if signum is None else \
+                'it was killed by signal %d (its bounds: %d s of CPU, %d MB of address space)' % (signum, cpu, memory >> 20)
         tail = session_tail(sandbox.read_capped(log, 4096) or '')
-        raise InspectionFailed('%s%s' % (why or 'it failed (exit %s)' % status, ': %s' % tail if tail else ''))
+        raise InspectionFailed('%s%s' % (why, ': %s' % tail if tail else ''))
 
 
 def inspect(box, work, upload, wanted_sheet):
@@ -405,7 +409,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                 else:
                     how_run = _how_run(box)
                     session = run_session(job, work, underlay, isolate, box, on_step)
-        except unpack.UnpackError as err:
+        except (unpack.UnpackError, sandbox.UploadRefused) as err:
             session = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % err}
         except InspectionFailed as err:
             session = {'build': None, 'runs': [], 'error': 'the inspection of the upload failed: %s' % err}

@@ -73,6 +73,10 @@ class SandboxUnavailable(RuntimeError):
     """The machine cannot make a box: the grader refuses to run student code (unless told to)."""
 
 
+class UploadRefused(ValueError):
+    """An upload too large or too deep to stage for its box (:func:`stage_upload`): that student's row."""
+
+
 def box_env(env, home=BOX_HOME):
     """Only what ROS and the build need from ``env`` (ROS_*, the workspace's paths, PATH, locale), with
     a fresh HOME and a user name of the box: nothing else of the grading user reaches student code."""
@@ -442,15 +446,15 @@ def stage_upload(source, target, max_bytes=UPLOAD_BYTES, max_files=UPLOAD_FILES)
     without reading anything of it: regular files (opened with O_NOFOLLOW), folders and links (as
     links, never followed); FIFOs, devices and sockets are left out. Everything is root's and
     world-readable, nothing writable by a box. An upload over ``max_bytes``, ``max_files`` or
-    :data:`UPLOAD_DEPTH` folders deep raises ``ValueError`` (the student's row says so)."""
+    :data:`UPLOAD_DEPTH` folders deep raises :class:`UploadRefused`."""
     budget = {'bytes': max_bytes, 'files': max_files}
 
     def take(size):
         budget['files'] -= 1
         budget['bytes'] -= size
         if budget['files'] < 0 or budget['bytes'] < 0:
-            raise ValueError('the upload is larger than the grader takes (%d MB, %d files)'
-                             % (max_bytes >> 20, max_files))
+            raise UploadRefused('the upload is larger than the grader takes (%d MB, %d files)'
+                                % (max_bytes >> 20, max_files))
 
     def copy_file(src, dest):
         fd = os.open(src, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
@@ -467,7 +471,7 @@ def stage_upload(source, target, max_bytes=UPLOAD_BYTES, max_files=UPLOAD_FILES)
 
     def copy(src, dest, depth=0):
         if depth > UPLOAD_DEPTH:
-            raise ValueError('the upload has folders more than %d deep' % UPLOAD_DEPTH)
+            raise UploadRefused('the upload has folders more than %d deep' % UPLOAD_DEPTH)
         info = os.lstat(src)
         if stat.S_ISLNK(info.st_mode):
             take(0)
