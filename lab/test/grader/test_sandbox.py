@@ -235,13 +235,16 @@ def test_an_upload_is_staged_as_bytes_never_followed(tmp_path):
     upload, staged = tmp_path / 'upload', tmp_path / 'staged'
     (upload / 'exam' / 'launch').mkdir(parents=True)
     (upload / 'exam' / 'launch' / 'exam.launch').write_text('<launch/>')
+    (upload / 'exam' / 'node.py').write_text('#!/usr/bin/env python3\n')
+    (upload / 'exam' / 'node.py').chmod(0o700)
     secret = tmp_path / 'secret.txt'
     secret.write_text('root-only')
     secret.chmod(0o600)
     os.symlink(str(secret), str(upload / 'exam' / 'leak.txt'))
     os.mkfifo(str(upload / 'exam' / 'fifo'))
     sandbox.stage_upload(str(upload), str(staged))
-    assert sorted(os.listdir(str(staged / 'exam'))) == ['launch', 'leak.txt']
+    assert sorted(os.listdir(str(staged / 'exam'))) == ['launch', 'leak.txt', 'node.py']
+    assert oct(os.stat(str(staged / 'exam' / 'node.py')).st_mode & 0o777) == '0o755', 'a script stays executable'
     assert os.readlink(str(staged / 'exam' / 'leak.txt')) == str(secret)
     assert (staged / 'exam' / 'launch' / 'exam.launch').read_text() == '<launch/>'
     assert oct(os.stat(str(staged / 'exam' / 'launch' / 'exam.launch')).st_mode & 0o777) == '0o644'

@@ -389,7 +389,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             progress.report(on_step, 'unpack')
             upload = os.path.join(work, 'upload', folder if folder not in ('', '.', '..') else 'upload')
             os.mkdir(os.path.dirname(upload), 0o755)
-            sandbox.stage_upload(submission, upload)
+            sandbox.stage_upload(os.path.realpath(submission), upload)  # the teacher's path: followed
             for sub in ('ws', 'ws/src'):
                 os.mkdir(os.path.join(work, sub), 0o755)
             with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None) as box:

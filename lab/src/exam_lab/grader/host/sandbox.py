@@ -443,7 +443,8 @@ UPLOAD_DEPTH = 32
 
 def stage_upload(source, target, max_bytes=UPLOAD_BYTES, max_files=UPLOAD_FILES):
     """Copy the upload ``source`` (a file or a folder) to ``target`` for a box to read, byte for byte and
-    without reading anything of it: regular files (opened with O_NOFOLLOW), folders and links (as
+    without reading anything of it: regular files (opened with O_NOFOLLOW; executable ones stay so:
+    whether a script was, is a fact of the grade), folders and links (as
     links, never followed); FIFOs, devices and sockets are left out. Everything is root's and
     world-readable, nothing writable by a box. An upload over ``max_bytes``, ``max_files`` or
     :data:`UPLOAD_DEPTH` folders deep raises :class:`UploadRefused`."""
@@ -464,7 +465,7 @@ def stage_upload(source, target, max_bytes=UPLOAD_BYTES, max_files=UPLOAD_FILES)
                 return
             take(info.st_size)
             with os.fdopen(os.dup(fd), 'rb') as f, open(dest, 'xb') as g:
-                os.chmod(dest, 0o644)
+                os.chmod(dest, 0o755 if info.st_mode & 0o111 else 0o644)  # a script keeps its x bit
                 shutil.copyfileobj(f, g)
         finally:
             os.close(fd)
