@@ -229,6 +229,33 @@ def test_reading_student_bytes_is_bounded(tmp_path):
             shutil.rmtree(work, ignore_errors=True)
 
 
+def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
+    """A class zip is opened by a box's uid (boxed/intake), never root: its students come back as names
+    and folders inside the intake's own folder; an archive that climbs out is refused as a whole."""
+    if os.geteuid() != 0 or sandbox.check() is not None:
+        pytest.skip('boxes need root and bubblewrap: %s' % sandbox.check())
+    import zipfile
+    from exam_lab.grader.boxed import unpack
+    archive = str(tmp_path / 'class.zip')
+    with zipfile.ZipFile(archive, 'w') as zf:
+        for folder in ('Jane Doe_12_assignsubmission_file_', 'Bob_13_assignsubmission_file_'):
+            zf.writestr('%s/exam/package.xml' % folder, '<package><name>exam</name></package>')
+    work_dirs = []
+    try:
+        students = runner.class_students(archive, work_dirs)
+        assert [name for name, _ in students] == ['Bob', 'Jane Doe']
+        for _, folder in students:
+            assert folder.startswith(work_dirs[0] + '/') and os.stat(folder).st_uid >= sandbox.BOX_UID_BASE
+            assert os.path.isfile(os.path.join(folder, 'exam', 'package.xml'))
+        with zipfile.ZipFile(archive, 'a') as zf:
+            zf.writestr('../outside.txt', 'x')
+        with pytest.raises(unpack.UnpackError, match='unpacking it in its box failed'):
+            runner.class_students(archive, work_dirs)
+    finally:
+        for work in work_dirs:
+            shutil.rmtree(work, ignore_errors=True)
+
+
 def test_an_upload_is_staged_as_bytes_never_followed(tmp_path):
     """What root does with an upload before its box reads it: a copy of its regular files, folders and
     links (as links: never followed, even to a root-only file), no FIFO, within a size budget."""

@@ -21,6 +21,12 @@ runs through :meth:`Box.argv`::
   underlay and their sources; the student's package read-only; only the box's own work folder
   (``build/``, ``devel/``) writable. Fresh ``/proc``, ``/dev``, and private ``/tmp``, ``/var/tmp``,
   ``/dev/shm`` and HOME (size-capped tmpfs). No /root, /home, other students, grader output.
+- **Reading the upload** (:meth:`Box.run` with ``mounts`` and ``network=False``): the grader's own
+  readers of student bytes (``boxed/inspect``, ``boxed/intake``, the similarity check) run in the
+  same box, as its uid, in a network namespace without even loopback, seeing only the upload that
+  root staged byte for byte (:func:`stage_upload`, read-only), the folder they write (the workspace,
+  their output) and the grader's source (read-only). Root reads back one record
+  (:mod:`~exam_lab.grader.host.egress`).
 - **Environment**: empty (``--clearenv``) but for the variables :func:`box_env` lets through.
 - **Limits**: memory and processes by a cgroup of the box's own where the machine lets root make one
   (cgroup v1 ``memory`` + ``pids``, or v2), always ``prlimit`` (address space, processes, CPU time,
