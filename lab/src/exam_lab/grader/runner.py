@@ -55,7 +55,7 @@ SESSION_TIMEOUT = 420.0 + 2 * LATE_WARNING_S
 #: The simulator packages of the underlay.
 SIMULATORS = ('drone_sim', 'mydrone', 'submarinedrone')
 #: Bounds of the boxes that read student bytes: (wall clock s, CPU s, address space bytes). One upload's
-#: inspection (measured: 0.3 s for a package); a class archive's intake; the class's similarity check.
+#: inspection (measured: 0.2 s a package, box included); a class archive's intake; the class's similarity check.
 INSPECT_BOUNDS = (60.0, 60, 1 << 30)
 INTAKE_BOUNDS = (300.0, 300, 1 << 30)
 SIMILARITY_BOUNDS = (900.0, 300, 3 << 30)
