@@ -21,6 +21,12 @@ runs through :meth:`Box.argv`::
   underlay and their sources; the student's package read-only; only the box's own work folder
   (``build/``, ``devel/``) writable. Fresh ``/proc``, ``/dev``, and private ``/tmp``, ``/var/tmp``,
   ``/dev/shm`` and HOME (size-capped tmpfs). No /root, /home, other students, grader output.
+- **Reading the upload** (:meth:`Box.run` with ``mounts`` and ``network=False``): the grader's own
+  readers of student bytes (``boxed/inspect``, ``boxed/intake``, the similarity check) run in the
+  same box, as its uid, in a network namespace without even loopback, seeing only the upload that
+  root staged byte for byte (:func:`stage_upload`, read-only), the folder they write (the workspace,
+  their output) and the grader's source (read-only). Root reads back one record
+  (:mod:`~exam_lab.grader.host.egress`).
 - **Environment**: empty (``--clearenv``) but for the variables :func:`box_env` lets through.
 - **Limits**: memory, processes and CPU by a cgroup of the box's own where the machine lets root make
   one (cgroup v1 ``memory`` + ``pids`` + ``cpu``, or v2), always ``prlimit`` (address space, processes,
@@ -103,6 +109,10 @@ _checked = {}
 
 class SandboxUnavailable(RuntimeError):
     """The machine cannot make a box: the grader refuses to run student code (unless told to)."""
+
+
+class UploadRefused(ValueError):
+    """An upload too large or too deep to stage for its box (:func:`stage_upload`): that student's row."""
 
 
 def box_env(env, home=BOX_HOME):
@@ -451,9 +461,14 @@ class Box(object):
         self.close()
         return False
 
-    def argv(self, command, env, cwd=None):
+    def argv(self, command, env, cwd=None, mounts=None, network=True):
         """The command line that runs ``command`` in the box with ``env`` (filtered by :func:`box_env`)
-        and ``cwd`` (a path as the box sees it; default its workspace)."""
+        and ``cwd`` (a path as the box sees it; default its workspace).
+
+        :param mounts: ``[(host path, path in the box, writable)]`` instead of the workspace (the
+            inspection's upload, workspace and output); unsandboxed, commands get host paths instead.
+        :param network: False: a network namespace of the box's own, without even loopback.
+        """
         env = box_env(env, self.home)
         cwd = cwd or self.workspace
         limits = ['prlimit', '--as=%d' % ADDRESS_SPACE_BYTES, '--nproc=%d' % PROCESSES,
@@ -488,9 +503,14 @@ class Box(object):
             box += ['--size', str(TMP_BYTES), '--tmpfs', path]
         for path in self.binds:  # after the private /tmp: an underlay may live in the host's /tmp
             box += ['--ro-bind', path, path]
-        box += ['--bind', os.path.join(self.folder, 'ws'), BOX_WS,
-                '--ro-bind', os.path.join(self.work, 'ws', 'src'), BOX_WS + '/src',
-                '--remount-ro', '/', '--chdir', cwd]
+        if mounts is None:
+            mounts = [(os.path.join(self.folder, 'ws'), BOX_WS, True),
+                      (os.path.join(self.work, 'ws', 'src'), BOX_WS + '/src', False)]
+        for host, inside, writable in mounts:
+            box += ['--bind' if writable else '--ro-bind', host, inside]
+        if not network and '--unshare-net' not in box:
+            box.append('--unshare-net')
+        box += ['--remount-ro', '/', '--chdir', cwd]
         for name, value in sorted(env.items()):
             box += ['--setenv', name, value]
         return join + limits + user + box + ['--'] + list(command)
@@ -502,6 +522,28 @@ class Box(object):
         if self.slot is None:
             return list(command)
         return _join(self.judge_cgroups.get(part, [])) + _as_user(self.judge_uid) + list(command)
+
+    def run(self, command, env, log, timeout, cwd=None, mounts=None, network=True):
+        """Run ``command`` in the box (:meth:`argv`) and wait at most ``timeout`` s of wall clock, its
+        output (stdout and stderr) in the file ``log`` (root's, outside the box); then end whatever of
+        the box's uid is left. Returns ``(exit status, None)``, or ``(None, why)`` when it was killed
+        at the deadline."""
+        argv = self.argv(command, env, cwd, mounts, network)
+        with open(log, 'wb') as out:
+            child = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
+                                     start_new_session=True)
+            try:
+                status, why = child.wait(timeout=timeout), None
+            except subprocess.TimeoutExpired:
+                status, why = None, 'did not finish within %.0f s' % timeout
+            finally:
+                try:
+                    os.killpg(child.pid, signal.SIGKILL)  # the unsandboxed mode's children, in its session
+                except OSError:
+                    pass
+                child.wait()
+        self.end()
+        return status, why
 
     def leftovers(self):
         """Pids of the box's uid still alive (there should be none once its command ended). A rootless
@@ -579,6 +621,60 @@ def _try_a_box():
         return 'a box could not be made: %s' % err
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+#: Most bytes and entries of one upload staged for a box (unpack's own budget applies inside).
+UPLOAD_BYTES = 256 << 20
+UPLOAD_FILES = 20000
+UPLOAD_DEPTH = 32
+
+
+def stage_upload(source, target, max_bytes=UPLOAD_BYTES, max_files=UPLOAD_FILES):
+    """Copy the upload ``source`` (a file or a folder) to ``target`` for a box to read, byte for byte and
+    without reading anything of it: regular files (opened with O_NOFOLLOW; executable ones stay so:
+    whether a script was, is a fact of the grade), folders and links (as
+    links, never followed); FIFOs, devices and sockets are left out. Everything is root's and
+    world-readable, nothing writable by a box. An upload over ``max_bytes``, ``max_files`` or
+    :data:`UPLOAD_DEPTH` folders deep raises :class:`UploadRefused`."""
+    budget = {'bytes': max_bytes, 'files': max_files}
+
+    def take(size):
+        budget['files'] -= 1
+        budget['bytes'] -= size
+        if budget['files'] < 0 or budget['bytes'] < 0:
+            raise UploadRefused('the upload is larger than the grader takes (%d MB, %d files)'
+                                % (max_bytes >> 20, max_files))
+
+    def copy_file(src, dest):
+        fd = os.open(src, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+        try:
+            info = os.fstat(fd)
+            if not stat.S_ISREG(info.st_mode):
+                return
+            take(info.st_size)
+            with os.fdopen(os.dup(fd), 'rb') as f, open(dest, 'xb') as g:
+                os.chmod(dest, 0o755 if info.st_mode & 0o111 else 0o644)  # a script keeps its x bit
+                shutil.copyfileobj(f, g)
+        finally:
+            os.close(fd)
+
+    def copy(src, dest, depth=0):
+        if depth > UPLOAD_DEPTH:
+            raise UploadRefused('the upload has folders more than %d deep' % UPLOAD_DEPTH)
+        info = os.lstat(src)
+        if stat.S_ISLNK(info.st_mode):
+            take(0)
+            os.symlink(os.readlink(src), dest)
+        elif stat.S_ISDIR(info.st_mode):
+            take(0)
+            os.mkdir(dest, 0o755)
+            os.chmod(dest, 0o755)
+            for name in sorted(os.listdir(src)):
+                copy(os.path.join(src, name), os.path.join(dest, name), depth + 1)
+        elif stat.S_ISREG(info.st_mode):
+            copy_file(src, dest)
+
+    copy(source.rstrip('/') or '/', target)
 
 
 #: What of a log reaches the results: its first and last LOG_PART bytes.
