@@ -9,7 +9,7 @@ overall time limit. Then :mod:`~exam_lab.grader.score.rubric` scores and :mod:`~
 writes; what reaches the results from the session's folder is copied as data (regular files only,
 each capped: :func:`~exam_lab.grader.host.sandbox.copy_results`).
 
-The simulators (``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
+The simulators (``node_kit``, ``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
 workspace (cached under ``$EXAM_WS/grader/underlay``, rebuilt when their sources change); each student's
 package is built alone in an overlay of its own on top of it, so a student's ``exam`` never meets ours.
 """
@@ -46,7 +46,7 @@ START_TIMEOUT = 20.0
 RUN_TIMEOUT = 90.0 + LATE_WARNING_S
 SESSION_TIMEOUT = 420.0 + 2 * LATE_WARNING_S
 #: The simulator packages of the underlay.
-SIMULATORS = ('drone_sim', 'mydrone', 'submarinedrone')
+SIMULATORS = ('node_kit', 'drone_sim', 'mydrone', 'submarinedrone')
 
 #: Log lines worth the teacher's eye: warnings, errors, tracebacks.
 _ODD = re.compile(r'\[(WARN|ERROR|FATAL)\]|Traceback|Error\b|Exception\b')
