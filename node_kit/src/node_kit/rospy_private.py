@@ -1,16 +1,16 @@
 """Every use of rospy's private names in this project: one function each, and why no public API does it.
 
-Read from python3-rospy 1.15.15 of Debian 12 (``/usr/lib/python3/dist-packages/rospy``), the same code
-as ROS Noetic's 1.16: ROS 1's last release is frozen, so these will not move under us. Still, each
-function is held to the installed rospy by a test of its own (``node_kit/test/unit/test_rospy_private.py``),
-which fails if the name or the behaviour relied upon changes. Nothing else in the repository touches
+Read from python3-rospy 1.15.15 of Debian 12 (``/usr/lib/python3/dist-packages/rospy``). ROS 1's last
+release is frozen, so these will not move under us; still, each function is held to the installed
+rospy by a test of its own (``node_kit/test/unit/test_rospy_private.py``), which fails if the name or
+the behaviour relied upon changes. Nothing else in the repository touches
 ``rospy.impl``, ``rospy.core`` or a private name of rospy (``lab/test/unit/test_layers.py`` checks it).
 
 Used by :mod:`node_kit.lifecycle` (a node's stop) and :mod:`node_kit.master_link` (a master restart).
 """
 import rospy
-# rospy 1.15.15: the registry of the services this process serves, and the client end of a TCPROS
-# connection (rospy/impl/registration.py, rospy/impl/tcpros_base.py).
+# rospy 1.15.15: the parameter cache, the registry of the services this process serves, and the client
+# end of a TCPROS connection (rospy/impl/paramserver.py, registration.py, tcpros_base.py).
 from rospy.impl import paramserver, registration
 from rospy.impl.tcpros_base import TCPROSTransport
 
