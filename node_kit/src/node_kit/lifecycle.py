@@ -66,6 +66,10 @@ _lock = threading.RLock()
 _timers = []
 _stops = []
 _installed = []
+# Not _lock: making the Updater registers its publisher with the master, which rospy retries until
+# is_shutdown() while the master is down, and _stop takes _lock before it raises that flag (a node
+# built as its master died hung until roslaunch's SIGKILL: 3 of 9 runs of test_stops.py).
+_updater_lock = threading.Lock()
 _updaters = []
 
 
@@ -129,7 +133,7 @@ def stopping():
 def updater():
     """The node's one ``diagnostic_updater.Updater`` (made at the first call, after ``init_node``):
     add the node's statuses to it; :func:`run` publishes them."""
-    with _lock:
+    with _updater_lock:
         if not _updaters:
             made = diagnostic_updater.Updater()
             made.setHardwareID(rospy.get_name())
@@ -137,10 +141,10 @@ def updater():
         return _updaters[0]
 
 
-def _publish_statuses(event):
+def _publish_statuses(statuses):
     """Publish every status of the node on /diagnostics (a timer's callback: never raises)."""
     try:
-        updater().force_update()
+        statuses.force_update()
     except Exception as err:
         rospy.logerr_throttle(60.0, '/diagnostics: statuses not published: %s: %s'
                               % (type(err).__name__, err))
@@ -202,9 +206,10 @@ def run(name, build):
         status_period = params.positive_float(rospy.resolve_name('~diagnostic_period'),
                                               rospy.get_param('~diagnostic_period', STATUS_PERIOD_S), 's')
         build()
-        link = master_link.start(updater())
+        statuses = updater()
+        link = master_link.start(statuses)
         on_stop(link.stop)
-        timer(status_period, _publish_statuses)
+        timer(status_period, lambda event: _publish_statuses(statuses))
     except params.ParamError as err:
         rospy.logfatal('%s: %s', rospy.get_name(), err)
         sys.exit(1)

@@ -4,7 +4,6 @@ Each test runs in a forked child (rospy's state is global to a process: a shutdo
 without a master, or with a stand-in that records what it was asked. A rospy that renamed or changed
 one of these internals fails its test here rather than a node in flight.
 """
-import multiprocessing
 import os
 import threading
 from xmlrpc.server import SimpleXMLRPCServer
@@ -16,16 +15,8 @@ from diagnostic_msgs.srv import AddDiagnostics, AddDiagnosticsResponse
 
 from node_kit import rospy_private
 
-#: A bound for a child's run: far beyond its few milliseconds, short of a hung test.
-CHILD_TIMEOUT = 60.0
 #: No master listens here: a call to it is refused at once.
 NO_MASTER = 'http://127.0.0.1:9/'
-
-
-def in_child(function, *args):
-    """``function(*args)`` run in a forked child; its result, or its exception raised here."""
-    with multiprocessing.get_context('fork').Pool(1) as pool:
-        return pool.apply_async(function, args).get(CHILD_TIMEOUT)
 
 
 @pytest.fixture(autouse=True)
@@ -45,7 +36,7 @@ def _shutdown_seen_by_hooks():
     return before, seen
 
 
-def test_shutdown_begun_is_true_in_the_hooks_while_is_shutdown_is_still_false():
+def test_shutdown_begun_is_true_in_the_hooks_while_is_shutdown_is_still_false(in_child):
     before, seen = in_child(_shutdown_seen_by_hooks)
     assert before is False
     assert seen == [('client hook', True, False), ('pre-shutdown hook', True, False)]
@@ -59,7 +50,7 @@ def _is_shutdown_in_the_pre_shutdown_hook():
     return seen
 
 
-def test_the_flag_raised_by_a_client_hook_is_seen_by_the_pre_shutdown_hooks():
+def test_the_flag_raised_by_a_client_hook_is_seen_by_the_pre_shutdown_hooks(in_child):
     # lifecycle._stop relies on it: the topic manager's registration retries end before close_all().
     assert in_child(_is_shutdown_in_the_pre_shutdown_hook) == [True]
 
@@ -69,7 +60,7 @@ def _cached_without_a_master():
     return rospy.get_param_cached('/rosout_disable_topics_generation')
 
 
-def test_a_cached_parameter_is_answered_without_asking_the_master():
+def test_a_cached_parameter_is_answered_without_asking_the_master(in_child):
     # Without the cache, get_param_cached asks the master, which refuses the connection here.
     assert in_child(_cached_without_a_master) is True
 
@@ -86,7 +77,7 @@ def _services_served():
     return service.uri, rospy_private.served_services()
 
 
-def test_served_services_lists_each_service_with_its_uri():
+def test_served_services_lists_each_service_with_its_uri(in_child):
     uri, served = in_child(_services_served)
     assert uri.startswith('rosrpc://')
     assert [list(entry) for entry in served] == [['/kit_echo', uri]]
@@ -104,7 +95,7 @@ def _call_over_the_connection_opened_ahead(master_uri):
     return answers, same
 
 
-def test_a_persistent_proxy_calls_over_the_connection_opened_ahead_without_the_master():
+def test_a_persistent_proxy_calls_over_the_connection_opened_ahead_without_the_master(in_child):
     # A stand-in master that records what it is asked: rospy reads /tcp_keepalive once per process
     # when it opens its first connection, and nothing else may reach the master.
     asked = []
