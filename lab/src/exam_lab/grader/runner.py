@@ -17,7 +17,7 @@ limit;
 the results from the session's folder is copied as data (regular files only, each capped:
 :func:`~exam_lab.grader.host.sandbox.copy_results`).
 
-The simulators (``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
+The simulators (``node_kit``, ``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
 workspace (cached under ``$EXAM_WS/grader/underlay``, rebuilt when their sources change); each student's
 package is built alone in an overlay of its own on top of it, so a student's ``exam`` never meets ours.
 """
@@ -55,7 +55,7 @@ START_TIMEOUT = 20.0
 RUN_TIMEOUT = 90.0 + LATE_WARNING_S
 SESSION_TIMEOUT = 420.0 + 2 * LATE_WARNING_S
 #: The simulator packages of the underlay.
-SIMULATORS = ('drone_sim', 'mydrone', 'submarinedrone')
+SIMULATORS = ('node_kit', 'drone_sim', 'mydrone', 'submarinedrone')
 #: Bounds of the boxes that read student bytes: (wall clock s, CPU s, address space bytes). One upload's
 #: inspection (measured: 0.2 s a package, box included); a class archive's intake; the class's similarity check.
 INSPECT_BOUNDS = (60.0, 60, 1 << 30)

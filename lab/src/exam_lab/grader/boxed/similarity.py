@@ -63,7 +63,7 @@ LAUNCH_TEMPLATES = [
 """,
 ]
 #: Packages whose code every student had (the sheets' drones).
-SHEET_PACKAGES = ('mydrone', 'submarinedrone', 'drone_sim')
+SHEET_PACKAGES = ('mydrone', 'submarinedrone', 'drone_sim', 'node_kit')
 
 
 class SimilarityError(Exception):
