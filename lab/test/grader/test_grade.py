@@ -128,7 +128,7 @@ def graded(tmp_path_factory):
             shutil.copytree(source, str(folder / 'exam'), symlinks=True,
                             ignore=shutil.ignore_patterns('__pycache__', '.grader-*'))
     out = root / 'out'
-    records = runner.grade_class(str(klass), str(out), jobs=2)
+    records = runner.grade_class(str(klass), str(out), jobs=3)
     return out, {r['student']: r for r in records}
 
 

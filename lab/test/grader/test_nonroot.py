@@ -35,7 +35,7 @@ from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
 from test_sandbox import files_under  # this folder's: the files of a student's results, as text
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.realpath(__file__))  # the repository's, not the workspace's src/ link
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 GOOD = os.path.join('lab', 'test', 'grader', 'submissions', 'good_student', 'exam')
 SABOTEUR = os.path.join('lab', 'test', 'grader', 'hostile', 'saboteur', 'exam')
