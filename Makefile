@@ -8,18 +8,19 @@ ENV := source tools/env.sh
 # `make test TESTS=run_tests_exam` runs one catkin test target instead of all of them.
 TESTS ?= run_tests
 
-.PHONY: help deps build run run-submarine test report bench soak mutation grade clean
+.PHONY: help deps build run run-submarine run-simple test report bench soak mutation grade clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
 	@echo "make run-submarine  the same with the underwater drone"
+	@echo "make run-simple [SHEET=altitude|depth]  the simple answer of docs/report.md, built on its own"
 	@echo "make test           install, build, and run every unit and rostest test"
 	@echo "make report         regenerate docs/ (command outputs, figures, PDF) from a live run"
 	@echo "make bench          benchmarks of the exam node against the naive baseline"
 	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
 	@echo "make mutation       mutation testing of the nodes' code against its tests (about 30 min)"
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
-	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv>]"
+	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv> [WORKSHEET_SCALE=1]] [ENGINE=local|slurm] [SLURM_ARGS='...']"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
 
@@ -35,6 +36,11 @@ run: build
 
 run-submarine: build
 	@tools/run_launch.sh exam_submarine.launch $(ARGS)
+
+# `make run-simple [SHEET=altitude|depth] [ARGS='threshold:=1200']`: the simple answer (docs/simple_answer/exam),
+# a second package named exam, in a workspace of its own (.ws/simple_answer).
+run-simple: deps
+	@docs/simple_answer/run.sh $(or $(SHEET),altitude) $(ARGS)
 
 test: build
 	@tools/run_tests.sh $(TESTS)
@@ -53,11 +59,13 @@ mutation: build
 
 # make grade SUBMISSION=<dir or zip> | CLASS=<dir or zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]
 #            [WORKSHEET=<Moodle's offline grading worksheet, filled into OUT>]
+#            [ENGINE=slurm: one Slurm array task per student] [SLURM_ARGS=<sbatch's options, e.g. --partition=x>]
 grade: build
 	@$(ENV) && exec python3 lab/scripts/grade.py \
 	  $(if $(SUBMISSION),--submission "$(SUBMISSION)") $(if $(CLASS),--class "$(CLASS)") \
 	  $(if $(SHEET),--sheet "$(SHEET)") $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)") \
-	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)")
+	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") $(if $(WORKSHEET_SCALE),--worksheet-scale) \
+	  $(if $(ENGINE),--engine "$(ENGINE)") $(if $(SLURM_ARGS),--slurm-args "$(SLURM_ARGS)")
 
 clean:
 	rm -rf .ws

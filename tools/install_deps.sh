@@ -18,6 +18,8 @@ packages=(
   iproute2 bubblewrap
   # the teacher's page is tested in a headless browser; the similarity check has a venv of its own
   chromium python3-venv
+  # the report's page limit is read from its PDF (pdftohtml) by the docs tests
+  poppler-utils
   "$@"
 )
 

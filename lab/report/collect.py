@@ -10,7 +10,8 @@ The order follows the exam sheets:
    no workspace of ours on CMAKE_PREFIX_PATH.
 2. A master; ``rosrun mydrone mydrone_node.py`` alone; questions 4 to 8, the warning service by hand,
    and question 10's first step (a node that only logs what it receives).
-3. ``catkin_create_pkg`` in a scratch folder (question 9); a launch with a bad threshold (question 12).
+3. ``catkin_create_pkg`` of each sheet in a scratch folder (question 9); a launch with a bad threshold
+   (question 12).
 4. The full default flight: ``rosbag record`` then ``roslaunch exam exam.launch`` for one profile loop;
    meanwhile the commands of questions 10 to 14. At the same time, on a second master, the same flight
    with ``threshold:=1200 delay:=3`` (question 14), and on a third the simple answer's launch, in
@@ -140,12 +141,13 @@ def flight(run, run_seconds, student_env):
     log('mydrone alone on %s' % master.uri)
     node_alone(run, master, command_list.MYDRONE_NODE, '/temperature', command_list.MYDRONE_ALONE)
 
-    scratch = os.path.join(run.supervisor.log_dir, 'create_pkg')
-    os.makedirs(scratch)
-    create_pkg = command_list.CREATE_PKG
-    run.run_all(master.env, [create_pkg], cwd=scratch)
-    with open(os.path.join(scratch, 'exam', 'package.xml')) as f:
-        run.results[create_pkg.key]['package_xml'] = f.read()
+    for create_pkg in (command_list.CREATE_PKG, command_list.CREATE_PKG_SUBMARINE):
+        scratch = os.path.join(run.supervisor.log_dir, create_pkg.key)
+        os.makedirs(scratch)
+        run.run_all(master.env, [create_pkg], cwd=scratch)
+        for name, key in (('package.xml', 'package_xml'), ('CMakeLists.txt', 'cmakelists')):
+            with open(os.path.join(scratch, 'exam', name)) as f:
+                run.results[create_pkg.key][key] = f.read()
     # No drone runs on this master now: the bad launch starts both nodes, and roslaunch ends it.
     run.run_all(master.env, [command_list.BAD_LAUNCH])
 

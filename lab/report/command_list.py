@@ -46,12 +46,14 @@ MYDRONE_ALONE = [
     Command('mydrone.echo_led', 'rostopic echo -n 1 /alt_warn_led', 15),
     Command('mydrone.call_normal', 'rosservice call /altitude_warning "status: \'NORMAL\'"', 15),
     Command('mydrone.call_bad', 'rosservice call /altitude_warning "status: \'RED\'"', 15),
-    # Question 10's first step: a node that only logs what it receives (lab/report/exam_node_step10.py).
+    # Question 10's first step: the student's node that only logs what it receives (lab/report/).
     Command('mydrone.first_step', 'timeout -s INT 3 rosrun exam_lab exam_node_step10.py', 20),
 ]
 
-# --- sheet 000, question 9: the package (run in a scratch folder, compared with exam/package.xml) ----
-CREATE_PKG = Command('exam.create_pkg', 'catkin_create_pkg exam rospy std_msgs mydrone submarinedrone', 30)
+# --- both sheets, question 9: the package, each sheet's command in a scratch folder of its own ------
+CREATE_PKG = Command('exam.create_pkg', 'catkin_create_pkg exam rospy std_msgs mydrone', 30)
+CREATE_PKG_SUBMARINE = Command('exam.create_pkg_submarine', 'catkin_create_pkg exam rospy std_msgs submarinedrone',
+                               30)
 
 # --- both sheets, question 12: a launch whose exam node refuses its parameter ends at once -----------
 BAD_LAUNCH = Command('flight.bad_launch', 'roslaunch exam exam.launch threshold:=1300m', 40,
@@ -95,7 +97,7 @@ SUBMARINE_ALONE = [
     Command('submarine.hz_pressure_remote', 'timeout -s INT 4 rostopic hz /pressure_remote', 15),
     Command('submarine.call_warning', 'rosservice call /depth_warning "status: \'WARNING\'"', 15),
     Command('submarine.call_normal', 'rosservice call /depth_warning "status: \'NORMAL\'"', 15),
-    Command('submarine.first_step', 'timeout -s INT 3 rosrun exam_lab exam_node_step10.py _mode:=depth', 20),
+    Command('submarine.first_step', 'timeout -s INT 3 rosrun exam_lab exam_submarine_node_step10.py', 20),
 ]
 
 # --- sheet 001, questions 10 to 14: the exam node in depth mode, one full default dive --------------
@@ -125,7 +127,7 @@ BACKGROUND = [MYDRONE_NODE, FLIGHT_RECORD, FLIGHT_LAUNCH, CUSTOM_RECORD, CUSTOM_
               SUBMARINE_NODE, DIVE_RECORD, DIVE_LAUNCH, SIMPLE_RECORD, SIMPLE_LAUNCH, SIMPLE_DIVE_RECORD,
               SIMPLE_DIVE_LAUNCH]
 #: Commands run to completion, output captured.
-FOREGROUND = ([CATKIN_MAKE] + MYDRONE_ALONE + [CREATE_PKG, BAD_LAUNCH] + FLIGHT_LIVE + CUSTOM_LIVE
-              + SIMPLE_LIVE + SUBMARINE_ALONE + DIVE_LIVE)
+FOREGROUND = ([CATKIN_MAKE] + MYDRONE_ALONE + [CREATE_PKG, CREATE_PKG_SUBMARINE, BAD_LAUNCH] + FLIGHT_LIVE
+              + CUSTOM_LIVE + SIMPLE_LIVE + SUBMARINE_ALONE + DIVE_LIVE)
 ALL = BACKGROUND + FOREGROUND
 BY_KEY = {command.key: command for command in ALL}

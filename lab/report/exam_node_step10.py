@@ -1,23 +1,22 @@
 #!/usr/bin/env python3
-"""Question 10's first step: log each value the drone's two sensor topics bring, nothing more.
-``~mode``: "altitude" (sheet 000: temperature, pressure; the default) or "depth" (001: two pressures)."""
-import rospy
-from std_msgs.msg import Float32
+# Question 10, first step (sheet 000): scripts/exam_node.py as it is before question 11.
+# It only displays the values it receives on /temperature and /pressure.
 
-# The two input topics of each sheet, with their units.
-INPUTS = {'altitude': [('temperature', 'degC'), ('pressure', 'Pa')],
-          'depth': [('pressure_robot', 'Pa'), ('pressure_remote', 'Pa')]}
+import rospy                       # the ROS client library for Python
+from std_msgs.msg import Float32   # the message type of both sensor topics
 
 
-def on_reading(msg, topic_and_unit):
-    """Called by rospy for each message of one topic: log the value."""
-    topic, unit = topic_and_unit
-    rospy.loginfo('received %s = %.2f %s', topic, msg.data, unit)
+def temperature_callback(msg):  # rospy calls it for each message on /temperature
+    rospy.loginfo('temperature %.2f degC', msg.data)
+
+
+def pressure_callback(msg):  # the same for /pressure
+    rospy.loginfo('pressure %.2f Pa', msg.data)
 
 
 if __name__ == '__main__':
-    rospy.init_node('exam')
-    for topic, unit in INPUTS[rospy.get_param('~mode', 'altitude')]:
-        # One subscriber per topic; callback_args tells the shared callback which topic it is.
-        rospy.Subscriber(topic, Float32, on_reading, callback_args=(topic, unit))
-    rospy.spin()  # wait for messages until Ctrl-C
+    rospy.init_node('exam')   # register with the master as the node /exam
+    # One subscriber per topic: topic name, message type, and the function rospy calls for each message.
+    rospy.Subscriber('/temperature', Float32, temperature_callback)
+    rospy.Subscriber('/pressure', Float32, pressure_callback)
+    rospy.spin()              # nothing else to do: wait for messages until Ctrl-C

@@ -11,9 +11,14 @@ The template is Markdown with placeholders, each replaced by something this run 
 - ``{{value NAME}}``: a number or short text computed from the run (see :func:`facts`);
 - ``{{block NAME}}``: a preformatted block computed from the run (log excerpts, comparisons);
 - ``{{file PATH}}``: a file of the repository, verbatim;
-- ``{{source MODULE:NAME}}``: the source of one function or class of the code, verbatim.
+- ``{{source MODULE:NAME}}``: the source of one function or class of the code, verbatim;
+- ``{{excerpt NAME}}``: the lines of the simple answer that answer one question (excerpts.py).
 
-Placeholders of one kind (run, source, block) separated by blank lines only share one block.
+Placeholders of one kind (run, source, block) separated by blank lines only share one block. A
+placeholder alone on a line of a block quote (``> {{file PATH}}``) becomes a block inside the quote:
+the answer boxes of questions 9 to 14 hold the simple answer's code that way. A line ``LEFT || RIGHT``,
+each side one or more placeholders, puts sheet 000's blocks beside sheet 001's (a two-column table of
+raw HTML, which pandoc and GitHub both keep): the questions part stays within its 10 pages.
 
 An unknown placeholder or key is an error: the report never shows a hole.
 """
@@ -21,6 +26,7 @@ import argparse
 import importlib
 import inspect
 import json
+import math
 import os
 import re
 import shlex
@@ -35,9 +41,14 @@ from mydrone import atmosphere
 
 import analysis
 import command_list
+import excerpts
 import figures
 
-PLACEHOLDER = re.compile(r'\{\{(run|line|value|block|file|source) ([^ }]+)\}\}')
+PLACEHOLDER = re.compile(r'\{\{(run|line|value|block|file|source|excerpt) ([^ }]+)\}\}')
+#: A placeholder alone on a line of a block quote.
+QUOTED = re.compile(r'^> (\{\{(?:run|block|file|source|excerpt) [^ }]+\}\})$', re.M)
+#: Two sets of placeholders side by side: ``{{run a}} {{run b}} || {{run c}}``, maybe in a block quote.
+PAIR = re.compile(r'^(> )?((?:\{\{[a-z]+ [^ }]+\}\} ?)+)\|\| ((?:\{\{[a-z]+ [^ }]+\}\} ?)+)$', re.M)
 ANSI = re.compile(r'\x1b\][^\x07\x1b]*(\x07|\x1b\\)?|\x1b\[[0-9;]*[A-Za-z]|\][0-9];[^\n]*?(?=\n|$)')
 
 
@@ -58,6 +69,30 @@ def last_rate(hz_output):
 def console_lines(text, pattern):
     """Lines of a console that match ``pattern`` (colour codes removed)."""
     return [line for line in clean(text).splitlines() if re.search(pattern, line)]
+
+
+def log_excerpt(text, pattern):
+    """The lines of a console that match ``pattern``, each run of lines left out marked in its place
+    with their number, so that a reader never takes a filtered log for the whole one."""
+    kept, skipped = [], 0
+    for line in clean(text).splitlines():
+        if re.search(pattern, line):
+            if skipped:
+                kept.append('[... %d line%s left out ...]' % (skipped, '' if skipped == 1 else 's'))
+            kept.append(line)
+            skipped = 0
+        else:
+            skipped += 1
+    if not kept:
+        raise RuntimeError('no line matches %r:\n%s' % (pattern, text[-2000:]))
+    if skipped:
+        kept.append('[... %d line%s left out ...]' % (skipped, '' if skipped == 1 else 's'))
+    return '\n'.join(kept)
+
+
+def uncommented(text, comment):
+    """``text`` without its comments (``comment``: a regular expression) and blank lines."""
+    return '\n'.join(line.rstrip() for line in re.sub(comment, '', text).splitlines() if line.strip())
 
 
 def logged_threshold(console):
@@ -211,7 +246,7 @@ def facts(work, repo, outputs):
     v['custom.delay'] = '%g' % param_value(outputs, 'custom.param_delay')
     v['custom.calls'] = str(len(custom['changes']))
     # The 1200 m example on the drone's clock: from its first log line (the flight's time 0), which
-    # comes after roslaunch's own start-up (a few seconds, varying); README and architecture.md use it.
+    # comes after roslaunch's own start-up (about 1.5 s, varying); README and architecture.md use it.
     first = console_lines(outputs['custom.launch']['output'], r'\]: /mydrone: profile')
     if not first:
         raise RuntimeError('custom.launch: no start line of the drone')
@@ -232,7 +267,8 @@ def facts(work, repo, outputs):
     v['model.mean_t_3000'] = '%.1f' % analysis.mean_temperature_error(3000.0)
     v['model.t_1300'] = '%.2f' % atmosphere.temperature_c(1300.0)
     v['model.p_1300'] = '%.0f' % atmosphere.pressure_pa(1300.0)
-    v['model.fix_max'] = '%.1e' % max(abs(e) for _, e in fixed)
+    # Rounding only: the bound, a power of ten, rather than digits that change with the sampling.
+    v['model.fix_max'] = 'less than 1e%d' % math.ceil(math.log10(max(abs(e) for _, e in fixed)))
     v['model.standard_1300'] = '%.3f' % analysis.standard_altitude(atmosphere.pressure_pa(1300.0))
     for level in (1200.0, 1500.0):
         errs = [e for h, e in measured if abs(h - level) < 0.5]
@@ -251,20 +287,22 @@ def facts(work, repo, outputs):
     b = {}
     # The exam node's lines only: its start-up summary, its decisions, and its service calls.
     exam_lines = r'\]: (/exam: |\w+ -?[0-9.]+ m .*: (WARNING|NORMAL)$|/\w+_warning: LED set to|could not set)'
-    b['flight.exam_log'] = '\n'.join(console_lines(outputs['flight.launch']['output'], exam_lines))
-    b['dive.exam_log'] = '\n'.join(console_lines(outputs['dive.launch']['output'], exam_lines))
-    b['flight.drone_log'] = '\n'.join(console_lines(outputs['flight.launch']['output'],
-                                                    r'altitude_warning: ALT WARN'))
-    b['dive.drone_log'] = '\n'.join(console_lines(outputs['dive.launch']['output'],
-                                                  r'depth_warning: DEPTH WARN'))
+    b['flight.exam_log'] = log_excerpt(outputs['flight.launch']['output'], exam_lines)
+    b['dive.exam_log'] = log_excerpt(outputs['dive.launch']['output'], exam_lines)
+    b['flight.drone_log'] = log_excerpt(outputs['flight.launch']['output'], r'altitude_warning: ALT WARN')
+    b['dive.drone_log'] = log_excerpt(outputs['dive.launch']['output'], r'depth_warning: DEPTH WARN')
     # The simple answer's own log: its threshold, then each call it made.
     simple_lines = r'\]: (threshold -?[0-9.]+ m$|(altitude|depth) -?[0-9.]+ m .*: (WARNING|NORMAL)$)'
-    b['simple.log'] = '\n'.join(console_lines(outputs['simple.launch']['output'], simple_lines))
-    b['simple_dive.log'] = '\n'.join(console_lines(outputs['simple_dive.launch']['output'], simple_lines))
-    line = 'git ls-files -s -- exam/scripts mydrone/scripts submarinedrone/scripts'
+    b['simple.log'] = log_excerpt(outputs['simple.launch']['output'], simple_lines)
+    b['simple_dive.log'] = log_excerpt(outputs['simple_dive.launch']['output'], simple_lines)
+    line = 'git ls-files -s -- mydrone/scripts submarinedrone/scripts docs/simple_answer/exam/scripts'
     listed = subprocess.run(shlex.split(line), cwd=repo, stdout=subprocess.PIPE, check=True)
     b['scripts.modes'] = '$ %s\n%s' % (line, listed.stdout.decode().rstrip())
-    created = depends(outputs['exam.create_pkg']['package_xml'])
+    created_files = outputs['exam.create_pkg']
+    b['exam.created_files'] = '%s\n\n%s' % (
+        '<!-- exam/package.xml -->\n' + uncommented(created_files['package_xml'], r'(?s)<!--.*?-->'),
+        '# exam/CMakeLists.txt\n' + uncommented(created_files['cmakelists'], r'(?m)#.*$'))
+    created = depends(created_files['package_xml'])
     with open(os.path.join(repo, 'exam', 'package.xml')) as f:
         ours = depends(f.read())
     rows = ['%-20s %-44s %s' % ('tag', 'catkin_create_pkg wrote', 'exam/package.xml has')]
@@ -320,12 +358,31 @@ def render(template, outputs, values, blocks, repo):
             return values[key]
         if kind == 'block':
             return fence(blocks[key], 'text')
+        if kind == 'excerpt':
+            path = excerpts.EXCERPTS[key][0]
+            return fence(excerpts.excerpt(repo, key), 'xml' if path.endswith('.launch') else 'python')
         if kind == 'file':
             with open(os.path.join(repo, key)) as f:
                 language = {'.launch': 'xml', '.xml': 'xml', '.py': 'python', '.srv': 'text'}
                 return fence(f.read().rstrip(), language.get(os.path.splitext(key)[1], ''))
         return fence(source_of(key), 'python')
-    return PLACEHOLDER.sub(replace, GROUP.sub(replace_group, template))
+    def quoted(text):
+        return '\n'.join(('> ' + line).rstrip() for line in text.splitlines())
+
+    def replace_quoted(match):
+        return quoted(PLACEHOLDER.sub(replace, match.group(1)))
+
+    def side(placeholders):
+        # Consecutive placeholders of one kind on a side: one block, as GROUP makes them.
+        return GROUP.sub(replace_group, '\n\n'.join(placeholders))
+
+    def replace_pair(match):
+        left, right = (re.findall(r'\{\{[^}]+\}\}', match.group(i)) for i in (2, 3))
+        cells = [PLACEHOLDER.sub(replace, side(placeholders)) for placeholders in (left, right)]
+        text = ('<table class="pair"><tr><td>\n\n%s\n\n</td><td>\n\n%s\n\n</td></tr></table>' % tuple(cells))
+        return quoted(text) if match.group(1) else text
+    template = PAIR.sub(replace_pair, template)
+    return PLACEHOLDER.sub(replace, GROUP.sub(replace_group, QUOTED.sub(replace_quoted, template)))
 
 
 def main():

@@ -3,25 +3,36 @@
 
     grade.py --submission DIR_OR_ZIP [--sheet altitude|depth] [--out DIR]
     grade.py --class DIR_OR_ZIP [--sheet altitude|depth] [--out DIR] [--jobs N] [--worksheet CSV]
+             [--engine local|slurm [--slurm-args '--partition=... --account=...']]
 
 Besides the grades, OUT/index.html (the page for the teacher), each student's results.json
 (Gradescope) and flight.png, for a class the similarity check and, with --worksheet, Moodle's
 offline grading worksheet filled (the teacher's desk: lab/src/exam_lab/grader/publish/desk.py).
 
-Prints the score table; exits 0 whenever grading completed, whatever the scores, and 1 when the
+Prints the score table (every line cleaned of control characters: it carries students' text);
+exits 0 whenever grading completed, whatever the scores, and 1 when the
 grader itself could not run (a missing input, the simulators not building, no sandbox: student code
 runs only in its sandbox, unless --unsandboxed-student-code-can-read-and-damage-my-files is given).
 """
 import argparse
 import os
+import shlex
 import sys
 
 from exam_lab.grader import runner
 
 from exam_lab.grader.boxed import documents, unpack
+from exam_lab.grader.engine import slurm
 
-from exam_lab.grader.publish import desk, progress, report
+from exam_lab.grader.publish import desk, moodle, progress, report
+from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import SHEETS
+
+
+def say(line, stream=None):
+    """Print ``line`` for the teacher with no control character in it (a student's escape sequence
+    could move the cursor and rewrite the summary above)."""
+    (stream or sys.stdout).write(safe_text.clean(line) + '\n')
 
 
 def main(argv=None):
@@ -36,11 +47,20 @@ def main(argv=None):
                         action='store_true', help='grade even where no sandbox can be made (never as root: '
                         'as root the code runs as a user of its own, with limits)')
     parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV) to fill")
+    parser.add_argument('--worksheet-scale', action='store_true',
+                        help="scale the grades to the worksheet's maximum grade (default: the machine's points "
+                        "out of 17, said on the terminal and in each comment)")
     parser.add_argument('--no-similarity', action='store_true', help='skip the similarity check (class)')
+    parser.add_argument('--engine', choices=['local', 'slurm'], default='local',
+                        help='where a class is graded: here, JOBS at a time, or one Slurm array task per student')
+    parser.add_argument('--slurm-args', default='', help="sbatch's options for the cluster, e.g. "
+                        "'--partition=short --account=ros101' (with --engine slurm)")
     args = parser.parse_args(argv)
+    if args.engine == 'slurm' and not args.klass:
+        parser.error('--engine slurm grades a class (--class): one array task per student')
     target = args.submission or args.klass
     if not os.path.exists(target):
-        sys.stderr.write('grade: %s does not exist\n' % target)
+        say('grade: %s does not exist' % target, sys.stderr)
         return 1
     name = os.path.basename(os.path.abspath(target).rstrip('/'))
     out = os.path.abspath(args.out or os.path.join(runner.workspace(), 'grades', name))
@@ -49,36 +69,44 @@ def main(argv=None):
             record = runner.grade_submission(args.submission, out, args.sheet, on_step=progress.StepProgress(),
                                              extra=documents.submission_facts(args.submission),
                                              unsandboxed=args.unsandboxed)
-            print(report.table([record]))
+            say(report.table([record]))
             if record.get('status_reason'):
-                print('%s: %s' % (record['status'], record['status_reason']))
+                say('%s: %s' % (record['status'], record['status_reason']))
+            for doubt in record.get('doubts') or []:
+                say('look at: %s' % doubt)
             for line in report.evidence_lines(record):
-                print('  ' + line)
-            print('grade.json and grade.md in %s' % out)
-            for line in desk.finish(out, [record], single=True, worksheet=args.worksheet):
-                print(line)
+                say('  ' + line)
+            say('grade.json and grade.md in %s' % out)
+            for line in desk.finish(out, [record], single=True, worksheet=args.worksheet,
+                                    scale=args.worksheet_scale):
+                say(line)
         else:
             shown = progress.ClassProgress(args.jobs)
             try:
-                records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=shown,
-                                             unsandboxed=args.unsandboxed)
+                if args.engine == 'slurm':
+                    records = slurm.grade_class(args.klass, out, args.sheet, progress=shown,
+                                                unsandboxed=args.unsandboxed, sbatch_args=shlex.split(args.slurm_args))
+                else:
+                    records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=shown,
+                                                 unsandboxed=args.unsandboxed)
             finally:
                 shown.close()
-            print(report.table(records))
+            say(report.table(records))
             waiting = report.needing_the_teacher(records)
             if waiting:
-                print('\n%d student(s) need the teacher (their points are not a grade yet):' % len(waiting))
+                say('\n%d student(s) need the teacher (their points are not a grade yet):' % len(waiting))
                 for line in waiting:
-                    print('  ' + line)
-            print('grades.csv and one folder per student in %s' % out)
+                    say('  ' + line)
+            say('grades.csv and one folder per student in %s' % out)
             for line in desk.finish(out, records, similar=None if args.no_similarity else
-                                    runner.class_similarity(args.klass, out, records), worksheet=args.worksheet):
-                print(line)
+                                    runner.class_similarity(args.klass, out, records), worksheet=args.worksheet,
+                                    scale=args.worksheet_scale, title=moodle.class_name(args.klass)):
+                say(line)
     except RuntimeError as err:
-        sys.stderr.write('grade: %s\n' % err)
+        say('grade: %s' % err, sys.stderr)
         return 1
     except unpack.UnpackError as err:  # the class archive itself (one student's upload never gets here)
-        sys.stderr.write('grade: the class archive cannot be opened safely: %s\n' % err)
+        say('grade: the class archive cannot be opened safely: %s' % err, sys.stderr)
         return 1
     return 0
 

@@ -293,3 +293,81 @@ def test_the_check_catches_a_command_or_path_that_moved():
     assert [what for what, ok in named_things(text) if not ok] == [
         'roslaunch exam drone_pair.launch', 'rosrun exam fleet_launch.py',
         '$(find exam)/launch/drone_pair.launch', 'exam/test/ops/replay.test']
+
+
+# --- the report's PDF: the questions part, then the appendices ---------------------------------------
+
+#: The questions part of docs/report.pdf: at most this many pages before the appendices (issue 28).
+QUESTION_PAGES = 10
+PDF = os.path.join(REPO, 'docs', 'report.pdf')
+
+
+def pdf_outline(path):
+    """The PDF's outline (bookmarks) as [(depth, page, title)], read with poppler's pdftohtml."""
+    import subprocess
+    xml = subprocess.run(['pdftohtml', '-xml', '-i', '-stdout', path], stdout=subprocess.PIPE,
+                         stderr=subprocess.DEVNULL, check=True).stdout.decode('utf-8', 'replace')
+    outline, depth = [], 0
+    for tag, page, title in re.findall(r'(<outline>|</outline>|<item page="(\d+)">(.*?)</item>)', xml):
+        if tag == '<outline>':
+            depth += 1
+        elif tag == '</outline>':
+            depth -= 1
+        else:
+            outline.append((depth, int(page), title))
+    return outline
+
+
+def questions_and_appendices(outline):
+    """(last page of the questions part, the top-level titles) of an outline."""
+    top = [(page, title) for depth, page, title in outline if depth == 1]
+    appendices = [page for page, title in top if title == 'Appendices']
+    assert appendices, 'no top-level "Appendices" in the outline: %s' % top
+    return appendices[0] - 1, [title for _, title in top]
+
+
+@pytest.mark.skipif(shutil.which('pdftohtml') is None, reason='pdftohtml (poppler-utils) is not installed')
+def test_report_pdf_has_at_most_ten_pages_of_questions_then_the_appendices_in_its_outline():
+    outline = pdf_outline(PDF)
+    last_question_page, top = questions_and_appendices(outline)
+    assert 'Questions 1 to 14' in top and top.index('Questions 1 to 14') < top.index('Appendices'), top
+    assert last_question_page <= QUESTION_PAGES, 'the questions part runs to page %d' % last_question_page
+    titles = [title for _, _, title in outline]
+    for expected in ['14b. The 5 s delay', 'A. This project\'s node, and what it does differently',
+                     'D. Corrections to the exam sheets and the grader\'s notes']:
+        assert any(t.replace('&#39;', "'").replace('&apos;', "'") == expected for t in titles), (expected, titles)
+
+
+def test_the_page_check_catches_a_questions_part_too_long():
+    # An outline whose appendices start on page 12: 11 pages of questions.
+    outline = [(1, 1, 'Model report'), (1, 1, 'Questions 1 to 14'), (2, 11, '14b. The 5 s delay'),
+               (1, 12, 'Appendices')]
+    last, top = questions_and_appendices(outline)
+    assert last == 11 and last > QUESTION_PAGES and top == ['Model report', 'Questions 1 to 14', 'Appendices']
+
+
+# --- docs/grading.md: its example grades are a grader's output, not typed ---------------------------
+
+def test_grading_examples_are_the_generators_output_with_every_item_of_the_rubric():
+    import grading_examples  # lab/report/grading_examples.py
+    from exam_lab.grader.score.sheets import ITEMS
+    text = read(grading_examples.GRADING)
+    for name, submission in grading_examples.EXAMPLES:
+        assert os.path.isdir(os.path.join(REPO, submission)), submission
+        found = re.search(r'%s\n```markdown\n(.*?)\n```\n%s' % (re.escape(grading_examples.BEGIN % name),
+                                                               re.escape(grading_examples.END % name)), text, re.S)
+        assert found, 'docs/grading.md: no generated example %r between its markers' % name
+        grade = found.group(1)
+        assert grade.startswith('# %s: ' % os.path.basename(submission)), grade[:80]
+        for item, (points, _) in ITEMS.items():
+            assert re.search(r'^\| %s \| .* \| [0-9.]+ / %g \|' % (item, points), grade, re.M), item
+
+
+def test_grading_examples_splice_replaces_only_the_block_between_its_markers():
+    import grading_examples
+    text = 'before\n%s\nold\n%s\nafter\n' % (grading_examples.BEGIN % 'x', grading_examples.END % 'x')
+    assert grading_examples.splice(text, 'x', '# x: 17 / 17\n') == (
+        'before\n%s\n```markdown\n# x: 17 / 17\n```\n%s\nafter\n' % (grading_examples.BEGIN % 'x',
+                                                                    grading_examples.END % 'x'))
+    with pytest.raises(ValueError):
+        grading_examples.splice(text, 'y', '')

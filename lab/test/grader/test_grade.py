@@ -40,12 +40,18 @@ EXPECTED = {
     'sleep_in_callback': {'Q14b': 2.0},                # sleep(5) in the callback: WARNING after a 3 s excursion
     'float64_depth': {},                               # /depth as std_msgs/Float64: the sheet names no type
     'python2_prints': {'runs': 1.0, 'Q10': 0.0, 'Q11': 0.0, 'Q13': 0.0, 'Q14a': 0.0, 'Q14b': 0.0},
+    'yaml_threshold': {},                              # limit in config/params.yaml loaded in the node's tag, the
+                                                       # drone by its launch file (issue 27: 15 when the derived
+                                                       # launch named the grader's path of the YAML)
+    'type_without_py': {'Q12': 0.5},                   # type="exam_node" for scripts/exam_node.py: run as fixed;
+                                                       # Q12 judges the file handed in (it starts no executable)
     'refused_upload': {item: 0.0 for item in FULL},    # an entry climbing out of the folder: not graded
 }
-SHEETS = {'wrong_topic': 'depth', 'one_subscriber': 'depth', 'float64_depth': 'depth'}
+SHEETS = {'wrong_topic': 'depth', 'one_subscriber': 'depth', 'float64_depth': 'depth', 'yaml_threshold': 'depth'}
 #: Each student's status (graded unless named): what the teacher must do with the grade.
 STATUS = {'no_kelvin': 'graded with fixes', 'windows_zip': 'graded with fixes', 'workspace_tgz': 'graded with fixes',
-          'renamed_package': 'graded with fixes', 'crash_at_start': 'needs a hand grade',
+          'renamed_package': 'graded with fixes', 'type_without_py': 'graded with fixes',
+          'crash_at_start': 'needs a hand grade',
           'python2_prints': 'needs a hand grade', 'refused_upload': 'not graded'}
 #: The folder in submissions/ each upload is made from, when not its own.
 MADE_FROM = {'windows_zip': 'good_student', 'workspace_tgz': 'hard_threshold', 'refused_upload': 'good_student'}
@@ -126,17 +132,21 @@ def graded(tmp_path_factory):
     return out, {r['student']: r for r in records}
 
 
+def assert_graded(record, lost, status):
+    """Full marks but for the ``lost`` items' points, and the ``status``; the evidence when not."""
+    got = {i['id']: i['points'] for i in record['items']}
+    evidence = '\n'.join('%s %s/%s: %s' % (i['id'], i['points'], i['max'], i['evidence']) for i in record['items'])
+    assert got == dict(FULL, **lost), evidence
+    assert record['max'] == 17.0
+    assert record['status'] == status, record['status_reason']
+
+
 @pytest.mark.parametrize('name', sorted(EXPECTED))
 def test_each_package_gets_exactly_its_points(graded, name):
     _, records = graded
     record = records[name]
-    got = {i['id']: i['points'] for i in record['items']}
-    wanted = dict(FULL, **EXPECTED[name])
-    evidence = '\n'.join('%s %s/%s: %s' % (i['id'], i['points'], i['max'], i['evidence']) for i in record['items'])
-    assert got == wanted, evidence
+    assert_graded(record, EXPECTED[name], STATUS.get(name, 'graded'))
     assert record['sheet'] == SHEETS.get(name, 'altitude')
-    assert record['max'] == 17.0
-    assert record['status'] == STATUS.get(name, 'graded'), record['status_reason']
     assert (record['status_reason'] == '') == (record['status'] == 'graded')
     for entry in record['items']:
         if entry['points'] < entry['max']:
@@ -186,6 +196,87 @@ def test_what_the_teacher_reads_of_each_status(graded):
     assert 'the WARNING came late' in late, late
     assert 'std_msgs/Float64, a numeric type' in [i for i in records['float64_depth']['items']
                                                   if i['id'] == 'Q11'][0]['evidence']
+
+
+#: A third kind of class (issue 27): what a teacher gives, graded by running; each failed before.
+FAIR_EXPECTED = {
+    'lowercase_service': {'Q13': 2.0},    # "warning"/"normal": refused by the drone, on time: half of 13, once
+    'duplicate_names': {'Q12': 0.0},      # roslaunch refuses the file as handed in (two nodes named /mydrone)
+    'float64_temperature': {'Q10': 1.0},  # /temperature as Float64: rospy refuses it, the node keeps 20 degC
+    'two_uploads': {},                    # exam.zip (14:52, no delay) and exam_v2.zip (16:58, complete)
+}
+FAIR_STATUS = {'lowercase_service': 'needs a hand grade', 'duplicate_names': 'graded with fixes',
+               'float64_temperature': 'graded', 'two_uploads': 'graded'}
+#: Who must be in the page's "needs the teacher" box, whatever the status.
+FAIR_DOUBTS = ('lowercase_service', 'duplicate_names', 'two_uploads')
+
+
+def dated_zip(source, path, when):
+    """The package zipped with every entry dated ``when`` (the student's clock when it was made)."""
+    with zipfile.ZipFile(path, 'w', zipfile.ZIP_DEFLATED) as zf:
+        for full, rel in _files(source):
+            info = zipfile.ZipInfo('exam/' + rel, when)
+            info.external_attr = (os.stat(full).st_mode & 0o777) << 16
+            with open(full, 'rb') as f:
+                zf.writestr(info, f.read())
+
+
+@pytest.fixture(scope='module')
+def fair(tmp_path_factory):
+    """A class of four graded with JOBS=2, and its desk (the page) written."""
+    from exam_lab.grader.publish import desk
+    root = tmp_path_factory.mktemp('fair')
+    klass = root / 'class'
+    for name in FAIR_EXPECTED:
+        folder = klass / ('%s_%d_assignsubmission_file_' % (name, 100 + len(name)))
+        folder.mkdir(parents=True)
+        if name == 'two_uploads':  # the first try, then the complete one, both kept by Moodle
+            dated_zip(os.path.join(SUBMISSIONS, 'no_delay', 'exam'), str(folder / 'exam.zip'),
+                      (2026, 6, 12, 14, 52, 0))
+            dated_zip(os.path.join(SUBMISSIONS, 'good_student', 'exam'), str(folder / 'exam_v2.zip'),
+                      (2026, 6, 12, 16, 58, 0))
+        else:
+            shutil.copytree(os.path.join(SUBMISSIONS, name, 'exam'), str(folder / 'exam'),
+                            ignore=shutil.ignore_patterns('__pycache__', '.grader-*'))
+    out = root / 'out'
+    records = runner.grade_class(str(klass), str(out), jobs=2)
+    desk.finish(str(out), records, title='ROS-Exam altitude')
+    return out, {r['student']: r for r in records}
+
+
+@pytest.mark.parametrize('name', sorted(FAIR_EXPECTED))
+def test_fair_each_package_gets_what_a_teacher_gives(fair, name):
+    _, records = fair
+    record = records[name]
+    assert_graded(record, FAIR_EXPECTED[name], FAIR_STATUS[name])
+    assert bool(record['doubts']) == (name in FAIR_DOUBTS), record['doubts']
+
+
+def test_fair_evidence_is_what_happened(fair):
+    out, records = fair
+    evidence = {n: {i['id']: i['evidence'] for i in r['items']} for n, r in records.items()}
+    lower = evidence['lowercase_service']
+    assert 'refused its 2 call(s) with "normal", "warning"' in lower['Q13'], lower['Q13']
+    assert 'WARNING while above, NORMAL once back below' in lower['Q13'], lower['Q13']
+    assert 'refused' in records['lowercase_service']['status_reason']
+    duplicate = evidence['duplicate_names']['Q12']
+    assert 'roslaunch refuses launch/exam.launch as handed in' in duplicate, duplicate
+    assert 'multiple nodes named [/mydrone]' in duplicate and 'starts mydrone/' not in duplicate, duplicate
+    assert 'multiple nodes named [/mydrone]' in records['duplicate_names']['status_reason']
+    types = evidence['float64_temperature']
+    assert '/temperature as std_msgs/Float64, but rospy refused the connection' in types['Q10'], types['Q10']
+    assert 'subscribes /temperature (std_msgs/Float32)' not in ' '.join(records['float64_temperature']['for_the_teacher'])
+    uploads = ' '.join(records['two_uploads']['doubts'])
+    assert "graded 'exam_v2.zip', the newest by its files' dates" in uploads, uploads
+    assert "'exam.zip' (files dated 2026-06-12 14:52)" in uploads, uploads
+    with open(os.path.join(str(out), 'index.html')) as f:
+        page = f.read()
+    assert '<title>Exam grades: ROS-Exam altitude</title>' in page
+    box = page.split('<h2 id="first">', 1)[1].split('<h2', 1)[0]
+    for name in FAIR_DOUBTS:
+        assert '>%s</a>' % name in box, name
+    assert '>float64_temperature</a>' not in box
+    assert os.path.isfile(os.path.join(str(out), 'lowercase_service', 'flight.png'))
 
 
 def test_our_node_on_the_depth_sheet(tmp_path):

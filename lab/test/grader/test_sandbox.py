@@ -186,7 +186,8 @@ def test_no_sandbox_no_grading_unless_the_risk_is_named(monkeypatch, tmp_path):
 def test_probe_results_must_belong_to_the_run():
     from exam_lab.grader.judge.session import probe_problem
     plan = {'kind': 'main', 'delay': 5.0}
-    real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0}}
+    real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0},
+            'clock': {'use_sim_time': [None, None], 'messages': 0, 'publishers': []}}
     assert probe_problem(real, plan, 99.0, 131.0) is None
     assert 'not within' in probe_problem(real, plan, 200.0, 240.0)       # an old run's file
     short = dict(real, schedule=dict(real['schedule'], long_down=121.0))

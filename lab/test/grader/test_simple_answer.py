@@ -1,17 +1,24 @@
 """The simple answer of docs/report.md (docs/simple_answer/exam, what a student can write in three
-hours) gets full marks on both sheets from the grader, and stays out of every catkin build of this
-repository (it is a second package named ``exam``). About 45 s per sheet.
+hours) gets full marks on both sheets from the grader, stays out of every catkin build of this
+repository (it is a second package named ``exam``), and `make run-simple` builds and runs it on its own
+for both sheets. About 45 s per sheet graded, and a build of four packages.
 """
 import os
+import re
+import subprocess
 
 import pytest
 from catkin_pkg.packages import find_packages
 
 from exam_lab.grader import runner
-from exam_lab.grader.score.sheets import ITEMS
+from exam_lab.grader.score.sheets import ITEMS, SHEETS
+from exam_lab.harness.supervisor import Supervisor
+from exam_lab.harness.wait import wait_until
 
 REPO = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..'))
 SIMPLE = os.path.join(REPO, 'docs', 'simple_answer', 'exam')
+#: What `make run-simple` runs.
+RUN_SIMPLE = os.path.join(REPO, 'docs', 'simple_answer', 'run.sh')
 
 
 @pytest.mark.parametrize('sheet', ['altitude', 'depth'])
@@ -29,3 +36,26 @@ def test_the_simple_answer_is_no_package_of_the_repository():
     names = [package.name for package in find_packages(REPO).values()]
     assert names.count('exam') == 1, names
     assert os.path.isfile(os.path.join(SIMPLE, 'package.xml'))
+
+
+def test_run_simple_builds_the_simple_answer_alone_and_runs_both_sheets(tmp_path):
+    # The build first, bounded (four packages; minutes on a loaded machine), then each sheet's launch
+    # on a master of its own: its node must be the simple answer's (its first line is "threshold
+    # 1300.0 m"; ours starts with its mode) and publish the sheet's output, and Ctrl-C must end it.
+    build = subprocess.run([RUN_SIMPLE, '--build-only', 'altitude'], stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, timeout=900)
+    assert build.returncode == 0, build.stdout.decode(errors='replace')[-3000:]
+    with Supervisor(str(tmp_path)) as supervisor:
+        for name, sheet in SHEETS.items():
+            master = supervisor.start_master(name + '.master')
+            launch = supervisor.start(name, [RUN_SIMPLE, name], master.env)
+            published = wait_until(lambda: master.publishers('/' + sheet.output), 60.0,
+                                   alive=lambda: launch.poll() is None)
+            assert published, supervisor.output(name)[-3000:]
+            status, echoed, _ = supervisor.run(name + '.echo', ['rostopic', 'echo', '-n', '1', '/' + sheet.output],
+                                               30.0, master.env)
+            assert status == 0 and 'data: ' in echoed, echoed
+            own_line = re.compile(r'\]: threshold %.1f m$' % sheet.threshold, re.M)
+            assert wait_until(lambda: own_line.search(supervisor.output(name)), 10.0), supervisor.output(name)[-3000:]
+            assert supervisor.stop(launch) == 0, supervisor.output(name)[-3000:]
+            supervisor.stop(master.proc)

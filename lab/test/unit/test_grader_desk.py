@@ -255,3 +255,34 @@ def test_the_probe_trace_is_compact():
     assert got['published'][-1] == [T0 + 11.0, None]
     assert got['oracle'][1] == [T0 + 3.0, 1430.123]
     json.dumps(got, allow_nan=False)
+
+
+def crafted_pdf(path, size=4 << 20):
+    """A PDF made to stop a backtracking reader: a page tree node that never closes, repeated, then
+    ``stream`` lines with nothing to inflate; its real page tree (7 pages) is in an object stream."""
+    import zlib
+    half = size // 2
+    unclosed = b'<< /Type /Pages ' + b'/Type /Pages /Count 1 ' * (half // 22)
+    streams = b'stream\n' * (half // 7)
+    real = b'1 0 obj\n<< /Type /ObjStm /Filter /FlateDecode >>\nstream\n' \
+        + zlib.compress(b'<< /Type /Pages /Kids [3 0 R] /Count 7 >>') + b'\nendstream\n'
+    with open(path, 'wb') as f:
+        f.write(b'%PDF-1.5\n' + real + unclosed + b'\n' + streams)
+
+
+def test_pdf_pages_in_linear_time(tmp_path):
+    """A crafted report of a few MB is read in well under a second (a backtracking regular expression
+    took 76 s on 325 KB, hours on 5 MB). In a child process, so that a regression fails, never hangs."""
+    import subprocess
+    import sys
+    path = str(tmp_path / 'crafted.pdf')
+    crafted_pdf(path)
+    assert os.path.getsize(path) > 3 << 20
+    code = ('import sys, time\nfrom exam_lab.grader.boxed import documents\nstarted = time.monotonic()\n'
+            'pages = documents.pdf_pages(sys.argv[1])\nprint(pages, time.monotonic() - started)\n')
+    try:
+        out = subprocess.run([sys.executable, '-c', code, path], stdout=subprocess.PIPE, timeout=60, check=True)
+    except subprocess.TimeoutExpired:
+        pytest.fail('pdf_pages took over 60 s on a 4 MB PDF')
+    pages, seconds = out.stdout.decode().split()
+    assert pages == '7' and float(seconds) < 0.5, out.stdout

@@ -29,6 +29,12 @@ def copy_submission(tmp_path, name):
     return target
 
 
+def in_box(path, pkg):
+    """A derived file's ``$(find exam)/...`` path, resolved as roslaunch does (the package at ``pkg``)."""
+    assert path.startswith('$(find exam)/'), path
+    return os.path.join(pkg, path[len('$(find exam)/'):])
+
+
 @pytest.mark.parametrize('name, sheet, param, value', [
     ('good_student', 'altitude', '/threshold', 1300),           # global <param>, as the sheet's notes
     ('every_cycle', 'altitude', '/exam/threshold', '1300'),     # private, through an <arg>
@@ -103,16 +109,18 @@ def test_group_namespace_include_and_yaml_file(tmp_path):
     derived = launch.derive(analysis, 'x', {found.origin: 999})
     tree = ET.parse(derived)
     include = tree.getroot().find('group/include')
-    assert include.get('file').endswith('.grader-x-node.launch') and include.find('arg').get('value') == '999'
+    assert include.get('file') == '$(find exam)/launch/.grader-x-node.launch', 'a path the run box resolves'
+    assert include.find('arg').get('value') == '999'
     assert tree.getroot().find('group').findall('include') == [include], 'the drone include is dropped'
-    node = ET.parse(include.get('file')).getroot().find('node')
+    node = ET.parse(in_box(include.get('file'), pkg)).getroot().find('node')
     assert node.get('launch-prefix') is None and node.get('output') == 'screen'
     # A YAML file's value is changed in a copy of the file.
     yaml_param = [p for p in analysis.params if p.name.endswith('max_altitude')][0]
     derived = launch.derive(analysis, 'y', {yaml_param.origin: 1111})
     node = ET.parse(os.path.join(pkg, 'launch', '.grader-y-node.launch')).getroot().find('node')
     loaded = node.find('rosparam').get('file')
-    assert loaded.endswith('.grader-y-params.yaml') and 'max_altitude: 1111' in open(loaded).read()
+    assert loaded == '$(find exam)/config/.grader-y-params.yaml'
+    assert 'max_altitude: 1111' in open(in_box(loaded, pkg)).read()
     assert 'max_altitude: 1300' in open(os.path.join(pkg, 'config', 'params.yaml')).read()
 
 
@@ -138,3 +146,143 @@ def test_value_alone_identifies_a_threshold(tmp_path):
     analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
     assert launch.threshold_param(analysis, 'depth')[0].name == '/exam/h'
     assert launch.threshold_param(analysis, 'altitude')[0] is None
+
+
+# --- what the analysis reads: the student's package and the box's environment only (issue 26) ------
+
+def test_env_substitutions_see_the_box_never_the_grader(tmp_path, monkeypatch):
+    from exam_lab.grader.host import sandbox
+    monkeypatch.setenv('EXAM_TEACHER_SECRET', 'hunter2-teacher-only')
+    pkg = package(tmp_path, {'launch/exam.launch': '''<launch>
+  <node pkg="exam" type="exam_node.py" name="exam">
+    <param name="threshold" value="$(optenv EXAM_TEACHER_SECRET 1300)"/>
+    <param name="token" value="$(env EXAM_TEACHER_SECRET)"/>
+    <param name="home" value="$(env HOME)"/>
+  </node>
+</launch>'''})
+    path = os.path.join(pkg, 'launch', 'exam.launch')
+    for env in (None, sandbox.box_env({'PATH': '/usr/bin'})):
+        analysis = launch.analyse(path, pkg) if env is None else launch.analyse(path, pkg, 'exam', env)
+        seen = repr([(p.name, p.value) for p in analysis.params]) + repr(analysis.problems)
+        assert 'hunter2' not in seen
+        assert launch.threshold_param(analysis, 'altitude')[0].value == 1300, 'the default: unset in the box'
+    assert {p.name: p.value for p in analysis.params}['/exam/home'] == sandbox.BOX_HOME
+
+
+def test_files_outside_the_package_are_never_read(tmp_path):
+    """``..``, a sibling folder whose name starts like the package's (a string prefix check took it),
+    a link out of the package and an absolute path: each refused with a problem, nothing read, and no
+    derived file written outside the package."""
+    outside = tmp_path / 'outside'
+    outside.mkdir()
+    (outside / 'secret.yaml').write_text('root_only_key: 1300\n')
+    (outside / 'other.launch').write_text('<launch><param name="from_outside" value="1300"/></launch>')
+    sibling = tmp_path / 'exam-evil'
+    sibling.mkdir()
+    (sibling / 'x.yaml').write_text('sibling_key: 1300\n')
+    pkg = package(tmp_path, {'launch/exam.launch': '''<launch>
+  <include file="$(find mydrone)/launch/mydrone.launch"/>
+  <include file="$(find exam)/../outside/other.launch"/>
+  <include file="%s"/>
+  <node pkg="exam" type="exam_node.py" name="exam">
+    <param name="threshold" value="1300"/>
+    <rosparam command="load" file="$(find exam)/../outside/secret.yaml"/>
+    <rosparam command="load" file="$(find exam)/../../%s/outside/secret.yaml"/>
+    <rosparam command="load" file="$(find exam)-evil/x.yaml"/>
+    <rosparam command="load" file="$(find exam)/config/link.yaml"/>
+  </node>
+</launch>''' % (outside / 'other.launch', tmp_path.name)})
+    os.mkdir(os.path.join(pkg, 'config'))
+    os.symlink(str(outside / 'secret.yaml'), os.path.join(pkg, 'config', 'link.yaml'))
+    analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
+    assert [p.name for p in analysis.params] == ['/exam/threshold'], 'nothing from outside'
+    outside_problems = [p for p in analysis.problems if p.startswith('file outside the package: ')]
+    assert len(outside_problems) == 6 and all(p.endswith(' not read') for p in outside_problems), analysis.problems
+    assert analysis.starts_drone('altitude'), 'the drone\'s own launch file still counts, unread'
+    found, _ = launch.threshold_param(analysis, 'altitude')
+    for tag, changes in (('main', None), ('threshold', {found.origin: 1000})):
+        launch.derive(analysis, tag, changes)
+    assert sorted(os.listdir(str(outside))) == ['other.launch', 'secret.yaml']
+    assert os.listdir(str(sibling)) == ['x.yaml']
+
+
+def test_derived_files_name_paths_the_run_box_sees(tmp_path):
+    """Issue 27's case: the threshold in a YAML loaded inside the node's tag, beside an include of the
+    drone's launch file; the derived files name no path of the grader's side (the box sees the package
+    at another path), and they are written in the package only."""
+    pkg = package(tmp_path, {
+        'launch/exam.launch': '''<launch>
+  <include file="$(find mydrone)/launch/mydrone.launch"/>
+  <include file="$(dirname)/node.launch"/>
+</launch>''',
+        'launch/node.launch': '''<launch>
+  <node pkg="exam" type="exam_node.py" name="exam">
+    <rosparam command="load" file="$(find exam)/config/params.yaml"/>
+  </node>
+</launch>''',
+        'config/params.yaml': 'threshold: 1300\n'})
+    analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
+    found, _ = launch.threshold_param(analysis, 'altitude')
+    assert found.name == '/exam/threshold' and analysis.starts_drone('altitude')
+    derived = launch.derive(analysis, 'threshold', {found.origin: 1040.0})
+    written = [os.path.join(d, f) for d, _, files in os.walk(str(tmp_path)) for f in files if f.startswith('.grader-')]
+    assert sorted(os.path.relpath(p, pkg) for p in written) == [
+        'config/.grader-threshold-params.yaml', 'launch/.grader-threshold-exam.launch',
+        'launch/.grader-threshold-node.launch']
+    for path in written:
+        with open(path) as f:
+            assert str(tmp_path) not in f.read(), '%s names a path of the grader\'s side' % path
+    include = ET.parse(derived).getroot().find('include')
+    assert include.get('file') == '$(find exam)/launch/.grader-threshold-node.launch'
+    node = ET.parse(in_box(include.get('file'), pkg)).getroot().find('node')
+    assert node.find('rosparam').get('file') == '$(find exam)/config/.grader-threshold-params.yaml'
+    again = launch.analyse(derived, pkg)
+    assert [(p.name, p.value) for p in again.params] == [('/exam/threshold', 1040.0)]
+
+
+def test_derived_file_is_never_written_through_a_link(tmp_path):
+    pkg = package(tmp_path, {'launch/exam.launch': '<launch><node pkg="exam" type="n.py" name="exam"/></launch>'})
+    victim = tmp_path / 'victim.txt'
+    victim.write_text('untouched')
+    os.symlink(str(victim), os.path.join(pkg, 'launch', '.grader-main-exam.launch'))
+    derived = launch.derive(launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg), 'main')
+    assert victim.read_text() == 'untouched'
+    assert not os.path.islink(derived) and ET.parse(derived).getroot().find('node').get('pkg') == 'exam'
+
+
+def alias_bomb(levels=9, width=9):
+    """The "billion laughs" of YAML: ``width ** levels`` parameters (nested mappings) from 0.6 KB."""
+    keys = 'abcdefghijklmnopqrstuvwxyz'[:width]
+    lines = ['l0: &l0 {%s}' % ', '.join('%s: 1' % k for k in keys)]
+    for level in range(1, levels):
+        lines.append('l%d: &l%d {%s}' % (level, level, ', '.join('%s: *l%d' % (k, level - 1) for k in keys)))
+    return '\n'.join(lines) + '\n'
+
+
+def test_yaml_alias_bomb_is_refused_at_once(tmp_path):
+    import time
+    import tracemalloc
+    from xml.sax.saxutils import escape
+    bomb = alias_bomb()
+    assert len(bomb) < 800
+    pkg = package(tmp_path, {
+        'launch/exam.launch': '<launch><node pkg="exam" type="n.py" name="exam">'
+                              '<rosparam command="load" file="$(find exam)/config/params.yaml"/>'
+                              '<rosparam>%s</rosparam><param name="threshold" value="1300"/></node></launch>' % escape(bomb),
+        'config/params.yaml': bomb})
+    tracemalloc.start()
+    try:
+        started = time.monotonic()
+        analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
+        seconds = time.monotonic() - started
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert seconds < 1.0 and peak < 10 << 20, (seconds, peak)
+    assert [p.name for p in analysis.params] == ['/exam/threshold']
+    refused = [p for p in analysis.problems if launch.ALIASES_REFUSED in p]
+    assert len(refused) == 2 and 'config/params.yaml' in refused[0] and '(line 1)' in refused[0], analysis.problems
+    # A plain YAML still reads, and a merge key (an alias) is refused too.
+    assert launch.load_yaml('a: {b: 1}\nc: [1, 2]\n') == {'a': {'b': 1}, 'c': [1, 2]}
+    with pytest.raises(launch.yaml.YAMLError):
+        launch.load_yaml('base: &b {x: 1}\nd:\n  <<: *b\n')

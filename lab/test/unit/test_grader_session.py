@@ -52,3 +52,44 @@ def test_sheet_detection(tmp_path):
     (pkg / 'package.xml').write_text('<package><name>exam</name><exec_depend>mydrone</exec_depend></package>')
     assert runner.detect_sheet(None, str(pkg), analyses)[0] == 'altitude', 'package.xml first'
     assert runner.margin_of(1300.0) == 130.0 and runner.margin_of(50.0) == 10.0
+
+
+CLEAN_CLOCK = {'use_sim_time': [None, None], 'messages': 0, 'publishers': [], 'ros_time_is_wall': True}
+
+
+def test_a_run_whose_node_set_the_time_is_refused():
+    """/use_sim_time set (before the probe's init or later) or /clock published: refused with the
+    reason, whatever the times say; a probe that did not watch is refused too."""
+    plan = {'kind': 'main', 'delay': 5.0}
+    real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0},
+            'clock': CLEAN_CLOCK}
+    assert session.probe_problem(real, plan, 99.0, 131.0) is None
+    sim = dict(real, clock=dict(CLEAN_CLOCK, use_sim_time=[True, True]))
+    assert '/use_sim_time was set' in session.probe_problem(sim, plan, 99.0, 131.0)
+    late = dict(real, clock=dict(CLEAN_CLOCK, use_sim_time=[None, True]))
+    assert '/use_sim_time was set' in session.probe_problem(late, plan, 99.0, 131.0)
+    ticking = dict(real, clock=dict(CLEAN_CLOCK, messages=40, publishers=['/exam']))
+    assert '/clock was published (40 messages by /exam)' in session.probe_problem(ticking, plan, 99.0, 131.0)
+    unwatched = {k: v for k, v in real.items() if k != 'clock'}
+    assert 'did not say' in session.probe_problem(unwatched, plan, 99.0, 131.0)
+
+
+def test_a_run_whose_master_went_over_its_memory_is_refused():
+    bounded = {'uid': 62000, 'memory': {'limit': 384 << 20, 'peak': 80 << 20, 'oom_kills': 0}}
+    assert session.master_problem(bounded, died=False) is None
+    flooded = {'uid': 62000, 'memory': {'limit': 384 << 20, 'peak': 384 << 20, 'oom_kills': 1}}
+    assert 'over its memory bound of 384 MB' in session.master_problem(flooded, died=True)
+    assert 'ended during the run' in session.master_problem({'uid': 62000, 'memory': None}, died=True)
+
+
+def test_a_refused_run_needs_a_hand_grade_with_its_reason():
+    from exam_lab.grader.score import rubric
+    probe = {'nodes': ['/exam'], 'clock': CLEAN_CLOCK}
+    measured = {'build': {'status': 0, 'tail': ''}, 'runs': [{'tag': 'main', 'probe': probe, 'launch': {}}]}
+    assert rubric.status({}, measured)[0] == rubric.GRADED
+    refused = {'build': {'status': 0, 'tail': ''},
+               'runs': [{'tag': 'main', 'probe': None, 'launch': {}, 'probe_error': 'result refused: x',
+                         'probe_refused': '/clock was published (40 messages by /exam): grade it by hand'}]}
+    status, reason = rubric.status({}, refused)
+    assert status == rubric.HAND_GRADE
+    assert reason.startswith('the main run was not measured: /clock was published'), reason

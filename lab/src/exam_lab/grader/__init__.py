@@ -15,7 +15,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
 - ``host/`` -- root: :mod:`~.host.sandbox` (the box: bubblewrap, a uid of its own, limits; the
   capped, regular-file-only copy of what a box leaves).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima) and
-  :mod:`~.score.rubric` (points, evidence and status from the measurements).
+  :mod:`~.score.rubric` (points, evidence and status from the measurements), :mod:`~.score.safe_text`
+  (student-derived text without control characters, for every record and output).
 - ``publish/`` -- what the teacher reads, from records only: :mod:`~.publish.report` (grade.json,
   grade.md, grades.csv, the terminal table), :mod:`~.publish.desk` (writes the rest into OUT),
   :mod:`~.publish.page` (index.html), :mod:`~.publish.flightplot`, :mod:`~.publish.moodle` (the
@@ -23,6 +24,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   (k of n, the time left; a run's steps).
 - :mod:`~exam_lab.grader.runner` -- one submission or a class, top to bottom: inspect, box, judge,
   score, publish.
+- ``engine/`` -- the host, as the teacher: where else a class is graded, each student by the runner
+  (:mod:`~.engine.slurm`: an array job on a Slurm cluster).
 """
 import os
 

@@ -159,22 +159,28 @@ def prepare(submission, work, wanted_sheet, notes, fixes=None):
     :returns: ``(sheet, static, job)``; ``job`` is None when nothing can be run (no node script).
     """
     fixes = notes if fixes is None else fixes
-    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes, fixes)
+    uploads = []
+    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes, fixes, uploads=uploads)
     name = unpack.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
     workspace = os.path.join(work, 'ws')
     pkg = os.path.join(workspace, 'src', name if re.match(r'^[A-Za-z][\w-]*$', name) else PACKAGE)
     unpack.copy_package(pkg_source, pkg, fixes)
     fixes.extend(source.fix_text(pkg))
-    analyses = [launch.analyse(path, pkg, name) for path in launch.launch_files(pkg)]
+    box_env = sandbox.box_env({'PATH': os.environ.get('PATH', '/usr/bin:/bin')})  # $(env) sees the box's, not ours
+    analyses = [launch.analyse(path, pkg, name, box_env) for path in launch.launch_files(pkg)]
     sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
     notes.insert(0, how)
     chosen = launch.choose(analyses, sheet)
     scripts = source.node_scripts(pkg)
-    launched = [n.type for n in chosen.exam_nodes] if chosen else [os.path.basename(p) for p in scripts[:1]]
+    types, type_fixes = source.node_type_fixes(pkg, chosen.exam_nodes if chosen else [])
+    fixes.extend(type_fixes)
+    launched = [types.get(n.type_origin, n.type) for n in chosen.exam_nodes] if chosen \
+        else [os.path.basename(p) for p in scripts[:1]]
     fixes.extend(source.make_runnable(pkg, launched))
     static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses], 'package': name,
               'package_dir': pkg, 'python2': source.python2_evidence(pkg),
-              'params_in_code': source.param_names(pkg), 'launch': None, 'threshold': None}
+              'params_in_code': source.param_names(pkg), 'launch': None, 'threshold': None,
+              'uploads': uploads}
     if static['python2']:
         notes.append('Python 2 code, which ROS Noetic cannot run: %s' % ', '.join(static['python2']))
     for analysis in analyses:
@@ -194,7 +200,7 @@ def prepare(submission, work, wanted_sheet, notes, fixes=None):
             static['threshold'] = {'name': param.name, 'value': param.value,
                                    'where': param.origin.describe(pkg) if param.origin else '?'}
             notes.append('threshold parameter: %s, set in %s' % (why, static['threshold']['where']))
-        main_launch = launch.derive(chosen, 'main')
+        main_launch = launch.derive(chosen, 'main', types)
         namespace = chosen.drone_namespace(sheet)
     else:
         static['threshold_reason'] = 'no launch file starts an exam node, so no parameter'
@@ -215,13 +221,16 @@ def prepare(submission, work, wanted_sheet, notes, fixes=None):
     runs.append({'tag': 'main', 'launch': main_launch, 'plan': plan})
     if param is not None and param.origin is not None:
         lowered = threshold_value - 2 * margin
-        runs.append({'tag': 'threshold', 'launch': launch.derive(chosen, 'threshold', {param.origin: lowered}),
+        threshold_changes = dict(types)
+        threshold_changes[param.origin] = lowered
+        runs.append({'tag': 'threshold', 'launch': launch.derive(chosen, 'threshold', threshold_changes),
                      'plan': dict(plan, kind='threshold', threshold=lowered,
                                   targets={'start': lowered - margin, 'step': threshold_value - margin})})
     elif param is not None:
         static['threshold']['not_rewritable'] = 'its value comes from no literal the grader can change'
     job = {'workspace': workspace, 'namespace': namespace, 'build_timeout': BUILD_TIMEOUT,
-           'run_timeout': RUN_TIMEOUT, 'runs': runs}
+           'run_timeout': RUN_TIMEOUT, 'runs': runs,
+           'handed_in_launch': os.path.relpath(chosen.path, os.path.join(workspace, 'src')) if chosen else None}
     return sheet, static, job
 
 
@@ -359,13 +368,14 @@ def could_not_grade(student, sheet, why, notes=()):
 
 
 def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False,
-                     on_step=None, extra=None, unsandboxed=False):
+                     on_step=None, extra=None, unsandboxed=False, jobs=1):
     """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
 
     :param on_step: called with each step's name as it starts (unpack, build, main flight...).
     :param extra: added to the record (:func:`exam_lab.grader.boxed.documents.submission_facts`).
     :param unsandboxed: run it even where no sandbox can be made (the teacher's flag that names the
         risk); otherwise :class:`~exam_lab.grader.host.sandbox.SandboxUnavailable` is raised there.
+    :param jobs: how many submissions are graded side by side: the box's part of the CPU.
     """
     start = time.monotonic()
     student = student or unpack.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
@@ -390,7 +400,8 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                            'error': 'no script of the package starts a ROS node'}
             else:
                 _prepare_workspace(work)
-                with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None) as box:
+                with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None,
+                                 cpus=sandbox.box_cpus(jobs)) as box:
                     notes.extend(box.notes)
                     how_run = _how_run(box)
                     session = run_session(job, work, underlay, isolate, box, on_step)
@@ -409,7 +420,8 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                 notes.append('not copied to logs/ (not a regular file): %s' % ', '.join(skipped))
         record = report.grade_record(student, chosen_sheet, items,
                                      hints(static, session, notes + fixes, pkg, isolate, how_run),
-                                     dict(extra or {}, seconds=round(time.monotonic() - start, 1)),
+                                     dict(extra or {}, seconds=round(time.monotonic() - start, 1),
+                                          doubts=rubric.doubts(static, session)),
                                      rubric.status(static, session, fixes))
         report.write_grade(out_dir, record)
         return record
@@ -437,6 +449,39 @@ def default_underlay():
     return os.path.join(workspace(), 'grader', 'underlay')
 
 
+def class_students(class_path, scratch):
+    """``[(name, folder or archive)]`` of a class, each name unique (``Jane Doe``, ``Jane Doe_2``): the
+    students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`). A class
+    archive is unpacked below ``scratch``."""
+    names, seen = [], set()
+    for name, folder in unpack.list_students(class_path, scratch):
+        unique, n = name, 2
+        while unique in seen:
+            unique, n = '%s_%d' % (name, n), n + 1
+        seen.add(unique)
+        names.append((unique, folder))
+    return names
+
+
+def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
+                  unsandboxed=False, jobs=1):
+    """Grade one student of a class into ``out_dir/name``; return the record. Anything the grader
+    raises is this student's record ("could not grade"), never the class's. Both engines grade a
+    student with it: a local pool's thread and a Slurm task."""
+    try:
+        return grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
+                                on_step=on_step, extra=documents.submission_facts(folder), unsandboxed=unsandboxed,
+                                jobs=jobs)
+    except Exception as err:  # anything: this student's row says so, the class goes on
+        record = could_not_grade(name, sheet, '%r' % err,
+                                 ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
+        try:
+            report.write_grade(os.path.join(out_dir, name), record)
+        except OSError:
+            pass
+        return record
+
+
 def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=None, unsandboxed=False):
     """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv.
     One student the grader cannot grade is that student's row ("could not grade"), never the class's.
@@ -449,36 +494,20 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
     os.makedirs(out_dir, exist_ok=True)
     scratch = tempfile.mkdtemp(prefix='class-', dir=out_dir)
     try:
-        students = unpack.list_students(class_path, scratch)
+        students = class_students(class_path, scratch)
         underlay = ensure_underlay(default_underlay())
         isolate = can_isolate() if isolate is None else isolate
-        names, seen = [], set()
-        for name, _ in students:
-            unique, n = name, 2
-            while unique in seen:
-                unique, n = '%s_%d' % (name, n), n + 1
-            seen.add(unique)
-            names.append(unique)
         records = [None] * len(students)
         if progress:
-            progress.begin(names)
+            progress.begin([name for name, _ in students])
 
         def one(index):
-            name, folder = names[index], students[index][1]
+            name, folder = students[index]
             if progress:
                 progress.started(name)
-            try:
-                record = grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
-                                          on_step=(lambda step: progress.step(name, step)) if progress else None,
-                                          extra=documents.submission_facts(folder), unsandboxed=unsandboxed)
-            except Exception as err:  # anything: this student's row says so, the class goes on
-                record = could_not_grade(name, sheet, '%r' % err,
-                                         ['grader error, please report: %s'
-                                          % traceback.format_exc().replace('\n', ' | ')])
-                try:
-                    report.write_grade(os.path.join(out_dir, name), record)
-                except OSError:
-                    pass
+            record = grade_student(name, folder, out_dir, sheet, underlay, isolate,
+                                   (lambda step: progress.step(name, step)) if progress else None, unsandboxed,
+                                   jobs=jobs)
             if progress:
                 progress.finished(record)
             return record

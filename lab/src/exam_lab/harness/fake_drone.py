@@ -4,7 +4,8 @@ It plays the drone for an exam node under test (ours in the rostests and the ben
 grader): it publishes the two sensor inputs of either sheet with the values a script sets, serves the
 warning service and records every call with the time it arrived, and publishes the LED colour on a
 latched topic as the real drones do. It also records what the exam node publishes. Times are ROS time
-(``rospy.get_time()``), the clock the exam node counts its delay in.
+(``rospy.get_time()``), the clock the exam node counts its delay in, unless a ``clock`` is given: the
+grader's probe passes ``time.time`` so that a student's ``/clock`` can never become the judge's.
 
 The values come from :mod:`exam_lab.harness.oracle`, never from the ``exam`` package.
 
@@ -52,9 +53,11 @@ class SensorFeeder(object):
 
     :param rates: dict topic name -> publishing rate in Hz.
     :param tcp_nodelay: ask subscribers for TCP_NODELAY (the bench: no Nagle batching in the stamps).
+    :param clock: the function that gives the times returned (default ``rospy.get_time``).
     """
 
-    def __init__(self, rates, tcp_nodelay=False):
+    def __init__(self, rates, tcp_nodelay=False, clock=None):
+        self._clock = clock or rospy.get_time
         self._lock = threading.Lock()
         self._pubs = {}
         self._values = {}
@@ -74,6 +77,11 @@ class SensorFeeder(object):
     def connected(self):
         """True when every input topic has a subscriber (the node under test is up and connected)."""
         return all(pub.get_num_connections() > 0 for pub in self._pubs.values())
+
+    def connections(self, topic):
+        """How many subscribers ``topic``'s publisher is connected to (rospy refuses one that asked
+        for another message type: the master lists it, but it has no connection)."""
+        return self._pubs[topic].get_num_connections()
 
     def wait_for_subscribers(self, timeout):
         return wait_until(self.connected, timeout, alive=_alive)
@@ -123,7 +131,7 @@ class SensorFeeder(object):
 
     def _publish(self, topic, value):
         """Publish one message (the caller holds the lock); return its ROS time."""
-        self._last_sent[topic] = rospy.get_time()
+        self._last_sent[topic] = self._clock()
         self._pubs[topic].publish(Float32(value))
         return self._last_sent[topic]
 
@@ -138,14 +146,17 @@ class FakeWarningService(object):
     broken LED driver would).
 
     :param on_call: optional function(status, success) called after each answered call.
+    :param clock: the function that times the calls (default ``rospy.get_time``).
     """
 
-    def __init__(self, name, srv_class, led_topic, advertise=True, on_call=None):
+    def __init__(self, name, srv_class, led_topic, advertise=True, on_call=None, clock=None):
+        self._clock = clock or rospy.get_time
         self._name = name
         self._srv_class = srv_class
         self._on_call = on_call
         self._lock = threading.Lock()
         self._calls = []
+        self._answers = []
         self._attempts = []
         self._delay = 0.0
         self._failing = False
@@ -198,6 +209,15 @@ class FakeWarningService(object):
         with self._lock:
             return list(self._calls)
 
+    def answers(self):
+        """Every answered call with the drone's answer: (ROS time of arrival, request, success, message).
+
+        A refused request (a status the drone does not know, or a scripted refusal) is a call all the
+        same: the grader judges when the node called, and says what the drone answered.
+        """
+        with self._lock:
+            return list(self._answers)
+
     def statuses(self):
         return [status for _, status in self.calls()]
 
@@ -209,6 +229,7 @@ class FakeWarningService(object):
     def clear(self):
         with self._lock:
             del self._calls[:]
+            del self._answers[:]
             del self._attempts[:]
 
     def wait_for_calls(self, count, timeout):
@@ -217,7 +238,7 @@ class FakeWarningService(object):
         return self.calls()
 
     def _handle(self, request):
-        now = rospy.get_time()
+        now = self._clock()
         with self._lock:
             if self._withdrawn:
                 raise rospy.ServiceException('the fake drone is gone (withdrawn by the test)')
@@ -240,6 +261,8 @@ class FakeWarningService(object):
             message = 'LED driver fault (scripted)'
         else:
             message = 'LED set' if colour is not None else 'unknown status'
+        with self._lock:
+            self._answers.append((now, request.status, colour is not None, message))
         return self._srv_class._response_class(colour is not None, message)
 
 
@@ -255,9 +278,11 @@ class TopicRecorder(object):
         LED topic).
     :param queue_size: messages rospy may hold for the recorder when it falls behind, the oldest
         dropped beyond; None keeps every one (the bench, measuring rates up to 1 kHz on a loaded machine).
+    :param clock: the function that times the messages (default ``rospy.get_time``).
     """
 
-    def __init__(self, topic, msg_type=Float32, tcp_nodelay=False, queue_size=100):
+    def __init__(self, topic, msg_type=Float32, tcp_nodelay=False, queue_size=100, clock=None):
+        self._clock = clock or rospy.get_time
         self._lock = threading.Lock()
         self._samples = []
         self._sub = rospy.Subscriber(topic, msg_type, self._callback, queue_size=queue_size,
@@ -296,7 +321,7 @@ class TopicRecorder(object):
         self._sub.unregister()
 
     def _callback(self, msg):
-        now = rospy.get_time()
+        now = self._clock()
         with self._lock:
             self._samples.append((now, msg.data))
 
@@ -330,10 +355,11 @@ class Drone(object):
         drone of several nodes (the bench). ``rates`` still takes the sheet's relative topic names;
         :attr:`fixed_topic` and :attr:`moving_topic` are the resolved ones.
     :param queue_size: of the output recorder, see :class:`TopicRecorder`.
+    :param clock: the function every time is read from (default ``rospy.get_time``).
     """
 
     def __init__(self, mode='altitude', advertise=True, led=True, rates=None, tcp_nodelay=False,
-                 on_call=None, namespace='', queue_size=100):
+                 on_call=None, namespace='', queue_size=100, clock=None):
         sheet = SHEETS[mode]
         self.mode = mode
 
@@ -341,10 +367,11 @@ class Drone(object):
             return namespace.rstrip('/') + '/' + relative if namespace else relative
 
         rates = dict(sheet['rates'], **(rates or {}))
-        self.feeder = SensorFeeder({name(topic): rate for topic, rate in rates.items()}, tcp_nodelay)
+        self.feeder = SensorFeeder({name(topic): rate for topic, rate in rates.items()}, tcp_nodelay, clock)
         self.service = FakeWarningService(name(sheet['service']), sheet['srv'],
-                                          name(sheet['led']) if led else None, advertise, on_call)
-        self.output = TopicRecorder(name(sheet['output']), tcp_nodelay=tcp_nodelay, queue_size=queue_size)
+                                          name(sheet['led']) if led else None, advertise, on_call, clock)
+        self.output = TopicRecorder(name(sheet['output']), tcp_nodelay=tcp_nodelay, queue_size=queue_size,
+                                    clock=clock)
         fixed_topic, self.fixed_value = sheet['fixed']
         self.fixed_topic = name(fixed_topic)
         self.moving_topic = name(sheet['moving'])

@@ -7,6 +7,13 @@ No rospy here: this is a small evaluator of roslaunch XML, enough for exam answe
 substitutions ``$(arg)``, ``$(find)``, ``$(dirname)``, ``$(env)``, ``$(optenv)``. What it cannot
 evaluate (``$(eval)``, unknown args) is reported, never guessed.
 
+What it reads is the student's, and only that (issue 26): ``$(env)`` / ``$(optenv)`` take their values
+from the ``env`` mapping given (the box's environment), never from the grader's own; every file a
+launch file names is opened only when its real path (links and ``..`` resolved) is inside the package
+folder, else the analysis says "file outside the package: ... not read"; YAML with anchors or aliases
+is refused (a 0.8 KB file of nested aliases expands to millions of parameters); at most
+``MAX_FILES`` launch files are read. ``<param textfile= binfile= command=>`` are never read.
+
 Every parameter keeps the place its literal value comes from (an attribute of an element, a key of
 inline YAML or of a YAML file), followed through ``$(arg ...)``, so the grader can change a threshold
 "however it is named or set" and run the student's own launch file with the new value.
@@ -14,9 +21,13 @@ inline YAML or of a YAML file), followed through ``$(arg ...)``, so the grader c
 The grader runs a *derived* launch file: the student's, without the drone (the grader's fake drone
 plays it) nor any other package's node or include, every node's output to the screen (the log the
 teacher reads), and optionally one parameter's value changed. Derived files are written next to the
-originals (``.grader-<tag>-<name>``), so ``$(dirname)`` still means what the student meant.
+originals (``.grader-<tag>-<name>``), which are all inside the package (so the derived files are in
+the grader's copy of it, the work folder), and ``$(dirname)`` still means what the student meant.
+The paths they name are ``$(find <package>)/...``: the run box sees the package at another path
+than the grader does.
 """
 import collections
+import errno
 import os
 import re
 import xml.etree.ElementTree as ET
@@ -32,7 +43,12 @@ _THRESHOLD_WORDS = ('thresh', 'seuil', 'limit', 'lim', 'max', 'alert', 'warn', '
 _OTHER_WORDS = ('rate', 'delay', 'hz', 'freq', 'period', 'duration', 'time', 'seed', 'profile', 'mode',
                 'count', 'tick', 'iter', 'queue', 'timeout', 'wait')
 
-Node = collections.namedtuple('Node', 'pkg type name ns file')
+ALIASES_REFUSED = 'YAML anchors and aliases (&name, *name) are refused: a few can expand to millions of values'
+#: Launch files read for one analysis (the top one and its includes, each time it is included).
+MAX_FILES = 50
+
+#: A node; ``type_origin`` is where its ``type`` literal lives (an :class:`Origin`), for a fix.
+Node = collections.namedtuple('Node', 'pkg type name ns file type_origin')
 #: A parameter: full name, value, where its literal lives (:class:`Origin` or None), owning node.
 Param = collections.namedtuple('Param', 'name value origin node')
 
@@ -65,17 +81,20 @@ class Origin(object):
 class Analysis(object):
     """What one top-level launch file (and the files it includes) would start and set."""
 
-    def __init__(self, path, package_dir, package=PACKAGE):
+    def __init__(self, path, package_dir, package=PACKAGE, env=None):
         self.path = path
         self.package_dir = package_dir
         #: The student's package name (``exam`` as asked, or whatever the student named it).
         self.package = package
+        #: The environment ``$(env)`` and ``$(optenv)`` see: the box's, never the grader's.
+        self.env = dict(env or {})
+        self.files_read = 0
         self.nodes = []
         self.params = []
         #: Drone packages started through an ``<include>`` of their own launch files.
         self.included_drones = []
         self.problems = []
-        #: path -> parsed tree of every file read (the top one and the exam package's includes).
+        #: real path -> parsed tree of every file read (the top one and the exam package's includes).
         self.trees = collections.OrderedDict()
 
     @property
@@ -143,10 +162,49 @@ def as_number(value):
         return None
 
 
+class _NoAliasLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing anchors and aliases as the composer meets them: before any
+    node is shared, so an alias bomb costs what its text costs."""
+
+    def compose_node(self, parent, index):
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent) or getattr(event, 'anchor', None) is not None:
+            raise yaml.composer.ComposerError(None, None, ALIASES_REFUSED, event.start_mark)
+        return super(_NoAliasLoader, self).compose_node(parent, index)
+
+
+def yaml_problem(err):
+    """A YAML error in one line: what, and where."""
+    mark = getattr(err, 'problem_mark', None)
+    what = getattr(err, 'problem', None) or str(err).split('\n')[0]
+    return '%s (line %d)' % (what, mark.line + 1) if mark is not None else what
+
+
+def load_yaml(text):
+    """``text`` as YAML, safely: no Python tags, no anchors or aliases (:class:`_NoAliasLoader`).
+
+    :raises yaml.YAMLError: for anything that does not parse or is refused, absurd nesting included.
+    """
+    try:
+        return yaml.load(text, Loader=_NoAliasLoader)
+    except RecursionError:
+        raise yaml.YAMLError('YAML nested too deep')
+
+
+def inside(package_dir, path):
+    """The real path of ``path`` (links and ``..`` resolved) when it is inside ``package_dir``, else
+    None: ``$(find exam)/../../..`` and a link out of the package are outside."""
+    if not path:
+        return None
+    root = os.path.realpath(package_dir)
+    real = os.path.realpath(path)
+    return real if real.startswith(root.rstrip(os.sep) + os.sep) else None
+
+
 def _yaml_value(text):
     """A ``<param value>`` as roslaunch types it: bool, int, float or str (no type= attribute)."""
     try:
-        value = yaml.safe_load(text)
+        value = load_yaml(text)
     except yaml.YAMLError:
         return text
     return value if isinstance(value, (bool, int, float)) else text
@@ -155,12 +213,13 @@ def _yaml_value(text):
 class _Scope(object):
     """Args of one launch file: name -> (value, Origin of its literal or None)."""
 
-    def __init__(self, path, package_dir, passed=None, package=PACKAGE):
+    def __init__(self, path, package_dir, passed=None, package=PACKAGE, env=None):
         self.path = path
         self.package_dir = package_dir
         self.package = package
         self.args = {}
         self.passed = passed or {}
+        self.env = env or {}
 
     def substitute(self, text):
         """``text`` with every substitution evaluated, and the Origin when it is exactly one $(arg)."""
@@ -187,30 +246,44 @@ class _Scope(object):
         if command == 'dirname':
             return os.path.dirname(self.path)
         if command in ('env', 'optenv'):
-            return os.environ.get(rest[0], ' '.join(rest[1:])) if rest else ''
+            return self.env.get(rest[0], ' '.join(rest[1:])) if rest else ''
         if command == 'anon':
             return '_'.join(rest)
         raise Unsupported('$(%s ...)' % command)
 
 
-def analyse(path, package_dir, package=PACKAGE):
+def analyse(path, package_dir, package=PACKAGE, env=None):
     """Analyse the launch file ``path`` of the package ``package`` in ``package_dir``; never raises for
-    content."""
-    analysis = Analysis(path, package_dir, package)
+    content.
+
+    :param env: what ``$(env)`` / ``$(optenv)`` see: the environment of a ROS process in the box
+        (:func:`exam_lab.grader.host.sandbox.box_env`); none when not given.
+    """
+    analysis = Analysis(path, package_dir, package, env)
+    if inside(package_dir, path) is None:
+        analysis.problems.append(_outside(path))
+        return analysis
     try:
-        _read_file(analysis, path, _Scope(path, package_dir, package=package), '/', depth=0)
+        _read_file(analysis, path, _Scope(path, package_dir, package=package, env=analysis.env), '/', depth=0)
     except Unsupported as err:
         analysis.problems.append('cannot evaluate %s: %s' % (os.path.relpath(path, package_dir), err))
     return analysis
 
 
+def _outside(written):
+    return 'file outside the package: %s not read' % written
+
+
 def _read_file(analysis, path, scope, ns, depth):
+    analysis.files_read += 1
+    if analysis.files_read > MAX_FILES:
+        raise Unsupported('more than %d launch files read (includes of includes)' % MAX_FILES)
     try:
         tree = ET.parse(path)
     except (ET.ParseError, OSError) as err:
         analysis.problems.append('%s is not valid XML: %s' % (os.path.relpath(path, analysis.package_dir), err))
         return
-    analysis.trees[path] = tree
+    analysis.trees[os.path.realpath(path)] = tree
     root = tree.getroot()
     if root.tag != 'launch':
         analysis.problems.append('%s: the root element is <%s>, not <launch>' % (path, root.tag))
@@ -239,8 +312,9 @@ def _read_children(analysis, parent, scope, ns, node, depth):
         elif tag == 'node':
             name = scope.substitute(element.get('name'))[0] or ''
             node_ns = _join(ns, scope.substitute(element.get('ns'))[0]) if element.get('ns') else ns
-            this = Node(scope.substitute(element.get('pkg'))[0], scope.substitute(element.get('type'))[0],
-                        name, node_ns, scope.path)
+            node_type, type_origin = scope.substitute(element.get('type'))
+            this = Node(scope.substitute(element.get('pkg'))[0], node_type, name, node_ns, scope.path,
+                        type_origin or Origin(scope.path, element, 'attr', 'type'))
             analysis.nodes.append(this)
             _read_children(analysis, element, scope, _join(node_ns, name), this, depth)
         elif tag == 'param':
@@ -287,11 +361,14 @@ def _read_rosparam(analysis, element, scope, ns, node):
     base = _join(ns, scope.substitute(element.get('ns'))[0]) if element.get('ns') else ns
     param = scope.substitute(element.get('param'))[0] if element.get('param') else None
     if element.get('file'):
-        yaml_file = scope.substitute(element.get('file'))[0]
-        if not yaml_file.startswith(analysis.package_dir) or not os.path.isfile(yaml_file):
+        yaml_file = inside(analysis.package_dir, scope.substitute(element.get('file'))[0])
+        if yaml_file is None:
+            analysis.problems.append(_outside('rosparam %s' % element.get('file')))
+            return
+        if not os.path.isfile(yaml_file):
             analysis.problems.append('rosparam file %s not found in the package' % element.get('file'))
             return
-        with open(yaml_file) as f:
+        with open(yaml_file, encoding='utf-8', errors='replace') as f:
             text = f.read()
         kind = 'yaml_file'
     else:
@@ -301,9 +378,10 @@ def _read_rosparam(analysis, element, scope, ns, node):
             text = scope.substitute(text)[0]
         kind = 'yaml'
     try:
-        data = yaml.safe_load(text)
+        data = load_yaml(text)
     except yaml.YAMLError as err:
-        analysis.problems.append('rosparam YAML does not parse: %s' % err)
+        analysis.problems.append('rosparam %s not read: %s'
+                                 % (element.get('file') or 'inline YAML', yaml_problem(err)))
         return
     prefix = _join(base, param) if param else base
     for key, value in _flatten(data, ()):
@@ -330,7 +408,11 @@ def _read_include(analysis, element, scope, ns, depth):
         if sheet_of_drone(found.group(1)):
             analysis.included_drones.append(found.group(1))
         return  # another package's launch file: not the student's, not analysed
-    if depth > 5 or not os.path.isfile(target):
+    real = inside(analysis.package_dir, target)
+    if real is None:
+        analysis.problems.append(_outside('include %s' % element.get('file')))
+        return
+    if depth > 5 or not os.path.isfile(real):
         analysis.problems.append('include %s not found' % element.get('file'))
         return
     passed = {}
@@ -338,8 +420,8 @@ def _read_include(analysis, element, scope, ns, depth):
         if child.tag == 'arg' and child.get('value') is not None:
             value, origin = scope.substitute(child.get('value'))
             passed[child.get('name')] = (value, origin or Origin(scope.path, child, 'attr', 'value'))
-    _read_file(analysis, target, _Scope(target, analysis.package_dir, passed, analysis.package), inner_ns,
-               depth + 1)
+    _read_file(analysis, real, _Scope(real, analysis.package_dir, passed, analysis.package, analysis.env),
+               inner_ns, depth + 1)
 
 
 # --- choosing --------------------------------------------------------------------------------------
@@ -409,6 +491,9 @@ def derive(analysis, tag, changes=None):
     are dropped), sends every node's output to the screen, and drops ``launch-prefix`` (a terminal or
     debugger the grader does not have). ``changes`` maps an :class:`Origin` to the new literal value.
     Included files of the exam package get derived copies too, and the includes point to them.
+
+    Every file is written beside its original, all of which are inside the package (:func:`analyse`
+    reads no other), and names the others as ``$(find <package>)/...``, which the run box resolves.
     """
     changes = changes or {}
     originals = {}
@@ -423,8 +508,9 @@ def derive(analysis, tag, changes=None):
         derived = {path: _derived_path(path, tag) for path in analysis.trees}
         for path, tree in analysis.trees.items():
             _strip(tree.getroot(), path, analysis, derived)
-            tree.write(derived[path], encoding='unicode')
-        return derived[analysis.path]
+            with _create(analysis, derived[path]) as f:
+                tree.write(f, encoding='unicode')
+        return _derived_path(analysis.path, tag)
     finally:
         for element, (attrib, text, children) in originals.items():
             element.attrib.clear()
@@ -437,22 +523,43 @@ def _derived_path(path, tag):
     return os.path.join(os.path.dirname(path), '.grader-%s-%s' % (tag, os.path.basename(path)))
 
 
+def _found(analysis, path):
+    """``path`` (inside the package) as the run box finds it: ``$(find <package>)/relative/path``."""
+    folder = os.path.relpath(os.path.realpath(os.path.dirname(path)), os.path.realpath(analysis.package_dir))
+    return '$(find %s)/%s' % (analysis.package, os.path.normpath(os.path.join(folder, os.path.basename(path))))
+
+
+def _create(analysis, path):
+    """``path`` opened for writing, only inside the package and never through a link a student left."""
+    folder = os.path.dirname(path)
+    if os.path.realpath(folder) != os.path.realpath(analysis.package_dir) \
+            and inside(analysis.package_dir, folder) is None:
+        raise ValueError('derived file %s would be outside the package %s' % (path, analysis.package_dir))
+    try:
+        os.unlink(path)
+    except OSError as err:
+        if err.errno != errno.ENOENT:
+            raise
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
+    return os.fdopen(fd, 'w', encoding='utf-8')
+
+
 def _apply(origin, value, analysis, tag, yaml_files):
     if origin.kind == 'attr':
         origin.element.set(origin.key, str(value))
         return
     if origin.kind == 'yaml':
-        data = yaml.safe_load(origin.element.text or '')
+        data = load_yaml(origin.element.text or '')
         origin.element.text = yaml.safe_dump(_set_key(data, origin.key, value), default_flow_style=False)
         return
     source = yaml_files.get(origin.yaml_file, origin.yaml_file)
-    with open(source) as f:
-        data = yaml.safe_load(f.read())
+    with open(source, encoding='utf-8', errors='replace') as f:
+        data = load_yaml(f.read())
     target = _derived_path(origin.yaml_file, tag)
-    with open(target, 'w') as f:
+    with _create(analysis, target) as f:
         f.write(yaml.safe_dump(_set_key(data, origin.key, value), default_flow_style=False))
     yaml_files[origin.yaml_file] = target
-    origin.element.set('file', target)
+    origin.element.set('file', _found(analysis, target))
 
 
 def _set_key(data, key, value):
@@ -464,7 +571,7 @@ def _set_key(data, key, value):
 
 
 def _strip(parent, path, analysis, derived):
-    scope = _Scope(path, analysis.package_dir, package=analysis.package)
+    scope = _Scope(path, analysis.package_dir, package=analysis.package, env=analysis.env)
     for element in list(parent):
         if not isinstance(element.tag, str):
             continue
@@ -481,11 +588,11 @@ def _strip(parent, path, analysis, derived):
             continue
         elif element.tag == 'include':
             try:
-                target = scope.substitute(element.get('file'))[0]
+                target = inside(analysis.package_dir, scope.substitute(element.get('file'))[0])
             except Unsupported:
                 target = None
             if target in derived:
-                element.set('file', derived[target])
+                element.set('file', _found(analysis, derived[target]))
             else:
                 parent.remove(element)
             continue

@@ -214,6 +214,31 @@ def make_runnable(package_dir, launched=()):
     return notes
 
 
+def node_type_fixes(package_dir, nodes):
+    """What a teacher changes in the launch file before running it: a node whose ``type`` names no
+    file of the package while ``<type>.py`` is one of its scripts (``type="exam_node"`` beside
+    ``scripts/exam_node.py``) is run as ``<type>.py``. The student's file is left as handed in
+    (question 12 is judged on it).
+
+    :param nodes: the launched :class:`~exam_lab.grader.boxed.launch.Node` s of the package.
+    :returns: ``({node.type_origin: fixed type}, [a note for each fix])``, the changes for
+        :func:`~exam_lab.grader.boxed.launch.derive`.
+    """
+    names = set()
+    for dirpath, dirnames, filenames in os.walk(package_dir):
+        dirnames[:] = [d for d in dirnames if not d.startswith('.')]
+        names.update(filenames)
+    scripts = dict((os.path.basename(p), os.path.relpath(p, package_dir)) for p in python_files(package_dir))
+    changes, notes = {}, []
+    for node in nodes:
+        meant = (node.type or '') + '.py'
+        if node.type and node.type not in names and meant in scripts and node.type_origin not in changes:
+            changes[node.type_origin] = meant
+            notes.append('the launch file starts type="%s", which is no file of the package: run as "%s" (%s), '
+                         'as a teacher would fix it' % (node.type, meant, scripts[meant]))
+    return changes, notes
+
+
 def student_code(package_dir):
     """The Python files a teacher reads for comments and quality: not setup.py, not tests."""
     return [p for p in python_files(package_dir) if os.path.basename(p) != 'setup.py'

@@ -10,7 +10,9 @@ meant, macOS's ``__MACOSX/`` is skipped, a whole workspace's build products (``b
 are dropped, links (catkin's ``src/CMakeLists.txt``) and special files are dropped, never followed;
 each is noted. Copies of folders never follow links.
 """
+import datetime
 import os
+import re
 import shutil
 import stat
 import tarfile
@@ -49,6 +51,11 @@ ARCHIVE_ENDINGS = ('.zip', '.tar', '.tar.gz', '.tgz', '.tar.bz2', '.tbz2', '.tar
 _UNSUPPORTED = ((b'Rar!\x1a\x07', 'a RAR archive'), (b'7z\xbc\xaf\x27\x1c', 'a 7-Zip archive'),
                 (b'\x1f\x8b', 'a gzip file that holds no tar'), (b'BZh', 'a bzip2 file that holds no tar'),
                 (b'\xfd7zXZ\x00', 'an xz file that holds no tar'), (b'%PDF', 'a PDF document'))
+#: A version number at the end of an upload's name (its archive ending off): exam_v2, exam-2,
+#: exam (2) as Moodle or a browser names a second copy, examV3.
+_VERSION = re.compile(r'(?:^|[^0-9])(?:[vV]|[_ -]|\()(\d{1,3})\)?$')
+#: Zip's "no date" (MS-DOS time starts in 1980): a date on or before it says nothing.
+_NO_DATE = datetime.datetime(1980, 1, 2)
 #: At most this many notes of one kind (links dropped, duplicates) are listed; the rest are counted.
 MAX_LISTED = 5
 
@@ -388,15 +395,80 @@ def _student_packages(root):
                                          p.count(os.sep), p))
 
 
-def open_submission(path, scratch, notes, fixes=None, budget=None):
+def archive_date(path):
+    """The newest modification date of the files in an archive (what the student's machine wrote when
+    it made it), or None when it has none the grader can read."""
+    dates = []
+    try:
+        if archive_kind(path) == 'zip':
+            with zipfile.ZipFile(path) as zf:
+                dates = [datetime.datetime(*info.date_time) for info in zf.infolist() if not info.is_dir()]
+        elif archive_kind(path) == 'tar':
+            with tarfile.open(path, 'r:*') as tf:
+                dates = [datetime.datetime.utcfromtimestamp(m.mtime) for m in tf if m.isfile()]
+    except (zipfile.BadZipFile, tarfile.TarError, OSError, EOFError, ValueError, OverflowError):
+        return None
+    dates = [d for d in dates if d > _NO_DATE]
+    return max(dates) if dates else None
+
+
+def version_number(name):
+    """The version number at the end of an upload's name (``exam_v2.zip``: 2), or None."""
+    stem = os.path.basename(name)
+    for ending in sorted(ARCHIVE_ENDINGS, key=len, reverse=True):
+        if stem.lower().endswith(ending):
+            stem = stem[:-len(ending)]
+            break
+    match = _VERSION.search(stem)
+    return int(match.group(1)) if match else None
+
+
+def choose_upload(uploads):
+    """Which of several uploads of one student to grade: the newest by its files' dates, then by the
+    version number in its name.
+
+    :param uploads: ``[(name, date or None, version or None)]``.
+    :returns: ``(index, why, ambiguous)``; ``ambiguous`` when neither the dates nor the names tell the
+        last one apart, or when they disagree (the teacher must look; the index is then the one the
+        dates, else the names, else the name's order favour).
+    """
+    def shown(i):
+        name, date, version = uploads[i]
+        return '%s (%s)' % (name, 'files dated %s' % date.strftime('%Y-%m-%d %H:%M') if date else 'no dates')
+    indices = list(range(len(uploads)))
+    dated = [i for i in indices if uploads[i][1] is not None]
+    versions = [i for i in indices if uploads[i][2] is not None]
+    by_version = max(versions, key=lambda i: uploads[i][2]) if versions else None
+    unique_version = by_version is not None and \
+        [uploads[i][2] for i in versions].count(uploads[by_version][2]) == 1 and \
+        all(uploads[i][2] is not None or uploads[by_version][2] > 1 for i in indices)
+    listed = ', '.join(shown(i) for i in indices)
+    if len(dated) == len(uploads):
+        newest = max(dated, key=lambda i: uploads[i][1])
+        if [uploads[i][1] for i in dated].count(uploads[newest][1]) == 1:
+            if unique_version and by_version != newest:
+                return newest, ('the dates and the names disagree on which is the last: %s; graded %s, the '
+                                'newest by its dates' % (listed, uploads[newest][0])), True
+            return newest, 'graded %s, the newest by its files\' dates, of %s' % (uploads[newest][0], listed), False
+    if unique_version:
+        return by_version, ('graded %s, the highest version number in its name (the dates do not tell: %s)'
+                            % (uploads[by_version][0], listed)), False
+    chosen = max(dated, key=lambda i: uploads[i][1]) if dated else sorted(indices, key=lambda i: uploads[i][0])[-1]
+    return chosen, ('neither the dates nor the names tell which upload is the last: %s; graded %s'
+                    % (listed, uploads[chosen][0])), True
+
+
+def open_submission(path, scratch, notes, fixes=None, budget=None, uploads=None):
     """The folder of the student's package in a submission: a folder, an archive, a folder of
     archives, archives in archives (``MAX_NESTING`` deep), a whole workspace.
 
     Archives are unpacked (checked) below ``scratch``, all paid from one ``budget``. ``notes`` receives
     what the teacher should know (other candidates, refused archives, what was dropped); ``fixes`` the
-    changes to what the student uploaded (links dropped, a package not named ``exam``). Raises
-    UnpackError when there is no package, saying what was found instead.
+    changes to what the student uploaded (links dropped, a package not named ``exam``); ``uploads``
+    one ``{"files", "chosen", "why", "ambiguous"}`` per choice among several uploads holding a package
+    (:func:`choose_upload`). Raises UnpackError when there is no package, saying what was found instead.
     """
+    uploads = [] if uploads is None else uploads
     budget = budget or Budget()
     fixes = notes if fixes is None else fixes
     path = os.path.abspath(path)
@@ -406,7 +478,7 @@ def open_submission(path, scratch, notes, fixes=None, budget=None):
         root = _unpack_one(path, scratch, notes, fixes, budget, counter)
     else:
         root = path
-    found = _search(root, scratch, notes, fixes, budget, counter, 0, seen)
+    found = _search(root, scratch, notes, fixes, budget, counter, 0, seen, uploads)
     if not found:
         refused = [s for s in seen if '(refused: ' in s or 'cannot be opened' in s]
         if refused:  # the reason is the archive that could not be opened, not a missing package
@@ -434,11 +506,13 @@ def _unpack_one(archive, scratch, notes, fixes, budget, counter):
     return target
 
 
-def _search(root, scratch, notes, fixes, budget, counter, depth, seen):
-    """Packages in ``root``, else in the archives it holds (each unpacked once, nested ones too)."""
+def _search(root, scratch, notes, fixes, budget, counter, depth, seen, uploads):
+    """Packages in ``root``, else in the archives it holds (each unpacked once, nested ones too); of
+    several archives holding a package, only the chosen one's (:func:`choose_upload`)."""
     found = _student_packages(root)
     if found or depth >= MAX_NESTING:
         return found
+    holding = []
     for archive in sorted(_archives_in(root)):
         rel = os.path.relpath(archive, root)
         if archive_kind(archive) is None:
@@ -453,10 +527,19 @@ def _search(root, scratch, notes, fixes, budget, counter, depth, seen):
             notes.append('%s refused: %s' % (shown_name(rel), err))
             seen.append('%s (refused: %s)' % (rel, err))
             continue
-        got = _search(inner, scratch, notes, fixes, budget, counter, depth + 1, seen)
+        got = _search(inner, scratch, notes, fixes, budget, counter, depth + 1, seen, uploads)
         if not got:
             seen.append('%s (no package inside)' % shown_name(rel))
+        else:
+            holding.append((rel, archive, got))
         found.extend(got)
+    if len(holding) > 1:
+        index, why, ambiguous = choose_upload([(shown_name(rel), archive_date(archive), version_number(rel))
+                                               for rel, archive, _ in holding])
+        uploads.append({'files': [rel for rel, _, _ in holding], 'chosen': holding[index][0], 'why': why,
+                        'ambiguous': ambiguous})
+        notes.append('%d uploads hold a package: %s' % (len(holding), why))
+        found = holding[index][2]
     if not found:
         seen.extend(shown_name(n) for n in sorted(os.listdir(root))[:MAX_LISTED]
                     if not any(n in s for s in seen))

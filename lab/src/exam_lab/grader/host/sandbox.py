@@ -22,9 +22,17 @@ runs through :meth:`Box.argv`::
   (``build/``, ``devel/``) writable. Fresh ``/proc``, ``/dev``, and private ``/tmp``, ``/var/tmp``,
   ``/dev/shm`` and HOME (size-capped tmpfs). No /root, /home, other students, grader output.
 - **Environment**: empty (``--clearenv``) but for the variables :func:`box_env` lets through.
-- **Limits**: memory and processes by a cgroup of the box's own where the machine lets root make one
-  (cgroup v1 ``memory`` + ``pids``, or v2), always ``prlimit`` (address space, processes, CPU time,
-  file size, open files, no core files). The box's work folder is a tmpfs of ``WORK_BYTES``.
+- **Limits**: memory, processes and CPU by a cgroup of the box's own where the machine lets root make
+  one (cgroup v1 ``memory`` + ``pids`` + ``cpu``, or v2), always ``prlimit`` (address space, processes,
+  CPU time, file size, open files, no core files). The box's work folder is a tmpfs of ``WORK_BYTES``.
+  CPU: at most ``cpus`` cores (a quota: the class's cores shared among the gradings side by side) at
+  the default weight, so 140 busy processes of one box (each ``setsid``: an autogroup of its own) take
+  that box's share, not its classmates' or the judge's.
+- **The judge** (the session's masters and its probe) runs outside the box as uid ``JUDGE_UID_BASE +
+  N`` of the same slot (:meth:`Box.judge_argv`), never root and never the box's uid, in cgroups of its
+  own: the master the student's nodes talk to is bounded in memory (``MASTER_MEMORY_BYTES``: the
+  parameters they set are its memory), and both outweigh a box for CPU (``JUDGE_SHARES``), so a box
+  that burns CPU cannot delay what measures its classmates.
 
 :func:`check` says whether boxes can be made here at all; the runner refuses to grade when they
 cannot unless the teacher accepts the risk by name.
@@ -42,6 +50,8 @@ import time
 
 #: First uid of the boxes (isolate uses 60000+); slot N runs as BOX_UID_BASE + N.
 BOX_UID_BASE = 61000
+#: First uid of the judges: slot N's masters and probe run as JUDGE_UID_BASE + N.
+JUDGE_UID_BASE = 62000
 SLOTS = 64
 LOCK_DIR = '/run/lock/exam-grader'
 #: Where the box sees its workspace, and its private HOME.
@@ -54,6 +64,17 @@ PROCESSES = 512                  # threads count: a rospy node has ~15, roslaunc
 CPU_SECONDS = 300                # each process
 FILE_BYTES = 64 << 20            # each file written, logs included
 OPEN_FILES = 1024
+#: CPU weights (cgroup v1 cpu.shares; v2 cpu.weight = shares * 100 / 1024): a box has the default, the
+#: judge's master and probe four times it, so they keep their timing beside a box that burns its quota.
+BOX_SHARES = 1024
+JUDGE_SHARES = 4096
+#: Period of the CPU quota (v1 cpu.cfs_period_us, v2 cpu.max), microseconds.
+CPU_PERIOD_US = 100000
+#: The least CPU quota of a box, in cores (a build or a node needs one at times).
+MIN_BOX_CPUS = 0.5
+#: The master the student's nodes talk to (roscore: rosmaster and rosout), and the probe: their memory.
+MASTER_MEMORY_BYTES = 384 << 20
+PROBE_MEMORY_BYTES = 512 << 20
 WORK_BYTES = 512 << 20           # build/ + devel/
 TMP_BYTES = 64 << 20             # each of /tmp, /var/tmp, /dev/shm, HOME
 #: /etc files a ROS process reads (name resolution of localhost, the dynamic linker, alternatives).
@@ -93,7 +114,7 @@ def _own_cgroups():
             for line in f:
                 _, controllers, path = line.rstrip('\n').split(':', 2)
                 for name in controllers.split(','):
-                    if name in ('memory', 'pids') and os.path.isdir('/sys/fs/cgroup/%s' % name):
+                    if name in ('memory', 'pids', 'cpu') and os.path.isdir('/sys/fs/cgroup/%s' % name):
                         found[name] = ('/sys/fs/cgroup/%s' % name, path)
                     elif controllers == '' and os.path.isfile('/sys/fs/cgroup/cgroup.controllers'):
                         found[''] = ('/sys/fs/cgroup', path)
@@ -102,32 +123,108 @@ def _own_cgroups():
     return found
 
 
-def _make_cgroups(name):
-    """Folders of new cgroups for one box with their limits set; [] when the machine does not let us."""
+def box_cpus(jobs, cores=None):
+    """The CPU quota of one box, in cores, when ``jobs`` gradings run side by side on ``cores`` (default
+    this machine's): an equal part of the machine, at least MIN_BOX_CPUS."""
+    cores = cores or os.cpu_count() or 1
+    return max(MIN_BOX_CPUS, float(cores) / max(1, jobs))
+
+
+def cgroup_limits(memory, shares, pids=None, cpus=None, v2=False):
+    """``[(controller, file, value)]`` that bound a cgroup: ``memory`` bytes, CPU weight ``shares``
+    (v1 units), at most ``pids`` processes and ``cpus`` cores (None: no bound). The controller is ''
+    under cgroup v2 (one folder for all)."""
+    quota = int(cpus * CPU_PERIOD_US) if cpus else None
+    if v2:
+        limits = [('', 'memory.max', memory), ('', 'cpu.weight', max(1, min(10000, shares * 100 // 1024)))]
+        if quota:
+            limits.append(('', 'cpu.max', '%d %d' % (quota, CPU_PERIOD_US)))
+        if pids:
+            limits.append(('', 'pids.max', pids))
+        return limits
+    limits = [('memory', 'memory.limit_in_bytes', memory), ('cpu', 'cpu.shares', shares)]
+    if quota:
+        limits += [('cpu', 'cpu.cfs_period_us', CPU_PERIOD_US), ('cpu', 'cpu.cfs_quota_us', quota)]
+    if pids:
+        limits.append(('pids', 'pids.max', pids))
+    return limits
+
+
+def _make_cgroups(name, memory, shares, pids=None, cpus=None):
+    """Folders of new cgroups called ``name`` with the limits of :func:`cgroup_limits`; [] when the
+    machine does not let us. cgroup v1 needs the ``memory`` controller (and ``pids`` when ``pids`` is
+    bounded); without ``cpu`` the CPU is not bounded. cgroup v2 is untested (needs the controllers
+    enabled in the parent's cgroup.subtree_control)."""
     own = _own_cgroups()
-    made = []
+    made = {}
     try:
-        if 'memory' in own and 'pids' in own:
-            for controller, limit_file, value in (('memory', 'memory.limit_in_bytes', MEMORY_BYTES),
-                                                  ('pids', 'pids.max', PROCESSES)):
-                root, path = own[controller]
-                folder = os.path.join(root, path.lstrip('/'), name)
-                _fresh_folder(folder)
-                made.append(folder)
-                with open(os.path.join(folder, limit_file), 'w') as f:
-                    f.write(str(value))
+        if 'memory' in own and ('pids' in own or not pids):
+            limits = [l for l in cgroup_limits(memory, shares, pids, cpus) if l[0] in own]
         elif '' in own:
-            root, path = own['']
-            folder = os.path.join(root, path.lstrip('/'), name)
-            _fresh_folder(folder)
-            made.append(folder)
-            for limit_file, value in (('memory.max', MEMORY_BYTES), ('pids.max', PROCESSES)):
-                with open(os.path.join(folder, limit_file), 'w') as f:
-                    f.write(str(value))
-        return made
+            limits = cgroup_limits(memory, shares, pids, cpus, v2=True)
+        else:
+            return []
+        for controller, limit_file, value in limits:
+            if controller not in made:
+                root, path = own[controller]
+                made[controller] = os.path.join(root, path.lstrip('/'), name)
+                _fresh_folder(made[controller])
+            with open(os.path.join(made[controller], limit_file), 'w') as f:
+                f.write(str(value))
+        return list(made.values())
     except OSError:
-        _remove_cgroups(made)
+        _remove_cgroups(list(made.values()))
         return []
+
+
+def memory_use(folders):
+    """What the memory cgroup among ``folders`` saw: ``{"limit", "peak" (bytes, None where the kernel
+    does not say), "oom_kills"}``; None without one. v1: memory.max_usage_in_bytes and oom_control;
+    v2: memory.peak and memory.events."""
+    for folder in folders:
+        v1 = os.path.join(folder, 'memory.limit_in_bytes')
+        v2 = os.path.join(folder, 'memory.max')
+        if not os.path.isfile(v1) and not os.path.isfile(v2):
+            continue
+        names = ('memory.limit_in_bytes', 'memory.max_usage_in_bytes', 'memory.oom_control') \
+            if os.path.isfile(v1) else ('memory.max', 'memory.peak', 'memory.events')
+        values = []
+        for name in names:
+            try:
+                with open(os.path.join(folder, name)) as f:
+                    values.append(f.read())
+            except OSError:
+                values.append('')
+        events = dict(line.split() for line in values[2].splitlines() if len(line.split()) == 2)
+        limit, peak = values[0].strip(), values[1].strip()
+        return {'limit': int(limit) if limit.isdigit() else None, 'peak': int(peak) if peak.isdigit() else None,
+                'oom_kills': int(events.get('oom_kill', '0'))}
+    return None
+
+
+def reset_memory_peak(folders):
+    """Start the peak of the memory cgroups among ``folders`` anew (v1; v2 kernels before 6.12 cannot)."""
+    for folder in folders:
+        for name in ('memory.max_usage_in_bytes', 'memory.peak'):
+            try:
+                with open(os.path.join(folder, name), 'w') as f:
+                    f.write('0')
+            except OSError:
+                pass
+
+
+def _join(folders):
+    """The command-line prefix that puts the command in the cgroups ``folders`` (then execs it)."""
+    if not folders:
+        return []
+    return ['sh', '-c', 'for g in "$@"; do case "$g" in --) shift; break;; esac; '
+            'echo $$ > "$g/cgroup.procs" || exit 125; shift; done; exec "$@"', 'sh'] + list(folders) + ['--']
+
+
+def _as_user(uid):
+    """The command-line prefix that drops root for ``uid`` (its own group, none else, no capabilities)."""
+    return ['setpriv', '--reuid=%d' % uid, '--regid=%d' % uid, '--clear-groups', '--no-new-privs',
+            '--inh-caps=-all', '--']
 
 
 def _fresh_folder(folder):
@@ -174,6 +271,23 @@ def pids_of_uid(uid):
     return found
 
 
+def _end_uid(uid):
+    """Kill whatever still runs as ``uid``; returns how many there were."""
+    left = pids_of_uid(uid)
+    for _ in range(3 if left else 0):
+        for pid in pids_of_uid(uid):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass
+        deadline = time.monotonic() + 5.0
+        while time.monotonic() < deadline and pids_of_uid(uid):
+            time.sleep(0.05)
+        if not pids_of_uid(uid):
+            break
+    return len(left)
+
+
 def _tmpfs(path, size, uid):
     """Mount a tmpfs of ``size`` bytes owned by ``uid`` on ``path``; False where root cannot mount."""
     done = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=%d,mode=0700,uid=%d,gid=%d,nosuid,nodev'
@@ -191,15 +305,19 @@ class Box(object):
         sources).
     :param bwrap: False for the unsandboxed mode the teacher asked for by name: same user and limits,
         no namespaces.
+    :param cpus: the box's CPU quota in cores (:func:`box_cpus`); None: its weight only.
     """
 
-    def __init__(self, work, binds=(), bwrap=True):
+    def __init__(self, work, binds=(), bwrap=True, cpus=None):
         self.work = work
         self.binds = [os.path.realpath(b) for b in binds]
         self.bwrap = bwrap
+        self.cpus = cpus
         self.slot = None
         self._lock = None
         self.cgroups = []
+        #: The judge's cgroups: {"master": [folders], "probe": [folders]}.
+        self.judge_cgroups = {}
         self.mounted = False
         self.folder = os.path.join(work, 'box')
         self.notes = []
@@ -207,13 +325,14 @@ class Box(object):
     def describe(self):
         """What the session needs to make this box's command lines (JSON): see :meth:`attached`."""
         return {'work': self.work, 'binds': self.binds, 'bwrap': self.bwrap, 'slot': self.slot,
-                'cgroups': self.cgroups}
+                'cgroups': self.cgroups, 'judge_cgroups': self.judge_cgroups, 'cpus': self.cpus}
 
     @classmethod
     def attached(cls, described):
         """The box :meth:`describe` described, opened by another process (the runner holds it)."""
-        box = cls(described['work'], described['binds'], described['bwrap'])
+        box = cls(described['work'], described['binds'], described['bwrap'], described.get('cpus'))
         box.slot, box.cgroups = described['slot'], described['cgroups']
+        box.judge_cgroups = described.get('judge_cgroups', {})
         return box
 
     @property
@@ -224,6 +343,11 @@ class Box(object):
     @property
     def uid(self):
         return BOX_UID_BASE + self.slot
+
+    @property
+    def judge_uid(self):
+        """The uid of this slot's judge (masters, probe); None unsandboxed and not root."""
+        return JUDGE_UID_BASE + self.slot if self.slot is not None else None
 
     @property
     def workspace(self):
@@ -247,7 +371,7 @@ class Box(object):
             except OSError:
                 lock.close()
                 continue
-            if _uid_in_use(BOX_UID_BASE + slot):
+            if _uid_in_use(BOX_UID_BASE + slot) or _uid_in_use(JUDGE_UID_BASE + slot):
                 lock.close()
                 continue
             self.slot, self._lock = slot, lock
@@ -272,10 +396,16 @@ class Box(object):
         for dirpath, dirnames, filenames in os.walk(self.folder):
             for name in [dirpath] + [os.path.join(dirpath, n) for n in dirnames + filenames]:
                 os.lchown(name, self.uid, self.uid)
-        self.cgroups = _make_cgroups('exam-box-%d' % self.slot)
+        self.cgroups = _make_cgroups('exam-box-%d' % self.slot, MEMORY_BYTES, BOX_SHARES, PROCESSES, self.cpus)
         if not self.cgroups:
             self.notes.append('no cgroup could be made: memory limited per process (%d GB of address '
-                              'space), processes per uid (%d)' % (ADDRESS_SPACE_BYTES >> 30, PROCESSES))
+                              'space), processes per uid (%d), CPU not bounded' % (ADDRESS_SPACE_BYTES >> 30, PROCESSES))
+        self.judge_cgroups = {
+            'master': _make_cgroups('exam-master-%d' % self.slot, MASTER_MEMORY_BYTES, JUDGE_SHARES),
+            'probe': _make_cgroups('exam-judge-%d' % self.slot, PROBE_MEMORY_BYTES, JUDGE_SHARES)}
+        if not self.judge_cgroups['master']:
+            self.notes.append('no cgroup could be made for the judge: the master the student\'s nodes talk '
+                              'to is not bounded in memory')
         return self
 
     def __enter__(self):
@@ -293,13 +423,8 @@ class Box(object):
         limits = ['prlimit', '--as=%d' % ADDRESS_SPACE_BYTES, '--nproc=%d' % PROCESSES,
                   '--cpu=%d' % CPU_SECONDS, '--fsize=%d' % FILE_BYTES, '--nofile=%d' % OPEN_FILES,
                   '--core=0', '--']
-        user = ['setpriv', '--reuid=%d' % self.uid, '--regid=%d' % self.uid, '--clear-groups',
-                '--no-new-privs', '--inh-caps=-all', '--'] if self.slot is not None else []
-        join = []
-        if self.cgroups:
-            join = ['sh', '-c', 'for g in "$@"; do case "$g" in --) shift; break;; esac; '
-                    'echo $$ > "$g/cgroup.procs" || exit 125; shift; done; exec "$@"', 'sh'] + \
-                self.cgroups + ['--']
+        user = _as_user(self.uid) if self.slot is not None else []
+        join = _join(self.cgroups)
         if not self.bwrap:
             os.makedirs(env['HOME'], exist_ok=True)
             if self.slot is not None:
@@ -332,32 +457,31 @@ class Box(object):
             box += ['--setenv', name, value]
         return join + limits + user + box + ['--'] + list(command)
 
+    def judge_argv(self, command, part):
+        """The command line that runs the judge's ``command`` (``part``: "master" or "probe") outside
+        the box, as this slot's judge uid in the judge's cgroups (as the grading user unsandboxed
+        without root). Its environment is the caller's: the judge's own, never the box's."""
+        if self.slot is None:
+            return list(command)
+        return _join(self.judge_cgroups.get(part, [])) + _as_user(self.judge_uid) + list(command)
+
     def leftovers(self):
         """Pids of the box's uid still alive (there should be none once its command ended)."""
         return pids_of_uid(self.uid) if self.slot is not None else []
 
     def end(self):
         """Kill whatever still runs as the box's uid; returns how many there were (0 expected)."""
-        left = self.leftovers()
-        for _ in range(3 if left else 0):
-            for pid in left:
-                try:
-                    os.kill(pid, signal.SIGKILL)
-                except OSError:
-                    pass
-            deadline = time.monotonic() + 5.0
-            while time.monotonic() < deadline and self.leftovers():
-                time.sleep(0.05)
-            if not self.leftovers():
-                break
-        return len(left)
+        return _end_uid(self.uid) if self.slot is not None else 0
 
     def close(self):
         if self.slot is None:
             shutil.rmtree(self.folder, ignore_errors=True)
             return
         self.end()
+        _end_uid(self.judge_uid)  # the session ends its judge's processes; this is for a crashed one
         _remove_cgroups(self.cgroups)
+        for folders in self.judge_cgroups.values():
+            _remove_cgroups(folders)
         if self.mounted:
             subprocess.run(['umount', '-l', self.folder], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                            timeout=30)

@@ -14,7 +14,12 @@ Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of que
 "threshold" also ``fit`` (the main run's calibration), ``targets`` and ``warn_after`` (s the main
 run's WARNING took).
 
-The main scenario (times are the script's, all recorded as ROS time of the events):
+Every time is the wall clock's (``time.time()``), never rospy's ROS time: a student's node can set
+``/use_sim_time`` on the master before the probe's ``init_node`` and publish ``/clock``, and rospy would
+follow. The probe watches for both (a subscriber on ``/clock``, the parameter read at its start and
+end: ``clock`` in its result), and the session refuses such a run.
+
+The main scenario (times are the script's, all recorded as wall-clock times of the events):
 
 1. wait for the student's node; note which inputs it subscribes to and what it publishes;
 2. question 11: a few input pairs (one with another temperature / remote pressure), the value the node
@@ -27,17 +32,22 @@ The main scenario (times are the script's, all recorded as ROS time of the event
    and every leg is checked on the node's own values (``legs``): the rubric judges nothing on a leg the
    node's value did not reach.
 """
+import ast
 import json
+import logging
 import math
 import os
+import re
 import sys
+import threading
 import time
 
 import rosgraph
 import rospy
+from rosgraph_msgs.msg import Clock
 from std_msgs import msg as std_msgs
 
-from exam_lab.grader.score.sheets import LATE_WARNING_S
+from exam_lab.grader.score.sheets import LATE_WARNING_S, request_meaning
 from exam_lab.harness import oracle
 from exam_lab.harness.fake_drone import Drone, TopicRecorder
 from exam_lab.harness.wait import wait_until
@@ -65,6 +75,68 @@ NUMERIC_TYPES = ('Float32', 'Float64', 'Int8', 'Int16', 'Int32', 'Int64', 'UInt8
 VALUE_TYPES = {'std_msgs/%s' % name: getattr(std_msgs, name) for name in NUMERIC_TYPES}
 #: Topics every node has or that are never an answer.
 IGNORED_TOPICS = ('/rosout', '/rosout_agg', '/diagnostics')
+
+
+#: rospy's words, in the probe's own log, when a subscriber asks for another type than the drone
+#: publishes (the md5sums differ): "Could not process inbound connection: topic types do not match:
+#: [std_msgs/Float64] vs. [std_msgs/Float32]{'callerid': '/exam', 'topic': '/temperature', ...}".
+_TYPE_REFUSAL = re.compile(r'topic types do not match: \[([^\]]*)\] vs\. \[([^\]]*)\](\{.*\})')
+
+
+class RefusedConnections(logging.Handler):
+    """The subscriptions the probe's publishers refused, read from rospy's own warning: which node
+    asked for which topic with which type. The master lists such a node as a subscriber, yet it never
+    gets a message (rospy drops the connection), so only this says what the node subscribed with."""
+
+    def __init__(self):
+        logging.Handler.__init__(self, logging.WARNING)
+        self._lock_refused = threading.Lock()
+        self._refused = {}
+
+    def emit(self, record):
+        try:
+            match = _TYPE_REFUSAL.search(record.getMessage())
+            header = ast.literal_eval(match.group(3)) if match else None
+        except (ValueError, SyntaxError):
+            return
+        if isinstance(header, dict) and header.get('topic'):
+            with self._lock_refused:
+                self._refused[str(header['topic'])] = {'node': str(header.get('callerid', '?')),
+                                                       'wanted': match.group(1), 'published': match.group(2)}
+
+    def refused(self):
+        """{topic: {"node", "wanted" (the subscriber's type), "published" (the drone's)}}."""
+        with self._lock_refused:
+            return dict(self._refused)
+
+class ClockWatch(object):
+    """Whether anyone set ``/use_sim_time`` or published ``/clock`` during the run: the parameter as
+    rospy's ``init_node`` read it and as it is at the end, the ``/clock`` messages received and the
+    nodes that publish it. Built right after ``init_node``."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._messages = 0
+        self._at_start = self._use_sim_time()
+        self._sub = rospy.Subscriber('/clock', Clock, self._count, queue_size=1)
+
+    @staticmethod
+    def _use_sim_time():
+        try:
+            return rospy.get_param('/use_sim_time', None)
+        except Exception:  # the master answers; a failure is a transient of the XML-RPC call
+            return None
+
+    def _count(self, _msg):
+        with self._lock:
+            self._messages += 1
+
+    def seen(self, graph):
+        """``{"use_sim_time": [at start, at end], "messages", "publishers", "ros_time_is_wall"}``."""
+        with self._lock:
+            messages = self._messages
+        return {'use_sim_time': [self._at_start, self._use_sim_time()], 'messages': messages,
+                'publishers': graph.publishers('/clock'), 'ros_time_is_wall': rospy.rostime.is_wallclock()}
 
 
 class Graph(object):
@@ -105,6 +177,10 @@ class Graph(object):
                     nodes[name]['services'].append(service)
         return nodes
 
+    def publishers(self, topic):
+        """Every node that publishes ``topic``, this probe included."""
+        return sorted(dict(self._state()[0]).get(topic, []))
+
     def subscribers(self, topic):
         names = dict(self._state()[1]).get(topic, [])
         return sorted(n for n in names if n in self.student_nodes())
@@ -119,7 +195,7 @@ def _last_value(recorder, since):
 def _settled(recorder, since, before=None):
     """The node's value after an input change at ``since``: read SETTLE_S later; when it is still the
     ``before`` value, waited for until it moves, up to STALE_S (a node that blocks in a callback)."""
-    time.sleep(max(0.0, since + SETTLE_S - rospy.get_time()))
+    time.sleep(max(0.0, since + SETTLE_S - time.time()))
     if before is not None:
         wait_until(lambda: _last_value(recorder, since)[0] not in (None, before), STALE_S - SETTLE_S,
                    period=0.1)
@@ -157,9 +233,12 @@ class Probe(object):
         self.result = {'kind': plan['kind'], 'sheet': self.sheet, 'threshold': plan['threshold'],
                        'margin': plan['margin'], 'delay': plan['delay'], 'start_timeout': plan['start_timeout']}
         self.graph = Graph()
-        self.drone = Drone(self.sheet)
+        self.refusals = RefusedConnections()
+        logging.getLogger('rosout').addHandler(self.refusals)
+        self.clock = ClockWatch()
+        self.drone = Drone(self.sheet, clock=time.time)
         self.recorder = self.drone.output
-        self.t0 = rospy.get_time()
+        self.t0 = time.time()
         self.flown = []  # [time, oracle value] at every input change, for the flight plot's trace
 
     # --- helpers ------------------------------------------------------------------------------------
@@ -183,13 +262,40 @@ class Probe(object):
     def wait_for_node(self):
         nodes = wait_until(lambda: self.graph.student_nodes() or None, self.plan['start_timeout'], period=0.1)
         self.result['nodes'] = nodes or []
-        self.result['node_seen_s'] = None if not nodes else rospy.get_time() - self.t0
+        self.result['node_seen_s'] = None if not nodes else time.time() - self.t0
         if not nodes:
             return False
         inputs = [self.resolved(t) for t in (self.drone.fixed_topic, self.drone.moving_topic)]
         wait_until(lambda: all(self.graph.subscribers(t) for t in inputs), SUBSCRIBE_S, period=0.1)
         self.result['subscribed'] = {t: self.graph.subscribers(t) for t in inputs}
+        self.result['input_types'] = self.input_types(
+            dict(zip(inputs, (self.drone.fixed_topic, self.drone.moving_topic))))
         return True
+
+    def input_types(self, inputs, timeout=3.0):
+        """{input topic: {"type" the node subscribed with, "connected", "refused"}}: a subscription
+        rospy refused (another type than the drone's) shows as no connection and a refusal in our log.
+        Waits up to ``timeout`` s for each subscribed input to connect or be refused.
+
+        :param inputs: {resolved input topic: the feeder's name of it}."""
+        feeder = self.drone.feeder
+
+        def settled():
+            return all(not self.graph.subscribers(t) or feeder.connections(name) > 0 or t in self.refusals.refused()
+                       for t, name in inputs.items())
+        wait_until(settled, timeout, period=0.1)
+        refused = self.refusals.refused()
+        out = {}
+        for topic, name in sorted(inputs.items()):
+            if topic in refused:
+                out[topic] = {'type': refused[topic]['wanted'], 'connected': feeder.connections(name) > 0,
+                              'refused': 'rospy refused the connection: the node asked for %s, the drone '
+                                         'publishes %s' % (refused[topic]['wanted'], refused[topic]['published'])}
+            elif self.graph.subscribers(topic):
+                connected = feeder.connections(name) > 0
+                out[topic] = {'type': 'std_msgs/Float32' if connected else None, 'connected': connected,
+                              'refused': None}
+        return out
 
     def find_output(self):
         expected = self.resolved(self.plan['output'])
@@ -208,7 +314,7 @@ class Probe(object):
         topic, kind = output['topic'], output['type']
         if topic is not None and (topic != expected or kind != 'std_msgs/Float32') and kind in VALUE_TYPES:
             self.recorder.close()
-            self.recorder = TopicRecorder(topic, msg_type=VALUE_TYPES[kind])
+            self.recorder = TopicRecorder(topic, msg_type=VALUE_TYPES[kind], clock=time.time)
         elif topic is not None and kind not in VALUE_TYPES:
             self.recorder = None  # a type the probe cannot read values from
         return topic is not None and self.recorder is not None
@@ -300,10 +406,10 @@ class Probe(object):
             reached = wait_until(lambda: next((t for t, v in self.recorder.samples(since)
                                                if on_side(v, threshold, side)), None), REACH_S, period=0.05)
             start = reached if reached is not None else since
-        time.sleep(max(0.0, start + hold - rospy.get_time()))
+        time.sleep(max(0.0, start + hold - time.time()))
         if late > hold:
-            wait_until(lambda: any(t >= since and s == 'WARNING' for t, s in self.drone.service.calls())
-                       or not self.graph.student_nodes(), start + late - rospy.get_time(), period=0.1)
+            wait_until(lambda: any(t >= since and request_meaning(s) == 'WARNING' for t, s in self.drone.service.calls())
+                       or not self.graph.student_nodes(), start + late - time.time(), period=0.1)
         return since
 
     def flight(self, lo, hi):
@@ -315,7 +421,7 @@ class Probe(object):
         schedule['short_down'] = self.leg(lo, 'below', GAP_S)
         schedule['long_up'] = self.leg(hi, 'above', delay + AFTER_S, late)
         schedule['long_down'] = self.leg(lo, 'below', AFTER_S)
-        schedule['end'] = rospy.get_time()
+        schedule['end'] = time.time()
         self.result['schedule'] = schedule
         self.result['legs'] = self.legs(schedule, ('rest', 'short_up', 'short_down', 'long_up', 'long_down'))
         if self.recorder is not None:
@@ -349,7 +455,7 @@ class Probe(object):
         schedule = {'start': self.leg(self.x_of(self.plan['targets']['start']), 'below', REST_S)}
         hold = max(self.plan['delay'], min(self.plan.get('warn_after') or 0.0, LATE_WARNING_S)) + AFTER_S
         schedule['step'] = self.leg(self.x_of(self.plan['targets']['step']), 'above', hold)
-        schedule['end'] = rospy.get_time()
+        schedule['end'] = time.time()
         self.result['schedule'] = schedule
         self.result['legs'] = self.legs(schedule, ('start', 'step'))
 
@@ -373,9 +479,18 @@ class Probe(object):
                 self.find_output()  # the node's own values, to check the legs on
                 self.threshold_check()
         self.result['calls'] = [[t, s] for t, s in self.drone.service.calls()]
+        self.result['answers'] = [[t, s, ok, message] for t, s, ok, message in self.drone.service.answers()]
         self.result['graph'] = self.graph.summary()
+        seen = self.result.get('input_types') or {}
+        for info in self.result['graph'].values():  # the master gives the publisher's type, not the subscriber's
+            for entry in info['subscribes']:
+                if entry[0] in seen:
+                    entry[1] = '%s%s' % (seen[entry[0]]['type'] or 'type unknown: no connection',
+                                         ', refused by rospy' if seen[entry[0]]['refused'] else '')
         self.result['alive_at_end'] = bool(self.graph.student_nodes())
         self.result['t0'] = self.t0
+        self.result['clock'] = self.clock.seen(self.graph)
+        self.result['judge_uid'] = os.getuid()
         self.result['trace'] = trace(self.recorder.samples(self.t0) if self.recorder is not None else [], self.flown)
         return self.result
 
@@ -387,7 +502,7 @@ TRACE_PERIOD_S = 0.09
 def trace(samples, flown, period=TRACE_PERIOD_S):
     """The flight for the teacher's plot (not for scoring): ``{"published": [[t, value]] at most one
     sample per ``period`` (non-finite values as None), "oracle": [[t, value]] (the oracle's value from t
-    on)}``, ROS times like the calls and the schedule."""
+    on)}``, wall-clock times like the calls and the schedule."""
     kept, last = [], None
     for t, v in samples:
         if last is None or t - last >= period:

@@ -4,9 +4,13 @@ The runner starts this module as root, alone in a network namespace that has onl
 
     python3 -m exam_lab.grader.judge.session JOB.json
 
-Here the grader's side (a master per run, the probe with its fake drone) runs as the grader, under a
-:class:`~exam_lab.harness.supervisor.Supervisor` whose log folder the student's code cannot see; every
-step that runs the student's code (``catkin_make``, ``roslaunch`` and the nodes) runs in the
+This orchestrator stays root (it starts the boxes, which drop root themselves) but parses no byte of the
+student's: it reads roslaunch's output and the probe's JSON, both capped. The judge (a master per run,
+the probe with its fake drone) runs as the slot's judge uid (:meth:`~exam_lab.grader.host.sandbox.Box.judge_argv`:
+not root, not the box's uid), the master bounded in memory and both weighted above the box for CPU,
+under a :class:`~exam_lab.harness.supervisor.Supervisor` whose log folder the student's code cannot see;
+the judge's own folder (``judge_home``: ROS logs, plans, the probe's results) is the judge's, mode 0700.
+Every step that runs the student's code (``catkin_make``, ``roslaunch`` and the nodes) runs in the
 submission's :class:`~exam_lab.grader.host.sandbox.Box`, another user in namespaces of its own that shares
 only this network namespace. The box's environment starts empty: the underlay's, ROS's, a fresh HOME;
 the student's own ``devel/setup.bash`` is sourced inside the box, never here. After each step, the box's
@@ -15,10 +19,12 @@ uid must have no process left (they die with its PID namespace); any found is ki
 Job (JSON, written by :mod:`exam_lab.grader.runner`): ``workspace`` (the student's catkin workspace as
 the box sees it), ``box`` (:meth:`~exam_lab.grader.host.sandbox.Box.describe`), ``underlay`` (setup.bash of
 the simulators' workspace), ``log_dir``, ``namespace`` (the drone's), ``build_timeout`` /
-``run_timeout`` (s), ``runs``: the main run and, when the launch file has a threshold the grader can
-change, the threshold run: each ``{"tag", "launch" (derived launch file, as the box sees it), "plan"
-(for the probe)}``. Writes ``<log_dir>/session.json``: ``{"build": {...}, "runs": [{"tag", "probe"
-(the probe's result or None), "launch": {...}}], "survivors": n}``.
+``run_timeout`` (s), ``judge_home`` (the judge's folder), ``runs``: the main run and, when the launch
+file has a threshold the grader can change, the threshold run: each ``{"tag", "launch" (derived launch
+file, as the box sees it), "plan" (for the probe)}``. Writes ``<log_dir>/session.json``: ``{"build":
+{...}, "runs": [{"tag", "probe" (the probe's result or None), "probe_refused" (why a result was
+refused), "master" (its memory, its uid), "probe_uid", "launch": {...}}], "survivors": n}``, and each
+probe's result as ``<log_dir>/probe-<tag>.json``.
 """
 import json
 import os
@@ -26,12 +32,12 @@ import re
 import sys
 import time
 
-from exam_lab.grader.host.sandbox import Box
+from exam_lab.grader.host.sandbox import FILE_CAP, Box, memory_use, read_capped, reset_memory_peak
+from exam_lab.grader.score.safe_text import clean as clean_text
+from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
 from exam_lab.harness.wait import wait_until
 
-#: Terminal colour and title sequences roslaunch writes even into a file.
-_ANSI = re.compile(r'\x1b\[[0-9;]*m|\x1b?\]2;[^\n\x07]*\x07?')
 #: roslaunch's words for a node that ended: "[exam-1] process has died [pid 12, exit code 1, ...]";
 #: a required node's death is announced as "REQUIRED process [exam-1] has died!" first.
 _ENDED = re.compile(r'(?:\[([^\]\s]+)\] )?process has (died|finished cleanly)(?: \[pid \d+, (exit code -?\d+))?')
@@ -51,10 +57,10 @@ def tail(text, lines=TAIL_LINES):
 
 
 def clean(output):
-    """roslaunch's output without colours and without its own chatter: what the nodes printed, and
-    roslaunch's words about them."""
+    """roslaunch's output without control characters (its colours and titles, a node's escape
+    sequences) and without its own chatter: what the nodes printed, and roslaunch's words about them."""
     kept = []
-    for line in _ANSI.sub('', output).splitlines():
+    for line in clean_text(output).splitlines():
         if not _CHATTER.match(line.strip('=')) or 'process has' in line:
             kept.append(line.strip('=') if line.startswith('=') else line)
     return '\n'.join(kept)
@@ -65,7 +71,7 @@ def launch_outcome(output, workspace=None):
     Paths inside ``workspace`` are shown relative to its src/ (``exam/scripts/...``)."""
     if workspace:
         output = output.replace(workspace.rstrip('/') + '/src/', '').replace(workspace.rstrip('/'), '<ws>')
-    text = _ANSI.sub('', output)
+    text = clean_text(output)
     ended, required = [], None
     for line in text.splitlines():
         match = _REQUIRED.search(line)
@@ -83,18 +89,40 @@ def warned_in_long_excursion(probe):
     schedule = (probe or {}).get('schedule') or {}
     if 'long_up' not in schedule:
         return False
-    return any(status == 'WARNING' and schedule['long_up'] <= t <= schedule['long_down']
+    return any(request_meaning(status) == 'WARNING' and schedule['long_up'] <= t <= schedule['long_down']
                for t, status in probe.get('calls', []))
 
 
+def clock_problem(clock):
+    """Why a run whose probe saw ``clock`` (its ``ClockWatch``) is not the judge's to measure, or None:
+    someone set ``/use_sim_time`` or published ``/clock`` (the node under test counting on a clock of
+    its own making; the probe times on the wall clock regardless)."""
+    if not isinstance(clock, dict):
+        return 'the probe did not say whether /clock was published'
+    said = []
+    if any(clock.get('use_sim_time') or []):
+        said.append('/use_sim_time was set on the master')
+    if clock.get('messages') or clock.get('publishers'):
+        said.append('/clock was published (%s messages%s)' % (
+            clock.get('messages', 0),
+            ' by %s' % ', '.join(map(str, clock['publishers'])) if clock.get('publishers') else ''))
+    if said:
+        return '%s: the grader times the node on the wall clock only; grade it by hand' % ' and '.join(said)
+    return None
+
+
 def probe_problem(result, plan, started, finished):
-    """Why the probe's ``result`` cannot be this run's measurement, or None: every time it records
-    (wall clock: ROS time without sim time) must lie between the probe's start and the result's
-    arrival, and the flight must have lasted its schedule (the long excursion at least the delay)."""
+    """Why the probe's ``result`` cannot be this run's measurement, or None: it has times, nobody set
+    the time (:func:`clock_problem`), every time it records (wall clock) must lie between the probe's
+    start and the result's arrival, and the flight must have lasted its schedule (the long excursion at
+    least the delay)."""
     schedule = result.get('schedule') or {}
     times = [t for t in [result.get('t0')] + list(schedule.values()) if isinstance(t, (int, float))]
     if not times:
         return 'the probe\'s result has no times'
+    problem = clock_problem(result.get('clock'))
+    if problem:
+        return problem
     if min(times) < started - 1.0 or max(times) > finished + 1.0:
         return 'the probe\'s times (%.1f to %.1f) are not within its run (%.1f to %.1f)' % (
             min(times), max(times), started, finished)
@@ -108,71 +136,177 @@ def probe_problem(result, plan, started, finished):
 def warning_latency(probe):
     """Seconds from the long excursion's start to the main run's first WARNING in it, or None."""
     schedule = (probe or {}).get('schedule') or {}
-    times = [t for t, status in (probe or {}).get('calls', []) if status == 'WARNING'
+    times = [t for t, status in (probe or {}).get('calls', []) if request_meaning(status) == 'WARNING'
              and schedule.get('long_up', float('inf')) <= t <= schedule.get('long_down', 0.0)]
     return min(times) - schedule['long_up'] if times else None
+
+
+#: roslaunch's own check of the launch file as handed in: s at most, lines of its words kept.
+LAUNCH_CHECK_TIMEOUT = 30.0
+LAUNCH_CHECK_LINES = 8
+#: Run in the box by the system's python3: roslaunch's loader reads the file as ``roslaunch exam
+#: exam.launch`` would (every include, argument, node name: ``roslaunch --nodes`` does the same) without
+#: starting anything, and says what roslaunch would print as errors before launching (unknown tags and
+#: attributes), which ``roslaunch --nodes`` keeps to itself.
+_LAUNCH_CHECK = '''
+import sys
+from roslaunch.config import load_config_default
+try:
+    config = load_config_default([sys.argv[1]], None, verbose=False, assign_machines=False)
+except Exception as err:
+    print('%s: %s' % (type(err).__name__, ' '.join(str(err).split())))
+    sys.exit(1)
+for error in config.config_errors:
+    print('WARNING: %s' % ' '.join(str(error).split())[:200])
+for node in config.nodes:
+    print('/' + (node.namespace + node.name).strip('/'))
+'''
+
+
+def launch_verdict(sup, job, base_env, box):
+    """roslaunch's verdict on the student's launch file as handed in (``job["handed_in_launch"]``, in
+    the workspace's src/), read by roslaunch's own loader in the box with the student's workspace
+    sourced (:data:`_LAUNCH_CHECK`). ``{"file" (in the package), "status" (exit code, None when it did
+    not finish), "refused" (roslaunch's words, '' when accepted), "warnings" [lines], "nodes" [names]}``;
+    None without a launch file. The output comes from the box: capped, read as text."""
+    relative = job.get('handed_in_launch')
+    if not relative:
+        return None
+    path = os.path.join(job['workspace'], 'src', relative)
+    status, output, _ = sup.run('launch-check', box.argv(
+        ['bash', '-c', 'source "$1/devel/setup.bash" && exec /usr/bin/python3 -c "$2" "$3"', 'bash',
+         job['workspace'], _LAUNCH_CHECK, path], dict(base_env, ROS_HOME=os.path.join(box.home, 'ros-check'))),
+        timeout=LAUNCH_CHECK_TIMEOUT)
+    lines = [l.strip()[:300] for l in clean_text(output).replace(job['workspace'].rstrip('/') + '/src/', '')
+             .splitlines() if l.strip()]
+    words = [l for l in lines if not l.startswith('/')]
+    return {'file': relative.split('/', 1)[-1], 'status': status,
+            'refused': '' if status == 0 else ' '.join(words[-LAUNCH_CHECK_LINES:]) or
+            ('roslaunch did not finish within %.0f s' % LAUNCH_CHECK_TIMEOUT if status is None
+             else 'roslaunch exit %s' % status),
+            'warnings': [l[len('WARNING: '):] for l in words if l.startswith('WARNING: ')][:LAUNCH_CHECK_LINES]
+            if status == 0 else [],
+            'nodes': [l for l in lines if l.startswith('/')][:20]}
+
+
+def capped_log(sup, name):
+    """What a process of the box printed, its middle cut beyond twice LOG_PART (:func:`read_capped`):
+    the orchestrator never reads more of what the student wrote."""
+    return read_capped(sup.log(name)) or ''
+
+
+def uid_of(pid):
+    """The real uid of the living process ``pid``, or None."""
+    try:
+        with open('/proc/%d/status' % pid) as f:
+            return int(next(line for line in f if line.startswith('Uid:')).split()[1])
+    except (OSError, StopIteration, ValueError, IndexError):
+        return None
+
+
+def master_problem(master, died):
+    """Why a run whose master ended early (``died``) or hit its memory bound (``master``: the cgroup's
+    :func:`~exam_lab.grader.host.sandbox.memory_use`) is not one to score, or None."""
+    memory = master.get('memory') or {}
+    if memory.get('oom_kills'):
+        return ('the master the node talks to went over its memory bound of %d MB (%d process(es) killed): '
+                'the node\'s parameters or messages filled it' % ((memory.get('limit') or 0) >> 20, memory['oom_kills']))
+    if died:
+        return 'the master the node talks to ended during the run'
+    return None
 
 
 def run_one(sup, job, run, base_env, box):
     """Start a master, the student's launch (in the box) and the probe; return the run's record."""
     tag = run['tag']
-    log_dir = sup.log_dir
-    master = sup.start_master(name='master-%s' % tag)
+    log_dir, judge_dir = sup.log_dir, job['judge_home']
+    reset_memory_peak(box.judge_cgroups.get('master', []))
+    killed_before = (memory_use(box.judge_cgroups.get('master', [])) or {}).get('oom_kills', 0)
+    master = sup.start_master(name='master-%s' % tag, wrap=box.judge_argv([], 'master'))
+    record = {'tag': tag, 'probe': None, 'master': {'uid': uid_of(master.proc.pid)}}
     launch_env = ros_env(base_env, master.uri, os.path.join(box.home, 'ros-%s' % tag), ip='127.0.0.1')
     launch = sup.start('launch-%s' % tag, box.argv(
         ['bash', '-c', 'source "$1/devel/setup.bash" && exec roslaunch --screen "$2"', 'bash',
          job['workspace'], run['launch']], launch_env))
-    plan_path = os.path.join(log_dir, 'plan-%s.json' % tag)
-    result_path = os.path.join(log_dir, 'probe-%s.json' % tag)
-    with open(plan_path, 'w') as f:
-        json.dump(run['plan'], f, indent=1, sort_keys=True)
-    probe_env = ros_env(master.env, master.uri, os.path.join(log_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')
+    plan_path = os.path.join(judge_dir, 'plan-%s.json' % tag)
+    result_path = os.path.join(judge_dir, 'probe-%s.json' % tag)
+    for path in (plan_path, os.path.join(log_dir, 'plan-%s.json' % tag)):  # the judge's, and the progress's
+        with open(path, 'w') as f:
+            json.dump(run['plan'], f, indent=1, sort_keys=True)
+    probe_env = ros_env(master.env, master.uri, os.path.join(judge_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')
     probe_env['ROS_NAMESPACE'] = job.get('namespace', '/')
     started, started_wall = time.monotonic(), time.time()
-    probe = sup.start('probe-%s' % tag, [sys.executable, '-m', 'exam_lab.grader.judge.probe', plan_path, result_path],
-                      probe_env)
+    probe = sup.start('probe-%s' % tag, box.judge_argv(
+        [sys.executable, '-m', 'exam_lab.grader.judge.probe', plan_path, result_path], 'probe'), probe_env)
     # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
     # nothing it does when its drone goes away (a failed service call, a crash) is counted.
-    wait_until(lambda: os.path.isfile(result_path) or probe.poll() is not None, job['run_timeout'], period=0.1)
-    seconds = time.monotonic() - started
-    record = {'tag': tag, 'probe': None, 'seconds': seconds}
+    wait_until(lambda: os.path.isfile(result_path) or probe.poll() is not None or master.proc.poll() is not None,
+               job['run_timeout'], period=0.1)
+    record['seconds'] = time.monotonic() - started
+    record['probe_uid'] = uid_of(probe.pid)  # lingering: its uid is the one it measured as
     record['launch_running'] = launch.poll() is None
+    master_died = master.proc.poll() is not None
     # Read before stopping: what the nodes print when the grader stops them is not their doing.
-    record['launch'] = launch_outcome(sup.output('launch-%s' % tag), job['workspace'])
+    record['launch'] = launch_outcome(capped_log(sup, 'launch-%s' % tag), job['workspace'])
     sup.stop(launch)
     record['survivors'] = box.end()
-    if os.path.isfile(result_path):
-        with open(result_path) as f:
-            record['probe'] = json.load(f)
+    text = read_capped(result_path, FILE_CAP) if os.path.isfile(result_path) else None
+    if text is not None:
+        try:
+            record['probe'] = json.loads(text)
+        except ValueError as err:
+            record['probe_error'] = 'result unreadable: %s' % err
+        if not isinstance(record['probe'], dict):
+            record['probe'] = None
+            record.setdefault('probe_error', 'result unreadable: not an object')
+    if record['probe'] is not None:
+        with open(os.path.join(log_dir, 'probe-%s.json' % tag), 'w') as f:
+            json.dump(record['probe'], f, indent=1, sort_keys=True)
         problem = probe_problem(record['probe'], run['plan'], started_wall, time.time())
         if problem:
             record['probe'], record['probe_error'] = None, 'result refused: %s' % problem
-    else:
+            record['probe_refused'] = problem
+    elif 'probe_error' not in record:
         record['probe_error'] = ('no result within %.0f s; ' % job['run_timeout'] if probe.poll() is None else
                                  'exit %s; ' % probe.poll()) + tail(sup.output('probe-%s' % tag), 15)
     record['probe_status'] = sup.stop(probe, grace=5.0)
     sup.stop(master.proc)
+    record['master']['memory'] = memory_use(box.judge_cgroups.get('master', []))
+    if record['master']['memory']:  # this run's kills: the slot's master cgroup serves every run
+        record['master']['memory']['oom_kills'] -= killed_before
+    problem = master_problem(record['master'], master_died)
+    if problem:
+        record['probe'], record['probe_refused'] = None, problem
+        record['probe_error'] = 'result refused: %s' % problem
     return record
 
 
 def session(job):
     result = {'build': None, 'runs': [], 'survivors': 0}
     box = Box.attached(job['box'])
-    # The grader's side keeps the grader's environment, with a HOME of its own the box cannot see.
-    judge_env = dict(os.environ, ROS_IP='127.0.0.1', HOME=job['judge_home'], PYTHONNOUSERSITE='1')
+    # The judge keeps the grader's environment, with a HOME and ROS folders of its own the box cannot
+    # see; its folder is its own (0700), where it writes as its uid.
+    judge_dir = job['judge_home']
+    if box.judge_uid is not None:
+        os.chown(judge_dir, box.judge_uid, box.judge_uid)
+    os.chmod(judge_dir, 0o700)
+    judge_env = dict(os.environ, ROS_IP='127.0.0.1', HOME=judge_dir, PYTHONNOUSERSITE='1',
+                     ROS_LOG_DIR=os.path.join(judge_dir, 'ros_log'), ROS_HOME=os.path.join(judge_dir, 'ros_home'))
     with Supervisor(job['log_dir'], env=judge_env) as sup:
         base_env = workspace_env(job['underlay'], {'PATH': os.environ.get('PATH', '/usr/bin:/bin'),
                                                    'LANG': 'C.UTF-8'})
-        status, output, seconds = sup.run(
+        status, _, seconds = sup.run(
             'build', box.argv(['catkin_make', '--directory', job['workspace'],
                                '-DPYTHON_EXECUTABLE=/usr/bin/python3', '-DCATKIN_ENABLE_TESTING=OFF'],
                               dict(base_env, ROS_HOME=os.path.join(box.home, 'ros'))),
             timeout=job['build_timeout'])
         result['survivors'] += box.end()
-        result['build'] = {'status': status, 'seconds': seconds, 'tail': tail(output),
+        result['build'] = {'status': status, 'seconds': seconds, 'tail': tail(capped_log(sup, 'build')),
                            'timeout': job['build_timeout']}
         if status != 0:
             return result
+        result['launch_check'] = launch_verdict(sup, job, base_env, box)
+        result['survivors'] += box.end()
         for run in job['runs']:
             if run['tag'] == 'threshold':
                 main = result['runs'][0]['probe'] if result['runs'] else None

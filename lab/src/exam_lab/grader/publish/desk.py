@@ -3,47 +3,85 @@
 After grading, :func:`finish` writes, in ``OUT``: each student's Gradescope ``results.json`` and
 flight plot, the similarity check across the class, the Moodle worksheet filled (when one is given),
 and ``index.html`` (:mod:`exam_lab.grader.publish.page`).
+
+The desk survives any one student: each student's results.json, flight plot and page section are
+made apart, and one that fails (a bug, a probe file no plot can be drawn from) is a note in that
+student's section, on the page's top and on the terminal; the rest is written. The grades are
+already written by then (grade.json, grades.csv): nothing here may lose them.
 """
+import html
 import json
 import os
 
 from exam_lab.grader.publish import flightplot, gradescope, moodle, page
+from exam_lab.grader.score import safe_text
 
 
 def _grade_md(folder, record):
     path = os.path.join(folder, 'grade.md')
-    text = open(path).read() if os.path.isfile(path) else ''
-    return '\n'.join(l for l in text.splitlines() if not l.startswith('# ')) if text else ''
+    if not os.path.isfile(path):
+        return ''
+    with open(path) as f:
+        return '\n'.join(l for l in f.read().splitlines() if not l.startswith('# '))
 
 
-def finish(out, records, single=False, similar=None, worksheet=None):
+def _failure(err):
+    """One line for the teacher: what went wrong, capped (a message may quote a student's bytes)."""
+    why = safe_text.one_line('%s: %s' % (type(err).__name__, err))
+    return why if len(why) <= 300 else why[:297] + '...'
+
+
+def _student(out, record, single):
+    """Write one student's results.json and flight plot; return its page entry, whose ``problems``
+    say what could not be made."""
+    folder = out if single else os.path.join(out, record['student'])
+    relative = '.' if single else os.path.relpath(folder, out)
+    entry = {'plot': None, 'grade_md': '', 'folder': relative, 'documents': record.get('documents'),
+             'problems': []}
+    try:
+        gradescope.write(folder, record)
+    except Exception as err:
+        entry['problems'].append('results.json (Gradescope) not written: %s' % _failure(err))
+    try:
+        if flightplot.draw(flightplot.load_runs(os.path.join(folder, 'logs')), os.path.join(folder, 'flight.png'),
+                           record['student']):
+            entry['plot'] = os.path.join(relative, 'flight.png')
+    except Exception as err:
+        entry['problems'].append('flight plot not drawn: %s' % _failure(err))
+        entry['plot_failed'] = True
+    try:
+        entry['grade_md'] = _grade_md(folder, record)
+    except Exception as err:  # the page makes it from the record instead
+        entry['problems'].append('grade.md not read: %s' % _failure(err))
+    return entry
+
+
+def finish(out, records, single=False, similar=None, worksheet=None, scale=False, title=None):
     """Write the desk's files for ``records`` graded into ``out``; return lines for the terminal.
 
     :param single: one submission (its results are in ``out`` itself, not ``out/<student>``).
     :param similar: the similarity check's result (:func:`exam_lab.grader.boxed.similarity.check`) or None.
     :param worksheet: the Moodle worksheet to fill, or None.
+    :param scale: scale the grades to the worksheet's maximum grade (:func:`moodle.fill`).
+    :param title: the class's name (:func:`moodle.class_name`); the output folder's name when None.
     """
     lines, notes, entries = [], [], {}
     for record in records:
-        folder = out if single else os.path.join(out, record['student'])
-        gradescope.write(folder, record)
-        plot = os.path.join(folder, 'flight.png')
-        drawn = flightplot.draw(flightplot.load_runs(os.path.join(folder, 'logs')), plot, record['student'])
-        relative = '.' if single else os.path.relpath(folder, out)
-        entries[record['student']] = {'plot': os.path.join(relative, 'flight.png') if drawn else None,
-                                      'grade_md': _grade_md(folder, record), 'folder': relative,
-                                      'documents': record.get('documents')}
+        entry = entries[record['student']] = _student(out, record, single)
+        lines += ['%s: %s' % (record['student'], problem) for problem in entry['problems']]
     if worksheet:
         base = os.path.splitext(os.path.basename(worksheet))[0]
         target = os.path.join(out, '%s-filled.csv' % base)
         try:
-            summary = moodle.fill_file(worksheet, target, records)
+            summary = moodle.fill_file(worksheet, target, records, scale)
             lines += moodle.summary_lines(summary, target)
             with open(os.path.join(out, 'worksheet.json'), 'w') as f:
                 json.dump(summary, f, indent=1, sort_keys=True)
         except (moodle.WorksheetError, OSError) as err:
             lines.append('worksheet NOT filled: %s' % err)
-        notes += lines
+        except Exception as err:  # a bug on one record's text: the page must still say so
+            lines.append('worksheet NOT filled (a grader bug, please report): %s' % _failure(err))
+    notes += lines
     pairs = None
     if similar is not None:
         pairs = similar.get('pairs', [])
@@ -54,8 +92,26 @@ def finish(out, records, single=False, similar=None, worksheet=None):
         else:
             lines.append('similarity: %d pair(s) flagged of %d student(s) (%s)'
                          % (len(pairs), similar.get('students', 0), os.path.join(out, 'index.html#similarity')))
-    title = 'Exam grades: %s' % (records[0]['student'] if single and records else os.path.basename(out))
+    title = 'Exam grades: %s' % (records[0]['student'] if single and records else title or os.path.basename(out))
+    try:
+        content = page.render(records, title, entries, pairs, notes)
+    except Exception as err:  # not one student's: the page shrinks to what cannot fail, and says why
+        problem = 'the page could not be made (a grader bug, please report): %s' % _failure(err)
+        lines.append(problem)
+        content = _plain_page(title, records, problem)
     with open(os.path.join(out, 'index.html'), 'w') as f:
-        f.write(page.render(records, title, entries, pairs, notes))
+        f.write(content)
     lines.append('page: %s' % os.path.join(out, 'index.html'))
-    return lines
+    return [safe_text.one_line(line) for line in lines]
+
+
+def _plain_page(title, records, problem):
+    """index.html when the page itself failed: the problem, and each student's total, status and folder."""
+    def e(value):
+        return html.escape(safe_text.one_line(value), quote=True)
+
+    rows = ''.join('<li><a href="%s/grade.md">%s</a>: %s / %s, %s</li>' % (
+        e(r.get('student')), e(r.get('student')), e(r.get('total')), e(r.get('max')), e(r.get('status')))
+        for r in records)
+    return ('<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>%s</title></head><body>'
+            '<h1>%s</h1><p>%s</p><ul>%s</ul></body></html>\n' % (e(title), e(title), e(problem), rows))

@@ -5,7 +5,10 @@ Drawn from the probe's results (``logs/probe-main.json``, ``logs/probe-threshold
 matplotlib's Agg backend (no display needed); times are seconds from the probe's start.
 """
 import json
+import math
 import os
+
+from exam_lab.grader.score.rubric import calls
 
 #: Legs of each run, in order, and the side of the threshold each is flown on.
 LEGS = {'rest': 'below', 'short_up': 'above', 'short_down': 'below', 'long_up': 'above', 'long_down': 'below',
@@ -14,6 +17,12 @@ _SIDE_COLOUR = {'above': '#f4cccc', 'below': '#d9e8f5'}
 #: Up to this many calls of a kind, each is also a vertical line across the panel.
 FEW_CALLS = 10
 _CALL_COLOUR = {'WARNING': '#cc0000', 'NORMAL': '#2a9d2a'}
+#: Values are drawn within +-LIMIT (student units; the drones fly within a few thousand): a node that
+#: published +-1.7e308 once made matplotlib's scaling overflow (LinAlgError) and stopped the desk.
+#: A value beyond is clamped to the limit (a published one is drawn as an arrow at the panel's edge,
+#: so the node's other values keep their scale), a time or value that is not a number is left out,
+#: and the panel says how many of each.
+LIMIT = 1e6
 
 
 def load_runs(log_dir):
@@ -50,14 +59,72 @@ def draw(runs, path, title=''):
     matplotlib.use('Agg')
     from matplotlib import pyplot as plt
     fig, axes = plt.subplots(len(runs), 1, figsize=(9.5, 3.1 * len(runs)), dpi=90, squeeze=False)
-    for ax, (tag, probe) in zip(axes[:, 0], runs):
-        _panel(ax, tag, probe)
-    if title:
-        fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    try:
+        for ax, (tag, probe) in zip(axes[:, 0], runs):
+            _panel(ax, tag, probe)
+        if title:
+            fig.suptitle(title, fontsize=11)
+        fig.tight_layout()
+        fig.savefig(path)
+    finally:
+        plt.close(fig)  # a plot that failed must not keep its figure for the class's next one
     return True
+
+
+class Clamp(object):
+    """Numbers made drawable, counting what was changed for the panel's note: values within
+    +-:data:`LIMIT`, times (seconds from the probe's start) within the same bound or left out."""
+
+    def __init__(self, limit=LIMIT):
+        self.limit, self.clamped, self.dropped = limit, 0, 0
+
+    def _number(self, x):
+        try:
+            x = float(x)
+        except (TypeError, ValueError):
+            return None
+        return None if math.isnan(x) else x
+
+    def value(self, x):
+        """``x`` within +-limit, or None (counted) when it is not a number at all."""
+        x = self._number(x)
+        if x is None:
+            self.dropped += 1
+        elif abs(x) > self.limit:
+            self.clamped += 1
+            x = math.copysign(self.limit, x)
+        return x
+
+    def time(self, t, t0):
+        """``t - t0``, or None (counted) when it is not a number or beyond the limit: a time drawn at
+        the limit would stretch the panel as far."""
+        t = self._number(t)
+        if t is None or not abs(t - t0) <= self.limit:
+            self.dropped += 1
+            return None
+        return t - t0
+
+    def pairs(self, pairs, t0):
+        """``[(t - t0, value)]`` of ``[[t, value]]``; a pair whose value is None (the probe's word for
+        a non-finite value) is left out uncounted, one that is malformed or not a number is counted."""
+        out = []
+        for pair in pairs or []:
+            if not isinstance(pair, (list, tuple)) or len(pair) != 2:
+                self.dropped += 1
+            elif pair[1] is not None:
+                t, v = self.time(pair[0], t0), self.value(pair[1])
+                if t is not None and v is not None:
+                    out.append((t, v))
+        return out
+
+    def note(self):
+        """What the panel says of the numbers changed, or ''."""
+        parts = []
+        if self.clamped:
+            parts.append('%d value(s) beyond ±%g (published ones: arrows at the edge)' % (self.clamped, self.limit))
+        if self.dropped:
+            parts.append('%d time(s) or value(s) not a number or out of range, not drawn' % self.dropped)
+        return '; '.join(parts)
 
 
 def _limits(ax, published, oracle, threshold):
@@ -78,37 +145,64 @@ def _limits(ax, published, oracle, threshold):
 
 
 def _panel(ax, tag, probe):
+    clamp = Clamp()
     t0 = probe.get('t0') or 0.0
+    t0 = t0 if isinstance(t0, (int, float)) and math.isfinite(t0) else 0.0
     trace = probe.get('trace') or {}
-    published = [(t - t0, v) for t, v in trace.get('published', []) if v is not None]
-    oracle = [(t - t0, v) for t, v in trace.get('oracle', [])]
-    end = max([t for t, _ in published] + [t for t, _ in oracle] + [(probe.get('schedule') or {}).get('end', t0) - t0])
-    for name, start, stop, side in legs(probe.get('schedule') or {}):
-        ax.axvspan(start - t0, stop - t0, color=_SIDE_COLOUR[side], alpha=0.6, lw=0)
-        ax.text((start + stop) / 2 - t0, 1.0, name.replace('_', ' '), transform=ax.get_xaxis_transform(),
+    published = clamp.pairs(trace.get('published'), t0)
+    beyond = [(t, v) for t, v in published if abs(v) >= clamp.limit]
+    published = [(t, v) for t, v in published if abs(v) < clamp.limit]
+    oracle = clamp.pairs(trace.get('oracle'), t0)
+    schedule = {k: clamp.time(v, t0) for k, v in (probe.get('schedule') or {}).items()}
+    schedule = {k: v for k, v in schedule.items() if v is not None}  # seconds from the probe's start
+    end = max([t for t, _ in published + beyond] + [t for t, _ in oracle] + [schedule.get('end', 0.0)])
+    for name, start, stop, side in legs(schedule):
+        ax.axvspan(start, stop, color=_SIDE_COLOUR[side], alpha=0.6, lw=0)
+        ax.text((start + stop) / 2, 1.0, name.replace('_', ' '), transform=ax.get_xaxis_transform(),
                 ha='center', va='bottom', fontsize=7, color='#555555')
     if oracle:
         xs = [t for t, _ in oracle] + [end]
         ys = [v for _, v in oracle] + [oracle[-1][1]]
         ax.step(xs, ys, where='post', color='#888888', lw=1.5, label='oracle (equation 1)')
-    if not published:
+    if not published and not beyond:
         ax.text(0.5, 0.5, 'the node published no value the probe could read', transform=ax.transAxes,
                 ha='center', fontsize=10, color='#b00000')
     if published:
         ax.plot([t for t, _ in published], [v for _, v in published], '.', ms=2.5, color='#1f5fa8',
                 label='published by the node')
+    for sign, edge, marker in ((1, 0.98, '^'), (-1, 0.02, 'v')):
+        times = [t for t, v in beyond if v * sign > 0]
+        if times:
+            ax.plot(times, [edge] * len(times), marker, color='#1f5fa8', ms=7, clip_on=False,
+                    transform=ax.get_xaxis_transform(), label='published beyond %s%g (%d)' % (
+                        '+' if sign > 0 else '-', clamp.limit, len(times)))
     threshold = probe.get('threshold')
+    threshold = clamp.value(threshold) if threshold is not None else None
     if threshold is not None:
         ax.axhline(threshold, color='#cc0000', ls='--', lw=1, label='threshold %g' % threshold)
+    made = calls(probe)
     for kind in ('WARNING', 'NORMAL'):
-        times = [t - t0 for t, status in probe.get('calls', []) if status == kind]
-        if len(times) <= FEW_CALLS:
-            for t in times:
-                ax.axvline(t, color=_CALL_COLOUR[kind], lw=1, alpha=0.8)
-        if times:
-            ax.plot(times, [0.96] * len(times), 'v', color=_CALL_COLOUR[kind], ms=6, clip_on=False,
-                    transform=ax.get_xaxis_transform(), label='%s call (%d)' % (kind, len(times)))
+        for accepted in (True, False):
+            times = [clamp.time(t, t0) for t, meaning, _, ok in made if meaning == kind and ok == accepted]
+            times = [t for t in times if t is not None]
+            requests = sorted(set(r for _, meaning, r, ok in made if meaning == kind and ok == accepted))
+            if len(times) <= FEW_CALLS:
+                for t in times:
+                    ax.axvline(t, color=_CALL_COLOUR[kind], lw=1, alpha=0.8, ls='-' if accepted else ':')
+            if times:
+                ax.plot(times, [0.96] * len(times), 'v', color=_CALL_COLOUR[kind], ms=6, clip_on=False,
+                        mfc=_CALL_COLOUR[kind] if accepted else 'white', transform=ax.get_xaxis_transform(),
+                        label='%s call (%d)' % (kind, len(times)) if accepted else
+                        'REFUSED %s call (%d)' % (' / '.join('"%s"' % r[:12] for r in requests[:2]), len(times)))
+    other = [(clamp.time(t, t0), r) for t, meaning, r, _ in made if meaning not in _CALL_COLOUR]
+    other = [(t, r) for t, r in other if t is not None]
+    if other:
+        ax.plot([t for t, _ in other], [0.96] * len(other), 'x', color='#7a4a00', ms=6, clip_on=False,
+                transform=ax.get_xaxis_transform(), label='REFUSED other call (%d)' % len(other))
     _limits(ax, [v for _, v in published], [v for _, v in oracle], threshold)
+    if clamp.note():
+        ax.text(0.99, 0.04, clamp.note(), transform=ax.transAxes, fontsize=8, color='#b00000', ha='right',
+                va='bottom', bbox=dict(facecolor='white', alpha=0.85, lw=0))
     run = 'main run' if tag == 'main' else 'threshold run (lowered threshold, question 14a)'
     ax.set_title(run, fontsize=9, loc='left', pad=12)
     ax.set_xlabel('s from the probe\'s start')

@@ -8,6 +8,7 @@ copies this file; a class graded here gets one per student, to upload with Grade
 import json
 import os
 
+from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 
 #: Statuses whose score is the grade; the others are shown to the teacher only until a hand grade.
@@ -32,7 +33,7 @@ def results(record):
     if status not in GRADED:
         out['output'] = 'Needs the teacher (%s): %s' % (status, record.get('status_reason', ''))
         out['visibility'] = 'hidden'  # a grade only the teacher sees until it is settled by hand
-    return out
+    return safe_text.cleaned(out)  # the student sees it: no control character of anyone's reaches it
 
 
 def write(out_dir, record):

@@ -21,6 +21,7 @@ feedback already in the worksheet as it was (a teacher's grade wins over the mac
 import html
 import re
 
+from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 
 #: The participant's number in a "download all submissions" name (folder or flat file).
@@ -41,6 +42,23 @@ _BOM = '\ufeff'
 
 class WorksheetError(Exception):
     """The file is not a worksheet this module can fill without changing what it must not."""
+
+
+#: Moodle's "download all submissions" zip: ``<course short name>-<assignment name>-<module id>.zip``
+#: (``download_submissions()`` in ``mod/assign/locallib.php``).
+_CLASS_ZIP = re.compile(r'^(.+?)-\d+$')
+
+
+def class_name(path):
+    """The class's name for the page's title: Moodle's zip gives the course and the assignment
+    (``ROS-Exam altitude-1234.zip`` gives ``ROS-Exam altitude``), a folder its own name."""
+    name = path.rstrip('/\\').replace('\\', '/').split('/')[-1]
+    for ending in ('.zip', '.tar.gz', '.tgz', '.tar'):
+        if name.lower().endswith(ending):
+            name = name[:-len(ending)]
+            match = _CLASS_ZIP.match(name)
+            return match.group(1) if match else name
+    return name
 
 
 def participant_number(name):
@@ -151,19 +169,28 @@ def _points(x, comma=False):
     return text.replace('.', ',') if comma else text
 
 
-def feedback(record):
+def feedback(record, maximum=None, scaled=None):
     """The feedback comment of one student (HTML, as Moodle's feedback comments are): the total, then
-    one line per item with its points, and why for each point lost."""
+    one line per item with its points, and why for each point lost. With the worksheet's ``maximum``
+    grade (a number) other than the machine's, it says on which scale the grade column is: ``scaled``
+    (the grade written) or the machine's points as they are."""
     lines = []
     for entry in record['items']:
         line = '%s %s/%s' % (entry['id'], _points(entry['points']), _points(entry['max']))
         if entry['points'] < entry['max'] and entry.get('evidence'):
-            why = entry['evidence'].split('\n', 1)[0]
+            why = safe_text.clean(entry['evidence']).split('\n', 1)[0]
             line += ': ' + (why if len(why) <= 200 else why[:197] + '...')
         lines.append(line)
     head = ('Machine-graded by running the package: %s / %s points (%s). Not scored by the machine: '
             'comments, code quality and the report.' % (_points(record['total']), _points(record['max']),
                                                         ', '.join(ITEMS)))
+    if maximum is not None and abs(maximum - record['max']) > 1e-9:
+        head += (' The grade is these points scaled to %s (x %s/%s).' % (_points(maximum), _points(maximum),
+                                                                        _points(record['max']))
+                 if scaled is not None else
+                 ' The grade is out of %s (the machine\'s items), not out of the maximum grade %s: the '
+                 'comments, code quality and report are added by the teacher.' % (_points(record['max']),
+                                                                                  _points(maximum)))
     text = '<p>%s</p><ul>%s</ul>' % (_escape(head), ''.join('<li>%s</li>' % _escape(l) for l in lines))
     return text
 
@@ -173,8 +200,12 @@ def _escape(text):
     return html.escape(text, quote=True).replace('\\', '&#92;')
 
 
-def fill(text, records):
+def fill(text, records, scale=False):
     """Fill the worksheet ``text`` with the grades of ``records`` (each with ``participant``).
+
+    The grade column gets the machine's points out of its 17, as they are, and the summary and each
+    comment say so when the worksheet's "Maximum grade" is another (20, Moodle's default 100); with
+    ``scale`` they are scaled to that maximum instead (the teacher's choice, never silent either).
 
     :returns: ``(filled text, summary)``; summary: ``graded`` [(student, participant, points)],
         ``kept`` [(student, why)] (rows matched but left as they were), ``unmatched`` [(student, why)],
@@ -201,7 +232,8 @@ def fill(text, records):
         match = _IDENTIFIER.match(fields[ident][1].strip())
         if match:
             by_number[int(match.group(1))] = fields
-    summary = {'graded': [], 'kept': [], 'unmatched': [], 'no_submission': []}
+    summary = {'graded': [], 'kept': [], 'unmatched': [], 'no_submission': [], 'maxima': [], 'scaled': scale,
+               'machine_max': []}
     matched = set()
     for record in records:
         number = record.get('participant')
@@ -223,14 +255,23 @@ def fill(text, records):
             continue
         top = fields[maximum][1].strip() if maximum is not None else ''
         comma = ',' in top and '.' not in top
-        if top and _number(top) is not None and record['total'] > _number(top) + 1e-9:
+        top_value = _number(top) if top else None
+        if top_value is not None and top_value not in summary['maxima']:
+            summary['maxima'].append(top_value)
+        if scale and top_value is None:
+            summary['kept'].append((student, 'no maximum grade in the worksheet to scale to'))
+            continue
+        total = record['total'] * top_value / record['max'] if scale else record['total']
+        if top_value is not None and total > top_value + 1e-9:
             summary['kept'].append((student, '%s points exceed the maximum grade %s' % (record['total'], top)))
             continue
-        points = _points(record['total'], comma)
+        points = _points(round(total, 2), comma)
         fields[grade][:] = [quoted(points), points]
-        note = feedback(record)
+        note = feedback(record, top_value, points if scale else None)
         fields[comments][:] = [quoted(note), note]
         summary['graded'].append((student, number, points))
+        if record['max'] not in summary['machine_max']:
+            summary['machine_max'].append(record['max'])
     for number, fields in sorted(by_number.items()):
         if number not in matched:
             summary['no_submission'].append(fields[names][1] if names is not None else 'Participant %d' % number)
@@ -244,15 +285,16 @@ def _number(text):
         return None
 
 
-def fill_file(source, target, records):
-    """Read the worksheet at ``source``, write the filled copy at ``target``; return the summary."""
+def fill_file(source, target, records, scale=False):
+    """Read the worksheet at ``source``, write the filled copy at ``target``; return the summary
+    (``scale``: see :func:`fill`)."""
     with open(source, 'rb') as f:
         raw = f.read()
     try:
         text = raw.decode('utf-8')
     except UnicodeDecodeError as err:
         raise WorksheetError('not UTF-8 (download the worksheet again from Moodle): %s' % err)
-    filled, summary = fill(text, records)
+    filled, summary = fill(text, records, scale)
     with open(target, 'wb') as f:
         f.write(filled.encode('utf-8'))
     return summary
@@ -262,10 +304,22 @@ def summary_lines(summary, target):
     """What the teacher reads after the run: where the file is, and every row not graded."""
     lines = ['worksheet: %d grade(s) written into %s; import it in Moodle (Assignment > View all '
              'submissions > Grading action: Upload grading worksheet)' % (len(summary['graded']), target)]
+    machine = sorted(set(r for r in summary.get('machine_max', []))) or [17.0]
+    for top in summary.get('maxima', []):
+        if abs(top - machine[0]) < 1e-9:
+            continue
+        if summary.get('scaled'):
+            lines.append('  SCALED: the worksheet\'s maximum grade is %s: each grade written is the machine\'s '
+                         'points x %s/%s' % (_points(top), _points(top), _points(machine[0])))
+        else:
+            lines.append('  NOT SCALED: the worksheet\'s maximum grade is %s, the grades written are the machine\'s '
+                         'points out of %s (comments, code quality and the report are yours to add); '
+                         'WORKSHEET_SCALE=1 (--worksheet-scale) writes them scaled to %s instead'
+                         % (_points(top), _points(machine[0]), _points(top)))
     for student, why in summary['kept']:
         lines.append('  left as it was: %s (%s)' % (student, why))
     for student, why in summary['unmatched']:
         lines.append('  NOT MATCHED: %s (%s)' % (student, why))
     if summary['no_submission']:
         lines.append('  in the worksheet, no graded submission: %s' % ', '.join(summary['no_submission']))
-    return lines
+    return [safe_text.one_line(line) for line in lines]

@@ -11,6 +11,7 @@ import os
 import re
 
 from exam_lab.grader.publish import report
+from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 
 #: Flagged pairs shown with their fragments; the rest are listed by name and score.
@@ -28,6 +29,7 @@ table.scores td.num { text-align: right; }
 td.lost { background: #fde2e2; } td.full { background: #e6f4e6; }
 .status-graded { color: #1d6b1d; } .status-graded-with-fixes { color: #1d6b1d; }
 .status-needs-a-hand-grade, .status-not-graded { color: #b00000; font-weight: bold; }
+.problem { color: #b00000; }
 .first { background: #fff4e0; border: 1px solid #e8b463; padding: .5em 1em; }
 .student { border-top: 3px solid #888; margin-top: 2.5em; }
 pre { background: #f6f6f6; padding: .5em; overflow-x: auto; font-size: .85em; }
@@ -152,11 +154,18 @@ def render(records, title, entries, pairs=None, notes=None):
 
     :param records: the grade records (grade.json), in the table's order.
     :param entries: per student: ``{"plot": relative path of the PNG or None, "grade_md": text,
-        "documents": [{"name", "pages"}], "folder": relative path of its results}``.
+        "documents": [{"name", "pages"}], "folder": relative path of its results, "problems": what the
+        desk could not make for it, "plot_failed": its plot was not drawn for one of those}``.
     :param pairs: the similarity check's flagged pairs (see :mod:`exam_lab.grader.boxed.similarity`), or
         None when it did not run.
     :param notes: lines for the top of the page (the worksheet's summary, the similarity's limits).
+
+    Every text is cleaned of control characters first (student-derived); a student whose section
+    cannot be made gets one that says why, and the others theirs.
     """
+    records, entries, pairs, notes = (safe_text.cleaned(records), safe_text.cleaned(entries),
+                                      safe_text.cleaned(pairs), safe_text.cleaned(notes))
+    title = safe_text.clean(title)
     parts = ['<!DOCTYPE html>', '<html lang="en"><head><meta charset="utf-8">',
              '<title>%s</title>' % _e(title), '<style>%s</style></head><body>' % _STYLE,
              '<h1>%s</h1>' % _e(title)]
@@ -165,12 +174,15 @@ def render(records, title, entries, pairs=None, notes=None):
     parts.append('<p>%d student(s); mean %.1f / %s; machine-scored items only (not the comments, the '
                  'code quality, the report).</p>' % (len(records), sum(totals) / max(len(totals), 1),
                                                       report._points(maximum)))
-    first = [r for r in records if _status(r) not in GRADED]
+    first = [r for r in records if _status(r) not in GRADED or r.get('doubts')]
     parts.append('<h2 id="first">Needs the teacher first</h2>')
     if first:
         parts.append('<div class="first"><ul>%s</ul></div>' % ''.join(
-            '<li><a href="#%s">%s</a>: %s - %s</li>' % (anchor(r['student']), _e(r['student']), _status_cell(r),
-                                                       _e(r.get('status_reason', ''))) for r in first))
+            '<li><a href="#%s">%s</a>: %s%s%s</li>' % (
+                anchor(r['student']), _e(r['student']), _status_cell(r),
+                ' - %s' % _e(r['status_reason']) if r.get('status_reason') else '',
+                '<ul>%s</ul>' % ''.join('<li>%s</li>' % _e(d) for d in r.get('doubts') or [])
+                if r.get('doubts') else '') for r in first))
     else:
         parts.append('<p>Nobody: every submission was graded by the machine.</p>')
     if notes:
@@ -183,7 +195,12 @@ def render(records, title, entries, pairs=None, notes=None):
     if pairs is not None:
         parts.append(_similarity(pairs))
     for record in records:
-        parts.append(_section(record, entries.get(record['student'], {})))
+        try:
+            parts.append(_section(record, entries.get(record['student'], {})))
+        except Exception as err:  # this student's section says so; the page and the others' stand
+            parts.append('<section class="student" id="%s"><h2>%s</h2><p class="problem">This section could '
+                         'not be made: %s. Its results are in its folder.</p></section>'
+                         % (anchor(record['student']), _e(record['student']), _e(safe_text.one_line(repr(err)))))
     parts.append('<script>%s</script></body></html>' % _SCRIPT)
     return '\n'.join(parts) + '\n'
 
@@ -241,6 +258,8 @@ def _section(record, entry):
                                        report._points(record['max'])),
              '<p>Status: %s%s</p>' % (_status_cell(record), ' - %s' % _e(record['status_reason'])
                                       if record.get('status_reason') else '')]
+    for problem in entry.get('problems') or []:
+        parts.append('<p class="problem">Not made for this student: %s</p>' % _e(problem))
     if entry.get('folder'):
         parts.append('<p>Results: <a href="%s/grade.md">grade.md</a>, <a href="%s/grade.json">grade.json</a>, '
                      '<a href="%s/logs/">logs</a></p>' % ((_e(entry['folder']),) * 3))
@@ -254,7 +273,7 @@ def _section(record, entry):
     if entry.get('plot'):
         parts.append('<p><img class="flight" src="%s" alt="flight of %s: value published against the '
                      'oracle, threshold, warning calls, legs"></p>' % (_e(entry['plot']), _e(record['student'])))
-    else:
+    elif not entry.get('plot_failed'):  # a plot that failed is said with the problems above
         parts.append('<p>No flight to plot: the node never ran against the probe.</p>')
     parts.append(markdown_html(entry.get('grade_md') or report.markdown(record)))
     parts.append('<p><a href="#table">back to the table</a></p></section>')

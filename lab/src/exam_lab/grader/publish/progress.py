@@ -13,6 +13,8 @@ import sys
 import threading
 import time
 
+from exam_lab.grader.score import safe_text
+
 #: (file the session writes into its log folder when the step starts, the step).
 STEPS = (('build.log', 'build'), ('plan-main.json', 'main flight'), ('plan-threshold.json', 'threshold flight'))
 #: Seconds one student takes before any has finished (docs/grading.md, "Speed").
@@ -113,9 +115,17 @@ class ClassProgress(object):
             self.running.pop(record['student'], None)
             self.done.append(record.get('seconds', 0.0))
             self._clear()
-            self.stream.write('graded %s: %s/%s, %s (%.0f s)\n' % (
+            self.stream.write(safe_text.one_line('graded %s: %s/%s, %s (%.0f s)' % (
                 record['student'], record['total'], record['max'], record.get('status', 'graded'),
-                record.get('seconds', 0.0)))
+                record.get('seconds', 0.0))) + '\n')
+            self._draw()
+            self.stream.flush()
+
+    def say(self, line):
+        """One line of news about the run (the Slurm engine's array state), above the status line."""
+        with self.lock:
+            self._clear()
+            self.stream.write(line + '\n')
             self._draw()
             self.stream.flush()
 
@@ -134,8 +144,8 @@ class ClassProgress(object):
         left = estimate_left(self.done, [now - start for start, _ in self.running.values()], waiting, self.jobs)
         now_on = ', '.join('%s (%s, %s)' % (name, step, duration(now - start))
                            for name, (start, step) in sorted(self.running.items()))
-        return '[%d of %d graded] now: %s; about %s left' % (len(self.done), self.total, now_on or '-',
-                                                           duration(left))
+        return safe_text.one_line('[%d of %d graded] now: %s; about %s left' % (
+            len(self.done), self.total, now_on or '-', duration(left)))
 
     def _tick(self):
         while not self.stop.wait(REDRAW_S):

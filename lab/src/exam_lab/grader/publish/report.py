@@ -1,10 +1,15 @@
 """The grader's outputs: grade.json, grade.md (for the teacher and the student), grades.csv, and the
 table printed on the terminal. No rospy here.
+
+A record's text is student-derived (evidence, log lines, names): :func:`grade_record` cleans it where it
+is made, and every output cleans what it writes again (:mod:`exam_lab.grader.score.safe_text`), since a
+record may also be made elsewhere (read back from grade.json, a test, a later change of the runner).
 """
 import csv
 import json
 import os
 
+from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS, SHEETS
 
 #: What no machine scores, with the rubric's points (sheet 000's notes).
@@ -22,7 +27,7 @@ def grade_record(student, sheet, items, for_the_teacher, extra=None, status=('gr
               'max': sum(i['max'] for i in items), 'items': items, 'for_the_teacher': for_the_teacher,
               'status': status[0], 'status_reason': status[1]}
     record.update(extra or {})
-    return record
+    return safe_text.cleaned(record)
 
 
 def _status_line(record):
@@ -33,6 +38,7 @@ def _status_line(record):
 
 def markdown(record):
     """grade.md: the score table, each lost point's reason, the hints for the teacher."""
+    record = safe_text.cleaned(record)
     sheet = SHEETS.get(record['sheet'])
     title = sheet and 'sheet %s (%s, %s)' % (sheet.seed, sheet.name, sheet.drone_pkg) or 'no sheet'
     if record.get('status') == 'not graded':
@@ -43,11 +49,13 @@ def markdown(record):
     lines = ['# %s: %s / %s' % (record['student'], _points(record['total']), _points(record['max'])),
              '',
              _status_line(record),
-             '',
-             how,
-             '',
-             '| item | what is checked | points | evidence |',
-             '|---|---|---|---|']
+             '']
+    if record.get('doubts'):
+        lines += ['**Look at:** %s' % '; '.join(d.replace('\n', ' ') for d in record['doubts']), '']
+    lines += [how,
+              '',
+              '| item | what is checked | points | evidence |',
+              '|---|---|---|---|']
     for entry in record['items']:
         what = ITEMS[entry['id']][1]
         evidence = entry['evidence'].split('\n', 1)[0].replace('|', '\\|')
@@ -66,7 +74,7 @@ def write_grade(out_dir, record):
     """Write ``grade.json`` and ``grade.md`` into ``out_dir``."""
     os.makedirs(out_dir, exist_ok=True)
     with open(os.path.join(out_dir, 'grade.json'), 'w') as f:
-        json.dump(record, f, indent=1, sort_keys=True)
+        json.dump(safe_text.cleaned(record), f, indent=1, sort_keys=True)
         f.write('\n')
     with open(os.path.join(out_dir, 'grade.md'), 'w') as f:
         f.write(markdown(record))
@@ -79,7 +87,8 @@ def write_csv(path, records):
         writer.writerow(['student', 'sheet', 'status'] + list(ITEMS) + ['total', 'max'])
         for record in records:
             points = {e['id']: e['points'] for e in record['items']}
-            writer.writerow([record['student'], record['sheet'], record.get('status', 'graded')] +
+            writer.writerow([safe_text.one_line(record['student']), record['sheet'],
+                             safe_text.one_line(record.get('status', 'graded'))] +
                             [_points(points.get(i, 0)) for i in ITEMS] +
                             [_points(record['total']), _points(record['max'])])
 
@@ -90,20 +99,26 @@ def table(records):
     rows = [header]
     for record in records:
         points = {e['id']: e['points'] for e in record['items']}
-        rows.append([record['student'], record['sheet'] or '-'] + [_points(points.get(i, 0)) for i in ITEMS] +
-                    ['%s/%s' % (_points(record['total']), _points(record['max'])), record.get('status', '')])
+        rows.append([safe_text.one_line(record['student']), record['sheet'] or '-'] +
+                    [_points(points.get(i, 0)) for i in ITEMS] +
+                    ['%s/%s' % (_points(record['total']), _points(record['max'])),
+                     safe_text.one_line(record.get('status', ''))])
     widths = [max(len(str(r[c])) for r in rows) for c in range(len(header))]
     return '\n'.join('  '.join(str(cell).ljust(w) for cell, w in zip(r, widths)).rstrip() for r in rows)
 
 
 def needing_the_teacher(records):
     """Lines for the terminal: each student whose grade the teacher must look at, and why (all but
-    'graded' and 'graded with fixes')."""
-    return ['%s: %s - %s' % (r['student'], r.get('status'), r.get('status_reason', ''))
-            for r in records if r.get('status') not in ('graded', 'graded with fixes')]
+    'graded' and 'graded with fixes', and any grade with a doubt: refused calls, a launch file roslaunch
+    refuses, several uploads...)."""
+    return [safe_text.one_line('%s: %s%s%s' % (r['student'], r.get('status'),
+                                                ' - %s' % r['status_reason'] if r.get('status_reason') else '',
+                                                ''.join('; %s' % d for d in r.get('doubts') or [])))
+            for r in records if r.get('status') not in ('graded', 'graded with fixes') or r.get('doubts')]
 
 
 def evidence_lines(record):
     """Each item with points lost, and why (printed under the table for one submission)."""
-    return ['%s %s/%s: %s' % (e['id'], _points(e['points']), _points(e['max']), e['evidence'].split('\n', 1)[0])
+    return [safe_text.one_line('%s %s/%s: %s' % (e['id'], _points(e['points']), _points(e['max']),
+                                                 safe_text.clean(e['evidence']).split('\n', 1)[0]))
             for e in record['items'] if e['points'] < e['max']]

@@ -10,7 +10,8 @@ Each tolerance is a constant below; docs/grading.md says why each is what it is.
 import math
 import re
 
-from exam_lab.grader.score.sheets import DELAY, ITEMS, SHEETS
+from exam_lab.grader.score.sheets import DELAY, ITEMS, REQUESTS, SHEETS, request_meaning
+from exam_lab.harness import oracle
 
 #: Question 11: the rate the sheet asks for, and the accepted relative deviation.
 RATE_HZ = 10.0
@@ -119,12 +120,23 @@ def score_q10(sheet, session):
     if not node_ran(session):
         return item('Q10', 0, _not_run(session))
     subscribed = probe.get('subscribed', {})
-    got = [t for t, nodes in sorted(subscribed.items()) if nodes]
+    types = probe.get('input_types') or {}
+    refused = refused_inputs(probe)
+    got = [t for t, nodes in sorted(subscribed.items()) if nodes and t not in refused]
     missing = [t for t, nodes in sorted(subscribed.items()) if not nodes]
-    evidence = 'subscribes to %s' % (', '.join(got) or 'neither input')
+    evidence = 'subscribes to %s' % (', '.join('%s%s' % (t, ' (%s)' % types[t]['type'] if (types.get(t) or {}).get('type')
+                                                         else '') for t in got) or 'neither input')
+    for topic in sorted(refused):
+        evidence += '; subscribes to %s as %s, but %s, so the node never receives it (0/1)' % (
+            topic, types[topic]['type'], types[topic]['refused'])
     if missing:
         evidence += '; never to %s' % ', '.join(missing)
     return item('Q10', len(got), evidence)
+
+
+def refused_inputs(probe):
+    """The input topics whose subscription rospy refused (another message type than the drone's)."""
+    return sorted(t for t, info in ((probe or {}).get('input_types') or {}).items() if info and info.get('refused'))
 
 
 def _agrees(expected, published):
@@ -172,10 +184,17 @@ def score_q11(sheet, session):
         'nothing' if r['published'] is None else '%.2f' % r['published'], r['expected'],
         '' if r['published'] is None or not math.isfinite(r['published'])
         else ' (error %+.2f m)' % (r['published'] - r['expected'])) for r in rows)
+    constant = _constant_input(sheet, rows, refused_inputs(probe)) if rows and wrong else None
     if rows and not wrong:
         points += 1.5
         notes.append('values agree with equation (1) within max(%.1f m, %.1f %%) (1.5): %s'
                      % (VALUE_TOLERANCE_M, VALUE_TOLERANCE_REL * 100, shown))
+    elif constant is not None:
+        points += 1.5
+        notes.append('values agree with equation (1) within max(%.1f m, %.1f %%) at the constant %s %g the node '
+                     'kept, since it never received %s (its subscription was refused: Q10\'s loss, not this one\'s) '
+                     '(1.5): %s' % (VALUE_TOLERANCE_M, VALUE_TOLERANCE_REL * 100, constant[0].lstrip('/'),
+                                    constant[1], constant[0], shown))
     else:
         notes.append('values: %d of %d disagree with equation (1) beyond max(%.1f m, %.1f %%) (0/1.5): %s'
                      % (len(wrong), len(rows), VALUE_TOLERANCE_M, VALUE_TOLERANCE_REL * 100, shown or 'none read'))
@@ -184,7 +203,33 @@ def score_q11(sheet, session):
     return item('Q11', points, '; '.join(notes))
 
 
-def score_q12(sheet, static):
+def _constant_input(sheet, rows, refused):
+    """``(topic, value)`` when the node's values agree with equation (1) for one constant value of a
+    fixed input it never received (``refused``), as a node whose subscription was refused computes
+    with its initial value; None otherwise."""
+    fixed = [t for t in refused if t.rstrip('/').split('/')[-1] == {'altitude': 'temperature',
+                                                                   'depth': 'pressure_remote'}[sheet]]
+    usable = [r for r in rows if r['published'] is not None and math.isfinite(r['published'])]
+    if not fixed or len(usable) < 2 or len(usable) < len(rows):
+        return None
+    topic = fixed[0]
+    moving = [[v for t, v in sorted(r['inputs'].items()) if t != topic][0] for r in usable]
+    first, value = moving[0], usable[0]['published']
+    try:
+        if sheet == 'altitude':
+            constant = value * oracle.MU_AIR * oracle.G / (oracle.R * math.log(oracle.P0 / first)) - oracle.ZERO_CELSIUS
+            expected = [oracle.altitude_of(constant, m) for m in moving]
+        else:
+            constant = first - value * oracle.RHO_SEA_WATER * oracle.G
+            expected = [oracle.depth_of(m, constant) for m in moving]
+    except (ValueError, ZeroDivisionError):
+        return None
+    if all(_agrees(e, r['published']) for e, r in zip(expected, usable)):
+        return topic, round(constant, 2)
+    return None
+
+
+def score_q12(sheet, static, session=None):
     launch = static.get('launch')
     if static.get('launch_files') is None:
         return item('Q12', 0, 'not judged: the package was not read (see runs)')
@@ -192,6 +237,11 @@ def score_q12(sheet, static):
         return item('Q12', 0, 'no launch file in the package starts an exam node (launch files: %s)'
                     % (', '.join(static.get('launch_files', [])) or 'none'))
     drone = SHEETS[sheet]
+    verdict = (session or {}).get('launch_check') or {}
+    if verdict.get('refused'):
+        return item('Q12', 0, 'roslaunch refuses %s as handed in, so `roslaunch` starts nothing: "%s" (the grader '
+                    'ran it without the drone\'s node, a fix named in the status)' % (verdict['file'], verdict['refused']))
+    warned = ('; roslaunch warns: %s' % ' | '.join(verdict['warnings'])) if verdict.get('warnings') else ''
     has_drone = launch['starts_drone']
     exam_ok = launch['exam_type_found']
     where = launch['file']
@@ -199,24 +249,46 @@ def score_q12(sheet, static):
     commented = launch.get('comments', 1) > 0
     comment_note = '' if commented else '; but not a single comment in it (-%g: half, as the notes say)' % NO_COMMENT_LOSS
     if has_drone and exam_ok:
-        return item('Q12', 1 - (0 if commented else NO_COMMENT_LOSS), '%s starts %s/%s and %s/%s%s' % (
-            where, drone.drone_pkg, drone.drone_type, package, launch['exam_type'], comment_note))
+        return item('Q12', 1 - (0 if commented else NO_COMMENT_LOSS), '%s starts %s/%s and %s/%s%s%s' % (
+            where, drone.drone_pkg, drone.drone_type, package, launch['exam_type'], comment_note, warned))
     notes = []
     if not has_drone:
         notes.append('does not start the drone (%s/%s)' % (drone.drone_pkg, drone.drone_type))
     if not exam_ok:
         notes.append('starts %s/%s, which is no executable of the package' % (package, launch['exam_type']))
-    return item('Q12', 0.5 - (0 if commented else NO_COMMENT_LOSS), '%s starts an exam node but %s%s'
-                % (where, ' and '.join(notes), comment_note))
+    return item('Q12', 0.5 - (0 if commented else NO_COMMENT_LOSS), '%s starts an exam node but %s%s%s'
+                % (where, ' and '.join(notes), comment_note, warned))
+
+
+def calls(probe):
+    """Every call the node made: ``[(time, meaning, request, accepted)]``, ``meaning`` the status the
+    request was meant as (:func:`~exam_lab.grader.score.sheets.request_meaning`; the request itself when
+    it means neither), ``accepted`` the drone's answer (success). A refused request is a call all the same."""
+    answers = {(a[0], a[1]): bool(a[2]) for a in (probe or {}).get('answers') or []}
+    out = []
+    for t, request in sorted((probe or {}).get('calls', [])):
+        meaning = request_meaning(request)
+        out.append((t, meaning or request, request, answers.get((t, request), request in REQUESTS)))
+    return out
+
+
+def refused_calls(probe, start=float('-inf'), end=float('inf')):
+    """The calls the drone refused between ``start`` and ``end``: ``[(time, request)]``."""
+    return [(t, request) for t, _, request, accepted in calls(probe) if not accepted and start <= t <= end]
+
+
+def _refused_words(refused):
+    requests = sorted(set(r for _, r in refused))
+    return '%d call(s) with %s' % (len(refused), ', '.join('"%s"' % r[:40] for r in requests[:4]))
 
 
 def _calls_between(probe, start, end, status=None):
-    return [(t, s) for t, s in probe.get('calls', []) if start <= t <= end and (status is None or s == status)]
+    return [(t, s) for t, s, _, _ in calls(probe) if start <= t <= end and (status is None or s == status)]
 
 
 def _repeats(probe, since):
-    calls = sorted(probe.get('calls', []))
-    return len([1 for previous, call in zip(calls, calls[1:]) if call[0] >= since and call[1] == previous[1]])
+    made = calls(probe)
+    return len([1 for previous, call in zip(made, made[1:]) if call[0] >= since and call[1] == previous[1]])
 
 
 def _flight(probe):
@@ -292,9 +364,19 @@ def score_q13(sheet, session):
         points = 0.0
         evidence = 'no WARNING call on %s while the node\'s own value stayed above the threshold for %.1f s' % (
             service, above)
+        others = sorted(set(r for t, m, r, _ in calls(probe) if m not in REQUESTS))
+        if others:
+            evidence += ' (it called with %s, which mean neither WARNING nor NORMAL)' % ', '.join(
+                '"%s"' % r[:40] for r in others[:4])
     if up and up[0][0] - schedule['long_up'] > probe.get('delay', DELAY) + WARNING_LATE_S:
         evidence += ' (the WARNING came late, %.1f s after the value went above: the flight waited for it)' % (
             up[0][0] - schedule['long_up'])
+    refused = refused_calls(probe, schedule['rest'], schedule['end'])
+    if refused and points:
+        points /= 2
+        evidence += ('; but the drone refused its %s (success False: the LED never changed): the sheet\'s '
+                     'requests are "WARNING" and "NORMAL", so half of Q13, once (the timing items judge when it '
+                     'called)' % _refused_words(refused))
     if looped:
         points /= 2
         evidence += '; but called in a loop: %d calls in %.0f s of flight, %d repeating the previous status' % (
@@ -395,7 +477,7 @@ def score_q14b(sheet, session):
 def score(sheet, static, session):
     """Every item of the rubric, in order."""
     return [score_runs(session), score_q10(sheet, session), score_q11(sheet, session),
-            score_q12(sheet, static), score_q13(sheet, session), score_q14a(sheet, static, session),
+            score_q12(sheet, static, session), score_q13(sheet, session), score_q14a(sheet, static, session),
             score_q14b(sheet, session)]
 
 
@@ -423,8 +505,8 @@ def status(static, session, fixes=()):
 
     Not graded: the upload was refused or unreadable, or the grader could not run it. Needs a hand
     grade: the package has no node, does not build, its node does not start or dies (the traceback's
-    last line and file:line; Python 2 named), or a leg of a flight was not reached (nothing judged
-    there). Graded with fixes: the grader made a teacher's fix (each in for_the_teacher).
+    last line and file:line; Python 2 named), a run's measurement was refused (the node set the time,
+    its master went over its memory bound), or a leg of a flight was not reached (nothing judged there). Graded with fixes: the grader made a teacher's fix (each in for_the_teacher).
     """
     static, session = static or {}, session or {}
     build = session.get('build')
@@ -441,6 +523,9 @@ def status(static, session, fixes=()):
         last = [l for l in (build.get('tail') or '').splitlines() if l.strip()]
         return HAND_GRADE, _one_line('the package does not build%s' % (': %s' % last[-1] if last else ''))
     runs = session.get('runs', [])
+    refused = [r for r in runs if r.get('probe_refused')]
+    if refused:
+        return HAND_GRADE, _one_line('the %s run was not measured: %s' % (refused[0]['tag'], refused[0]['probe_refused']))
     tails = '\n'.join(r.get('launch', {}).get('tail', '') for r in runs)
     if not node_ran(session) or not stayed_up(session):
         if python2:
@@ -454,9 +539,43 @@ def status(static, session, fixes=()):
             return HAND_GRADE, _one_line(
                 'in the %s run the node\'s own value never reached the side of the threshold of its %s: '
                 'nothing judged there, read its code' % (run['tag'], ', '.join(LEG_WORDS.get(m, m) for m in missed)))
+    refused = refused_calls(main_probe(session))
+    if refused:
+        return HAND_GRADE, _one_line(
+            'the drone refused %s (not the sheet\'s "WARNING"/"NORMAL"): the calls were judged on when they '
+            'came and Q13 lost half for the request; check' % _refused_words(refused))
+    ambiguous = [u for u in static.get('uploads') or [] if u.get('ambiguous')]
+    if ambiguous:
+        return HAND_GRADE, _one_line('several uploads: %s; check which one is the last' % ambiguous[0]['why'])
+    verdict = session.get('launch_check') or {}
+    if verdict.get('refused'):
+        fixes = list(fixes) + ['roslaunch refuses %s as handed in ("%s"): the grader ran it without the drone\'s '
+                               'node; Q12 judged on the file as handed in' % (verdict['file'], verdict['refused'])]
     if fixes:
         return GRADED_WITH_FIXES, _one_line('; '.join(fixes))
     return GRADED, ''
+
+
+def doubts(static, session):
+    """What makes a grade doubtful, one line each, for the "needs the teacher" box whatever the status:
+    refused service calls, roslaunch refusing (or warning about) the launch file as handed in, several
+    uploads, a run whose measurement was refused."""
+    static, session = static or {}, session or {}
+    out = []
+    refused = refused_calls(main_probe(session))
+    if refused:
+        out.append('the drone refused %s' % _refused_words(refused))
+    verdict = session.get('launch_check') or {}
+    if verdict.get('refused'):
+        out.append('roslaunch refuses %s as handed in: %s' % (verdict['file'], verdict['refused']))
+    elif verdict.get('warnings'):
+        out.append('roslaunch warns about %s: %s' % (verdict['file'], ' | '.join(verdict['warnings'])))
+    for upload in static.get('uploads') or []:
+        out.append('several uploads: %s' % upload['why'])
+    for run in session.get('runs', []):
+        if run.get('probe') is None and run.get('probe_error'):
+            out.append('%s run: %s' % (run['tag'], run['probe_error'].splitlines()[0] if run['probe_error'] else ''))
+    return [_one_line(line) for line in out]
 
 
 def _one_line(text, limit=300):

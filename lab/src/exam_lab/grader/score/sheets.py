@@ -49,6 +49,21 @@ HAND_ITEMS = collections.OrderedDict([
 ])
 
 
+#: The requests the sheets name for the warning service (the drone refuses any other string).
+REQUESTS = ('WARNING', 'NORMAL')
+
+
+def request_meaning(request):
+    """The status a warning-service request was meant as: ``'WARNING'`` or ``'NORMAL'`` for the sheets'
+    words in any case, spacing or quoting ("warning", " Normal", "'WARNING'"), else None.
+
+    The drone refuses all but the exact words; the rubric still judges *when* the node called from
+    what it meant, so a wrong spelling costs once (question 13), not every timing item too.
+    """
+    word = str(request).strip().strip('"\'').strip().upper()
+    return word if word in REQUESTS else None
+
+
 def drone_packages():
     """The simulator packages of both sheets."""
     return [sheet.drone_pkg for sheet in SHEETS.values()]

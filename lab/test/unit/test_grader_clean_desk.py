@@ -1,0 +1,299 @@
+"""What reaches the teacher is clean, and the desk survives any one student (issue 26, points 4 and 5).
+
+A record whose evidence, notes and log tail carry a student's escape sequences (cursor movement,
+erase, OSC, C1, DEL, NUL, bidi overrides) reaches no output with a control character in it: the
+terminal (table, progress, the lines grade.py prints), grade.md/json, grades.csv, Moodle's worksheet,
+Gradescope's results.json, the page. One student whose plot, results.json or page section fails
+costs only that student's part of the desk; values like +-1.7e308, inf and nan are drawn clamped.
+No master, no grading run (lab/test/grader/test_boundary_publish.py grades such a student).
+"""
+import csv
+import importlib.util
+import io
+import json
+import math
+import os
+import re
+
+import pytest
+
+from exam_lab.grader import runner
+from exam_lab.grader.judge import session
+
+from exam_lab.grader.publish import desk, flightplot, gradescope, moodle, page, progress, report
+from exam_lab.grader.score import safe_text
+from exam_lab.grader.score.sheets import ITEMS
+from test_grader_desk import probe_result
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
+#: What may not reach the teacher, written out here rather than taken from the module under test.
+CONTROL = re.compile('[\x00-\x08\x0b-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]')
+#: A traceback as a hostile node prints it: the screen erased, the cursor moved home and up, a line
+#: overwritten by a carriage return, a title (OSC), an 8-bit CSI, C1, DEL, NUL, a bidi override.
+HOSTILE = ('Traceback (most recent call last):\x1b[2J\x1b[H17/17 graded\x1b[1A\x1b[K\r'
+           'NameError: boom\x1b]0;owned\x07 \x9b2J\x85\x7f\x00 \u202edetarg\u202c end')
+#: A student's name as a hostile upload could make it (NUL aside: the name is a folder too).
+NAME = 'Eve\x1b[2J\x1b[H\r\x85\u202e'
+WORKSHEET = ('\ufeffIdentifier,Full name,Grade,Maximum grade,Last modified (grade),Feedback comments\n'
+             '"Participant 101","Eve",,17.00,-,\n')
+
+
+def hostile_record(student=NAME):
+    """A record as it could reach an output without passing :func:`report.grade_record` (read back
+    from grade.json, made by a later runner): every text field carries :data:`HOSTILE`."""
+    items = [{'id': item, 'points': top / 2 if item == 'Q11' else top, 'max': top,
+              'evidence': 'values wrong: %s\nmore %s' % (HOSTILE, HOSTILE) if item == 'Q11' else 'ok'}
+             for item, (top, _) in ITEMS.items()]
+    total = sum(i['points'] for i in items)
+    return {'student': student, 'sheet': 'altitude', 'total': total, 'max': 17.0, 'items': items,
+            'for_the_teacher': ['main run, odd lines in the log: %s' % HOSTILE], 'participant': 101,
+            'status': 'needs a hand grade', 'status_reason': 'the node crashed: %s' % HOSTILE,
+            'documents': [{'name': 'report%s.pdf' % HOSTILE, 'pages': 2}], 'seconds': 40.0}
+
+
+def strings(value):
+    """Every string in a JSON value, keys too."""
+    if isinstance(value, str):
+        yield value
+    elif isinstance(value, dict):
+        for k, v in value.items():
+            yield k
+            yield from strings(v)
+    elif isinstance(value, list):
+        for v in value:
+            yield from strings(v)
+
+
+def _read(path):
+    with open(path, encoding='utf-8', newline='') as f:
+        return f.read()
+
+
+def _grade_script():
+    spec = importlib.util.spec_from_file_location('grade_script', os.path.join(REPO, 'lab', 'scripts', 'grade.py'))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def out_terminal_table(tmp_path, record, monkeypatch, capsys):
+    return [report.table([record])] + report.needing_the_teacher([record]) + report.evidence_lines(record)
+
+
+def out_progress(tmp_path, record, monkeypatch, capsys):
+    stream = io.StringIO()
+    shown = progress.ClassProgress(2, stream, live=False)
+    shown.begin([record['student']])
+    shown.started(record['student'])
+    shown.finished(record)
+    shown.close()
+    return [stream.getvalue(), shown.line()]
+
+
+def out_grade_files(tmp_path, record, monkeypatch, capsys):
+    report.write_grade(str(tmp_path), record)
+    return [_read(str(tmp_path / 'grade.md')), _read(str(tmp_path / 'grade.json'))] + \
+        list(strings(json.loads(_read(str(tmp_path / 'grade.json')))))
+
+
+def out_grades_csv(tmp_path, record, monkeypatch, capsys):
+    report.write_csv(str(tmp_path / 'grades.csv'), [record])
+    text = _read(str(tmp_path / 'grades.csv'))
+    return [text.replace('\r\n', '\n')] + [cell for row in csv.reader(io.StringIO(text)) for cell in row]
+
+
+def out_worksheet(tmp_path, record, monkeypatch, capsys):
+    filled, summary = moodle.fill(WORKSHEET, [dict(record, status='graded')])
+    assert len(summary['graded']) == 1  # the feedback was written: the test sees it
+    return [filled] + moodle.summary_lines(summary, 'ws-filled.csv')
+
+
+def out_gradescope(tmp_path, record, monkeypatch, capsys):
+    gradescope.write(str(tmp_path), record)
+    return [_read(str(tmp_path / 'results.json'))] + list(strings(json.loads(_read(str(tmp_path / 'results.json')))))
+
+
+def out_page(tmp_path, record, monkeypatch, capsys):
+    out = tmp_path / 'out'
+    os.makedirs(str(out / record['student'] / 'logs'))
+    lines = desk.finish(str(out), [record], similar={'error': 'similarity failed on %s' % HOSTILE})
+    return lines + [_read(str(out / 'index.html'))]
+
+
+def out_grade_script(tmp_path, record, monkeypatch, capsys):
+    """What ``grade.py --class`` prints, the grading itself replaced by the record."""
+    (tmp_path / 'class').mkdir()
+    os.makedirs(str(tmp_path / 'out' / record['student']))
+    monkeypatch.setattr(runner, 'grade_class', lambda *args, **kwargs: [record])
+    monkeypatch.setattr(runner, 'class_similarity', lambda *args: {'pairs': [], 'students': 1})
+    assert _grade_script().main(['--class', str(tmp_path / 'class'), '--out', str(tmp_path / 'out')]) == 0
+    printed = capsys.readouterr()
+    assert 'need the teacher' in printed.out and 'Eve' in printed.out
+    return [printed.out, printed.err]
+
+
+OUTPUTS = [out_terminal_table, out_progress, out_grade_files, out_grades_csv, out_worksheet, out_gradescope,
+           out_page, out_grade_script]
+#: Outputs that show no evidence nor reason (names, points, status only).
+NO_EVIDENCE = (out_progress, out_grades_csv)
+
+
+@pytest.mark.parametrize('output', OUTPUTS, ids=lambda f: f.__name__[len('out_'):])
+def test_no_control_character_reaches_an_output(output, tmp_path, monkeypatch, capsys):
+    texts = output(tmp_path, hostile_record(), monkeypatch, capsys)
+    found = sorted({'%r' % c for t in texts for c in CONTROL.findall(t)})
+    assert found == []
+    assert output in NO_EVIDENCE or any('most recent call last' in t for t in texts)  # the text itself stays
+
+
+def test_the_record_is_clean_where_it_is_made():
+    """The boundary: the log tail as the session keeps it, the notes the runner makes of it, the
+    record :func:`report.grade_record` makes of them."""
+    outcome = session.launch_outcome('[exam-1] started\n%s\n[exam-1] process has died [pid 3, exit code 1]\n'
+                                     % HOSTILE)
+    assert CONTROL.findall(outcome['tail']) == [] and '17/17 graded' in outcome['tail']
+    run = {'tag': 'main', 'launch': {'tail': HOSTILE}}
+    notes = runner.hints({}, {'build': None, 'runs': [run]}, [], None, True)
+    record = report.grade_record('Eve', 'altitude', hostile_record()['items'], notes,
+                                 {'documents': hostile_record()['documents']}, ('needs a hand grade', HOSTILE))
+    assert [s for s in strings(record) if CONTROL.search(s)] == []
+    assert 'NameError: boom' in record['status_reason']
+
+
+@pytest.mark.parametrize('raw, shown', [
+    ('a\x1b[2J\x1b[Hb\x1b[1A\x1b[10;20Hc', 'abc'),        # erase, home, up, position
+    ('\x1b[1;31mred\x1b[0m', 'red'),                     # colour
+    ('\x1b]0;title\x07x\x1b]8;;http://e\x1b\\link\x1b]8;;\x1b\\', 'xlink'),  # OSC, ended by BEL or ST
+    ('\x9b2Jx\x9d0;t\x9cy', 'xy'),                        # 8-bit CSI and OSC
+    ('\x1b(Bx\x1bMy\x1b7z', 'xyz'),                       # two-character sequences
+    ('x\x85y\x7f\x00\x08z', 'xyz'),                       # C1, DEL, NUL, backspace
+    ('\x1bPdcs\x1b\\x\x90dcs\x9cy', 'xy'),                # DCS strings, 7- and 8-bit
+    ('\u202eevil\u202c \u2066x\u2069', 'evil x'),        # bidi overrides and isolates
+    ('one\rtwo\r\nthree\tfour', 'one\ntwo\nthree\tfour'),  # CR: a line of its own; tab kept
+    ('\x1b]unended\nnext', '\nnext'),                    # an OSC without its end stops at the line's
+    ('Größe 1300 m', 'Größe 1300 m'),
+])
+def test_clean_text(raw, shown):
+    assert safe_text.clean(raw) == shown
+    assert safe_text.one_line(raw) == shown.replace('\n', ' ').replace('\t', ' ')
+
+
+def test_cleaned_record_keeps_its_shape():
+    value = {'a\x1b[1A': ['x\x00', ('y\x7f', 1.5)], 'n': None, 'k': True}
+    assert safe_text.cleaned(value) == {'a': ['x', ('y', 1.5)], 'n': None, 'k': True}
+    assert value['a\x1b[1A'][0] == 'x\x00'  # a copy: the record given is not changed
+
+
+def extreme_probe():
+    """A main run whose node published +-1.7e308 once each, inf and nan, the threshold inf, an oracle
+    value of -1.7e308 and a call at a time that is not a number: as the probe's JSON carries them."""
+    probe = probe_result()
+    published = probe['trace']['published']
+    published[40][1], published[41][1] = 1.7e308, -1.7e308
+    published[42][1], published[43][1] = float('inf'), float('nan')
+    probe['trace']['oracle'].append([published[44][0], -1.7e308])
+    probe['calls'].append([float('nan'), 'WARNING'])
+    probe['threshold'] = float('inf')
+    return probe
+
+
+def test_extreme_values_are_drawn_clamped_and_said(tmp_path):
+    import matplotlib
+    matplotlib.use('Agg')
+    from matplotlib import pyplot as plt
+    path = str(tmp_path / 'flight.png')
+    assert flightplot.draw([('main', extreme_probe()), ('threshold', probe_result('threshold'))], path, 'Eve')
+    with open(path, 'rb') as f:
+        assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+    fig, ax = plt.subplots()
+    try:
+        flightplot._panel(ax, 'main', extreme_probe())
+        low, high = ax.get_ylim()
+        assert math.isfinite(low) and math.isfinite(high) and -2 * flightplot.LIMIT < low < high < 2 * flightplot.LIMIT
+        said = ' '.join(t.get_text() for t in ax.texts)
+        assert '5 value(s) beyond ±1e+06' in said  # 2 published, inf, the oracle's, the threshold
+        labels = ax.get_legend_handles_labels()[1]
+        assert 'published beyond +1e+06 (2)' in labels and 'published beyond -1e+06 (1)' in labels
+        assert '2 time(s) or value(s) not a number' in said            # nan published, the call's time
+    finally:
+        plt.close(fig)
+
+
+def test_a_student_with_extreme_values_gets_its_plot_on_the_page(tmp_path):
+    out = tmp_path / 'out'
+    logs = out / 'Eve' / 'logs'
+    os.makedirs(str(logs))
+    with open(str(logs / 'probe-main.json'), 'w') as f:
+        json.dump(extreme_probe(), f)  # Infinity, NaN: what json writes of them, and reads back
+    record = report.grade_record('Eve', 'altitude', hostile_record()['items'], [], {})
+    lines = desk.finish(str(out), [record])
+    assert os.path.isfile(str(out / 'Eve' / 'flight.png'))
+    assert 'src="Eve/flight.png"' in _read(str(out / 'index.html'))
+    assert [l for l in lines if l.startswith('Eve:')] == []
+
+
+def class_desk(tmp_path):
+    """Three graded students with their logs and grade.md, and a worksheet for them."""
+    out = tmp_path / 'out'
+    records = []
+    for number, name in enumerate(('Ada', 'Bob', 'Eve'), 101):
+        items = [{'id': item, 'points': top, 'max': top, 'evidence': 'ok'} for item, (top, _) in ITEMS.items()]
+        record = report.grade_record(name, 'altitude', items, ['hint'], {'participant': number})
+        os.makedirs(str(out / name / 'logs'))
+        with open(str(out / name / 'logs' / 'probe-main.json'), 'w') as f:
+            json.dump(probe_result(), f)
+        report.write_grade(str(out / name), record)
+        records.append(record)
+    worksheet = tmp_path / 'ws.csv'
+    worksheet.write_text('\ufeffIdentifier,Full name,Grade,Maximum grade,Last modified (grade),Feedback comments\n'
+                         + ''.join('"Participant %d","%s",,17.00,-,\n' % (r['participant'], r['student'])
+                                   for r in records), encoding='utf-8')
+    return out, records, str(worksheet)
+
+
+#: Each part of the desk made per student: (module, function, the student its call is for).
+PARTS = {'plot': (flightplot, 'draw', lambda runs, path, title: title),
+         'results.json': (gradescope, 'write', lambda folder, record: record['student']),
+         'section': (page, '_section', lambda record, entry: record['student'])}
+
+
+@pytest.mark.parametrize('part', sorted(PARTS))
+def test_the_desk_survives_one_student_whose_part_fails(part, tmp_path, monkeypatch):
+    out, records, worksheet = class_desk(tmp_path)
+    module, name, student_of = PARTS[part]
+    real = getattr(module, name)
+
+    def failing(*args):
+        if student_of(*args) == 'Bob':
+            raise RuntimeError('a bug on Bob\x1b[2J')
+        return real(*args)
+
+    monkeypatch.setattr(module, name, failing)
+    lines = desk.finish(str(out), records, similar={'pairs': [], 'students': 3}, worksheet=worksheet)
+    for student in ('Ada', 'Eve'):
+        assert os.path.isfile(str(out / student / 'flight.png'))
+        assert os.path.isfile(str(out / student / 'results.json'))
+    assert os.path.isfile(str(out / 'ws-filled.csv')) and any('3 grade(s) written' in l for l in lines)
+    html = _read(str(out / 'index.html'))
+    assert html.count('class="student"') == 3
+    assert 'src="Ada/flight.png"' in html and 'src="Eve/flight.png"' in html
+    bob = html[html.index('id="student-Bob"'):html.index('id="student-Eve"')]
+    assert 'a bug on Bob' in bob  # the note is in Bob's own section
+    assert 'never ran against the probe' not in bob  # its flight was flown: drawn, or its plot failed
+    if part != 'section':  # made before the page: the terminal says so too
+        assert [l for l in lines if l.startswith('Bob: ') and 'a bug on Bob' in l]
+    assert [l for l in lines if CONTROL.search(l)] == [] and CONTROL.search(html) is None
+
+
+def test_a_page_that_cannot_be_made_is_replaced_by_a_plain_one(tmp_path, monkeypatch):
+    out, records, worksheet = class_desk(tmp_path)
+
+    def broken(*args):
+        raise ValueError('no page\x1b[2J')
+
+    monkeypatch.setattr(page, 'render', broken)
+    lines = desk.finish(str(out), records, worksheet=worksheet)
+    html = _read(str(out / 'index.html'))
+    assert 'the page could not be made' in html and 'ValueError: no page' in html and CONTROL.search(html) is None
+    assert all('<a href="%s/grade.md">' % r['student'] in html for r in records)
+    assert any('the page could not be made' in l for l in lines) and os.path.isfile(str(out / 'ws-filled.csv'))

@@ -1,0 +1,89 @@
+"""The judge's side of a session (issue 26): its cgroup limits, and its master and probe never root.
+
+The limits are pure; the uid checks make a real box slot, so they need root (and bubblewrap's tools),
+and the master's a ROS install: they are skipped elsewhere.
+"""
+import os
+import shutil
+import subprocess
+import tempfile
+
+import pytest
+
+from exam_lab.grader.host import sandbox
+from exam_lab.grader.judge.session import uid_of
+from exam_lab.harness.supervisor import Supervisor, descendants
+from exam_lab.harness.wait import wait_until
+
+
+def test_a_box_gets_its_part_of_the_cores_and_the_judge_the_weight():
+    assert sandbox.box_cpus(2, cores=2) == 1.0
+    assert sandbox.box_cpus(1, cores=8) == 8.0
+    assert sandbox.box_cpus(8, cores=2) == sandbox.MIN_BOX_CPUS
+    v1 = sandbox.cgroup_limits(1 << 30, sandbox.BOX_SHARES, pids=512, cpus=1.0)
+    assert ('cpu', 'cpu.cfs_quota_us', sandbox.CPU_PERIOD_US) in v1
+    assert ('cpu', 'cpu.cfs_period_us', sandbox.CPU_PERIOD_US) in v1
+    assert ('cpu', 'cpu.shares', 1024) in v1 and ('pids', 'pids.max', 512) in v1
+    assert ('memory', 'memory.limit_in_bytes', 1 << 30) in v1
+    judge = sandbox.cgroup_limits(sandbox.MASTER_MEMORY_BYTES, sandbox.JUDGE_SHARES)
+    assert sorted(judge) == [('cpu', 'cpu.shares', sandbox.JUDGE_SHARES),
+                             ('memory', 'memory.limit_in_bytes', sandbox.MASTER_MEMORY_BYTES)]
+    assert sandbox.JUDGE_SHARES > sandbox.BOX_SHARES
+    v2 = dict((name, value) for _, name, value in sandbox.cgroup_limits(1 << 30, 4096, pids=512, cpus=0.5, v2=True))
+    assert v2 == {'memory.max': 1 << 30, 'cpu.weight': 400, 'cpu.max': '50000 100000', 'pids.max': 512}
+
+
+@pytest.fixture
+def box():
+    if os.geteuid() != 0 or sandbox.check() is not None:
+        pytest.skip('a box slot needs root and bubblewrap: %s' % sandbox.check())
+    work = tempfile.mkdtemp(prefix='exam-judge-test-')
+    os.chmod(work, 0o711)
+    os.makedirs(os.path.join(work, 'ws', 'src'))
+    try:
+        with sandbox.Box(work, cpus=1.0) as opened:
+            yield opened
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def test_the_judge_is_a_user_of_its_own_in_its_cgroups(box):
+    """The judge's commands drop root for the slot's judge uid (not the box's) and join the judge's
+    cgroups; the box's cgroup has its CPU quota."""
+    assert box.judge_uid == sandbox.JUDGE_UID_BASE + box.slot
+    done = subprocess.run(box.judge_argv(['sh', '-c', 'id -u; id -G; cat /proc/self/cgroup'], 'master'),
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=30)
+    lines = done.stdout.decode().splitlines()
+    assert lines[0] == str(box.judge_uid) and lines[1] == str(box.judge_uid), lines
+    assert [l for l in lines if ':memory:' in l and l.endswith('/exam-master-%d' % box.slot)], lines
+    assert [l for l in lines if ':cpu:' in l and l.endswith('/exam-master-%d' % box.slot)], lines
+    cpu = [f for f in box.cgroups if '/cpu/' in f]
+    assert cpu, box.cgroups
+    with open(os.path.join(cpu[0], 'cpu.cfs_quota_us')) as f:
+        assert int(f.read()) == sandbox.CPU_PERIOD_US
+    master_memory = [f for f in box.judge_cgroups['master'] if '/memory/' in f]
+    with open(os.path.join(master_memory[0], 'memory.limit_in_bytes')) as f:
+        assert int(f.read()) == sandbox.MASTER_MEMORY_BYTES
+
+
+def test_the_master_runs_as_the_judge_not_root(box, tmp_path):
+    """The master the session starts for the student's nodes: roscore and its children (rosmaster,
+    rosout) all have the judge's uid, and the master cgroup counts their memory."""
+    pytest.importorskip('rosgraph')
+    if shutil.which('roscore') is None:
+        pytest.skip('no ROS here')
+    judge_dir = os.path.join(box.work, 'judge')  # as the runner's: the work folder is 0711
+    os.mkdir(judge_dir, 0o700)
+    os.chown(judge_dir, box.judge_uid, box.judge_uid)
+    env = dict(os.environ, HOME=judge_dir, ROS_LOG_DIR=os.path.join(judge_dir, 'ros_log'),
+               ROS_HOME=os.path.join(judge_dir, 'ros_home'))
+    with Supervisor(str(tmp_path / 'logs'), env=env) as sup:
+        master = sup.start_master(wrap=box.judge_argv([], 'master'))
+        # roscore, then rosmaster and rosout (started once the master answers)
+        assert wait_until(lambda: len(descendants(master.proc.pid)) >= 2, 30.0, period=0.1), \
+            descendants(master.proc.pid)
+        family = [master.proc.pid] + descendants(master.proc.pid)
+        uids = {pid: uid_of(pid) for pid in family}
+        assert set(uids.values()) == {box.judge_uid}, uids
+        use = sandbox.memory_use(box.judge_cgroups['master'])
+        assert use['limit'] == sandbox.MASTER_MEMORY_BYTES and 0 < use['peak'] < use['limit'], use

@@ -1,0 +1,142 @@
+"""The Slurm engine's own logic, without Slurm: what it reads of squeue and scontrol, what it submits,
+and the retry rule (a task that ends without a grade is submitted once more, then is "not graded" with
+Slurm's words), against a scripted Slurm. lab/test/grader/test_slurm.py runs it on a real one."""
+import json
+import os
+
+import pytest
+
+from exam_lab.grader.engine import slurm
+
+
+def test_array_spec_joins_consecutive_indices():
+    assert slurm.array_spec(range(60)) == '0-59'
+    assert slurm.array_spec([17, 3, 18]) == '3,17-18'
+    assert slurm.array_spec([5]) == '5'
+
+
+def test_squeue_lines_give_each_task_its_state_and_reason():
+    text = '12 0 RUNNING None\n12 [1-3,5%2] PENDING Resources\n13 4 PENDING Priority\n'
+    tasks = slurm.parse_squeue(text)
+    assert tasks[('12', 0)] == ('RUNNING', 'None')
+    assert sorted(i for j, i in tasks if j == '12') == [0, 1, 2, 3, 5]
+    assert tasks[('12', 5)] == ('PENDING', 'Resources')
+    assert tasks[('13', 4)] == ('PENDING', 'Priority')
+
+
+def test_what_slurm_said_of_a_task():
+    fields = slurm.parse_scontrol('JobId=14 ArrayJobId=12 ArrayTaskId=2 JobName=exam-grade-out\n'
+                                  '   JobState=CANCELLED Reason=None Dependency=(null)\n'
+                                  '   Requeue=1 Restarts=0 BatchFlag=1 Reboot=0 ExitCode=0:15\n')
+    assert slurm.slurm_said(fields) == 'CANCELLED, exit code 0:15'
+    fields = slurm.parse_scontrol('JobState=TIMEOUT Reason=TimeLimit ExitCode=0:0')
+    assert slurm.slurm_said(fields) == 'TIMEOUT, reason TimeLimit'
+    assert slurm.slurm_said({}, ('PENDING', 'Resources')) == \
+        'the task left the queue and Slurm keeps no record of it (last seen PENDING, Resources)'
+    assert slurm.slurm_said({}) == 'the task left the queue and Slurm keeps no record of it'
+
+
+def test_the_state_line_counts_pending_running_and_done():
+    tasks = {('12', 0): ('RUNNING', 'None'), ('12', 1): ('PENDING', 'Resources'), ('13', 2): ('PENDING', 'Priority')}
+    assert slurm.state_line(['12', '13'], tasks, 3, 1, 8) == \
+        'slurm job 12+13: 2 pending, 1 running, 4 done of 8 (1 not graded)'
+
+
+class ScriptedSlurm(object):
+    """sbatch gives job ids 100, 101...; a task is in the queue for one look, then ends as ``ends``
+    says for that attempt (``'record'``: it leaves its grade, as a good task does; ``'queued'``: it
+    waits in the queue for ever)."""
+
+    def __init__(self, base, ends):
+        self.base, self.ends = base, ends
+        self.calls, self.queued, self.attempt = [], set(), {}
+        self.next_job = 100
+
+    def __call__(self, argv):
+        self.calls.append(argv)
+        if argv[0] == 'sbatch':
+            job = str(self.next_job)
+            self.next_job += 1
+            for index in slurm._indices(argv[argv.index('--array') + 1]):
+                self.attempt[index] = self.attempt.get(index, 0) + 1
+                self.queued.add((job, index))
+            return 0, '%s\n' % job, ''
+        if argv[0] == 'squeue':
+            lines = []
+            for key in sorted(self.queued):
+                job, index = key
+                end = self.ends[index][self.attempt[index] - 1]
+                lines.append('%s %d %s' % (job, index, 'PENDING Resources' if end == 'queued' else 'RUNNING None'))
+                if end == 'queued':
+                    continue
+                self.queued.discard(key)
+                if end == 'record':
+                    with open(os.path.join(self.base, 'results', '%d.json' % index), 'w') as f:
+                        json.dump({'student': 's%d' % index, 'status': 'graded'}, f)
+            return 0, '\n'.join(lines), ''
+        if argv[0] == 'scontrol':
+            index = int(argv[-1].split('_')[1])
+            return 0, 'JobState=%s Reason=None ExitCode=0:9' % self.ends[index][self.attempt[index] - 1], ''
+        return 0, '', ''
+
+
+@pytest.fixture
+def array(tmp_path, monkeypatch):
+    def make(ends):
+        base = str(tmp_path / '.slurm')
+        for sub in ('results', 'logs'):
+            os.makedirs(os.path.join(base, sub))
+        fake = ScriptedSlurm(base, ends)
+        monkeypatch.setattr(slurm, '_call', fake)
+        students = [('s%d' % i, '/class/s%d' % i) for i in range(len(ends))]
+        lines = []
+        return slurm._Array(students, base, os.path.join(base, 'task.sh'), 'exam-grade-out', ['--partition=p'],
+                            None, str(tmp_path), lines.append, None), fake, lines
+    return make
+
+
+def test_a_task_that_fails_is_submitted_once_more_then_not_graded_with_slurms_words(array):
+    run, fake, lines = array([['record'], ['NODE_FAIL', 'record'], ['CANCELLED', 'CANCELLED']])
+    run.submit(range(3))
+    for now in range(4):
+        run.look(float(now))
+    assert [c[c.index('--array') + 1] for c in fake.calls if c[0] == 'sbatch'] == ['0-2', '1-2']
+    assert all('--partition=p' in c for c in fake.calls if c[0] == 'sbatch')
+    assert [r['status'] for r in run.records] == ['graded', 'graded', 'not graded']
+    assert run.records[2]['status_reason'] == 'could not grade: Slurm said: CANCELLED, exit code 0:9'
+    assert os.path.isfile(os.path.join(str(run.out_dir), 's2', 'grade.json'))
+    assert any('s1 (task 100_1) ended without a grade: NODE_FAIL' in line for line in lines)
+    assert sum(1 for c in fake.calls if c[0] == 'sbatch') == 2, 'a second failure is not retried'
+
+
+def test_a_completed_task_is_given_time_for_its_grade_to_arrive(array):
+    run, fake, _ = array([['COMPLETED', 'COMPLETED']])
+    run.submit([0])
+    run.look(0.0)  # in the queue
+    run.look(1.0)  # gone, COMPLETED, no record yet: waited for
+    assert run.records == [None] and run.attempts[0] == 1
+    run.look(1.0 + slurm.RESULT_GRACE_S)
+    assert run.attempts[0] == 2, 'after the grace period, it is submitted again'
+
+
+def test_ctrl_c_cancels_the_class_jobs(array, monkeypatch):
+    run, fake, _ = array([['record'], ['record']])
+
+    def interrupted(now):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(run, 'look', interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        slurm._follow(run, 0.0, None, lambda line: None)
+    assert fake.calls[-1] == ['scancel', '100']
+
+
+def test_out_of_time_cancels_and_says_where_each_student_was(array, monkeypatch):
+    run, fake, _ = array([['record'], ['queued']])
+    monkeypatch.setattr(slurm.time, 'sleep', lambda seconds: None)
+    clock = iter([0.0, 5.0, 11.0])
+    monkeypatch.setattr(slurm.time, 'monotonic', lambda: next(clock))
+    records = slurm._follow(run, 0.0, 10.0, lambda line: None)
+    assert records[0]['status'] == 'graded'
+    assert records[1]['status_reason'] == \
+        'could not grade: Slurm said: no grade within 10 s; last seen PENDING, Resources'
+    assert ['scancel', '100'] in fake.calls
