@@ -112,3 +112,63 @@ def test_a_student_twice_or_a_renamed_column_is_refused(tmp_path):
         f.write('\n'.join([lines[0].replace('quality', 'Quality')] + lines[1:]) + '\n')
     with pytest.raises(hand.HandError, match='no column quality'):
         hand.read(path)
+
+
+def worksheet_script():
+    import importlib.util
+    import os
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    spec = importlib.util.spec_from_file_location('worksheet_script', os.path.join(repo, 'lab', 'scripts',
+                                                                                    'worksheet.py'))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+WORKSHEET = '\ufeff' + '\r\n'.join([
+    'Identifier,"Full name",Status,Grade,"Maximum grade","Grade can be changed","Last modified (grade)",'
+    '"Feedback comments"',
+    '"Participant 101","Jane Doe","Submitted for grading",,20.00,Yes,-,',
+    '"Participant 102","Paul Martin","Submitted for grading",,20.00,Yes,-,',
+]) + '\r\n'
+
+
+def test_the_whole_grade_on_the_worksheets_scale_and_nothing_missing_taken_as_zero(tmp_path, capsys):
+    import json
+    out = tmp_path / 'out'
+    jane, paul = record('Jane Doe', 17.0, 101), record('Paul Martin', 15.5, 102)
+    for r in (jane, paul):
+        (out / r['student']).mkdir(parents=True)
+        (out / r['student'] / 'grade.json').write_text(json.dumps(r))
+    hand.write(str(out / hand.FILE), [jane, paul])
+    cells = {('Jane Doe', item): str(top) for item, (top, _) in HAND_ITEMS.items()}
+    cells[('Jane Doe', 'quality')] = '1'
+    cells[('Paul Martin', 'Q4')] = '1'
+    fill(str(out / hand.FILE), cells)
+    (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8', newline='')
+    assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 0
+    printed = capsys.readouterr().out
+    filled = (out / 'ws-whole.csv').read_text(encoding='utf-8-sig')
+    rows = {r['Full name']: r for r in csv.DictReader(filled.splitlines())}
+    # Jane: 17 + 12 = 29 of 30 on a worksheet out of 20.
+    assert rows['Jane Doe']['Grade'] == '19.33'
+    comment = rows['Jane Doe']['Feedback comments']
+    assert '29 / 30 points: 17 of 17 by the machine' in comment and 'quality 1/2 (by hand)' in comment
+    # Paul's hand points are not all given: no grade, and he is named with what is missing.
+    assert rows['Paul Martin']['Grade'] == '' and rows['Paul Martin']['Feedback comments'] == ''
+    assert 'Paul Martin: Q5, Q6, Q7, Q8, Q9, comments, quality' in printed
+    assert 'hand points not given yet' in printed
+
+
+def test_a_badly_filled_hand_csv_stops_the_worksheet_with_every_problem(tmp_path, capsys):
+    import json
+    out = tmp_path / 'out'
+    (out / 'Jane Doe').mkdir(parents=True)
+    (out / 'Jane Doe' / 'grade.json').write_text(json.dumps(record('Jane Doe', 17.0, 101)))
+    hand.write(str(out / hand.FILE), [record('Jane Doe', 17.0, 101)])
+    fill(str(out / hand.FILE), {('Jane Doe', 'Q5'): 'two', ('Jane Doe', 'comments'): '9'})
+    (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8')
+    assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
+    err = capsys.readouterr().err
+    assert "column Q5: 'two'" in err and "column comments: '9'" in err
+    assert not (out / 'ws-whole.csv').exists()
