@@ -8,7 +8,7 @@ ENV := source tools/env.sh
 # `make test TESTS=run_tests_exam` runs one catkin test target instead of all of them.
 TESTS ?= run_tests
 
-.PHONY: help deps build run run-submarine run-simple test report bench soak mutation grade worksheet clean
+.PHONY: help deps build run run-submarine run-simple test report bench soak mutation grade worksheet check clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
@@ -24,6 +24,8 @@ help:
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
 	@echo "make worksheet OUT=<dir> WORKSHEET=<Moodle grading worksheet.csv>"
 	@echo "                    the whole grade (machine + OUT/hand.csv) into the worksheet, on its scale"
+	@echo "make check PACKAGE=<dir|zip> [SHEET=altitude|depth]"
+	@echo "                    a student's own check of their package, as an ordinary user (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
 
 deps:
@@ -73,6 +75,13 @@ grade: build
 # (OUT/hand.csv, filled by the teacher) as one grade on the worksheet's scale
 worksheet: build
 	@$(ENV) && exec python3 lab/scripts/worksheet.py --out "$(OUT)" --worksheet "$(WORKSHEET)"
+
+# make check PACKAGE=<dir or zip> [SHEET=altitude|depth]: a student's own check, without root or sudo.
+# It builds the workspace but installs nothing: a student's machine has ROS already, not the teacher's tools.
+check:
+	@$(if $(PACKAGE),,$(error make check needs PACKAGE=<your exam package: its folder or its zip>))
+	@tools/build_ws.sh
+	@$(ENV) && exec python3 lab/scripts/check.py --package "$(PACKAGE)" $(if $(SHEET),--sheet "$(SHEET)")
 
 clean:
 	rm -rf .ws

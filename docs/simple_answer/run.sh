@@ -3,7 +3,7 @@
 # (docs/simple_answer/exam) built and run on its own, as a student has it.
 # It is a second package named `exam`, so the repository's workspace never builds it (CATKIN_IGNORE):
 # it gets a catkin workspace of its own, $EXAM_WS/simple_answer (.ws/simple_answer by default), whose
-# src/ links to the drones, drone_sim and the simple answer, as in question 1 of the report. No other
+# src/ links to the drones, drone_sim and node_kit (what they share) and the simple answer, as in question 1 of the report. No other
 # workspace is its underlay, so `roslaunch exam ...` there can only find the simple answer's `exam`.
 # Then tools/run_launch.sh runs the sheet's launch file in that workspace (Ctrl-C stops it).
 # Usage: docs/simple_answer/run.sh [--build-only] altitude|depth [roslaunch arguments, e.g. threshold:=1200]
@@ -32,7 +32,7 @@ if [ -f /opt/ros/noetic/setup.bash ]; then
 fi
 
 mkdir -p "$ws/src"
-for package in drone_sim mydrone submarinedrone docs/simple_answer/exam; do
+for package in node_kit drone_sim mydrone submarinedrone docs/simple_answer/exam; do
   ln -sfn "$repo/$package" "$ws/src/$(basename "$package")"
 done
 cd "$ws"

@@ -6,7 +6,7 @@ Usage: collect.py --work DIR --run-dir DIR [--run-seconds S]
 The order follows the exam sheets:
 
 1. ``catkin_make`` in a scratch workspace as a student has it (question 1): src/ links to the drones'
-   packages (and drone_sim, which they share) and to the simple answer, docs/simple_answer/exam, with
+   packages (and drone_sim and node_kit, which they share) and to the simple answer, docs/simple_answer/exam, with
    no workspace of ours on CMAKE_PREFIX_PATH.
 2. A master; ``rosrun mydrone mydrone_node.py`` alone; questions 4 to 8, the warning service by hand,
    and question 10's first step (a node that only logs what it receives).
@@ -38,7 +38,7 @@ from exam_lab.harness.wait import wait_until
 import command_list
 
 #: The packages of question 1's workspace, as a student has them: the drones and their exam package.
-STUDENT_PACKAGES = ['drone_sim', 'mydrone', 'submarinedrone', 'docs/simple_answer/exam']
+STUDENT_PACKAGES = ['node_kit', 'drone_sim', 'mydrone', 'submarinedrone', 'docs/simple_answer/exam']
 #: Seconds of one recorded run: the default profiles loop in 100 s; the rest is start-up margin.
 DEFAULT_RUN_SECONDS = 106.0
 

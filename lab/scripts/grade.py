@@ -21,7 +21,7 @@ import sys
 
 from exam_lab.grader import runner
 
-from exam_lab.grader.boxed import documents, unpack
+from exam_lab.grader.boxed import unpack
 from exam_lab.grader.engine import slurm
 
 from exam_lab.grader.publish import desk, moodle, progress, report
@@ -67,7 +67,6 @@ def main(argv=None):
     try:
         if args.submission:
             record = runner.grade_submission(args.submission, out, args.sheet, on_step=progress.StepProgress(),
-                                             extra=documents.submission_facts(args.submission),
                                              unsandboxed=args.unsandboxed)
             say(report.table([record]))
             if record.get('status_reason'):

@@ -32,9 +32,10 @@ All times are ROS times, so the node follows ``/clock`` under ``use_sim_time``; 
 counts from the node's start (or from the first clock message under sim time).
 
 A master that restarts finds the node again within about a second, parameters included
-(:mod:`drone_sim.master_link`, which also publishes the "<node>: master" status on /diagnostics);
-the sensors and the service keep working while it is down. Timers and the service handler go through
-:mod:`drone_sim.lifecycle`: a stop at any moment is quiet.
+(:mod:`node_kit.master_link`, whose "<node>: master" status :mod:`node_kit.lifecycle` publishes on
+/diagnostics every ``~diagnostic_period`` s, default 1); the sensors and the service keep working
+while it is down. Timers and the service handler go through :mod:`node_kit.lifecycle`: a stop at
+any moment is quiet.
 """
 
 import collections
@@ -44,10 +45,10 @@ import threading
 import rospy
 from std_msgs.msg import Float32, String
 
-from drone_sim import lifecycle, params
 from drone_sim.led import WarningLed
 from drone_sim.noise import GaussianNoise
 from drone_sim.profile import parse_profile
+from node_kit import lifecycle, params
 
 Sensor = collections.namedtuple(
     'Sensor', 'topic default_rate default_noise unit read publishes_truth')
@@ -81,7 +82,7 @@ class SimulatorNode:
     """A drone simulator; see the module docstring for its ROS API.
 
     :param spec: the DroneSpec of the drone.
-    :raises drone_sim.params.ParamError: a parameter is invalid.
+    :raises node_kit.params.ParamError: a parameter is invalid.
     """
 
     def __init__(self, spec):

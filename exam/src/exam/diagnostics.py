@@ -1,6 +1,7 @@
-"""The exam node's /diagnostics: its inputs and its warning, once a second (rqt_runtime_monitor shows them).
+"""The exam node's /diagnostics: its inputs and its warning (rqt_runtime_monitor shows them).
 
-Two statuses, named after the node by diagnostic_updater:
+Two statuses, named after the node by diagnostic_updater, in the node's one Updater
+(:func:`node_kit.lifecycle.updater`, which publishes them with the "<node>: master" status):
 
 - ``<node>: inputs``: each input's measured rate [Hz], age [s] and rejected readings; WARN while an
   input is stale (older than ``~timeout``) or has never arrived.
@@ -10,26 +11,16 @@ Two statuses, named after the node by diagnostic_updater:
 The status functions only format copies the node takes under its locks (:class:`Snapshot`, and
 :meth:`exam.warning_link.WarningLink.snapshot`): they never touch the node's state themselves.
 
-The timer never dies: diagnostic_updater reads ``~diagnostic_period`` from the master on every update,
-which raises while the master is unreachable; the statuses are then published anyway (subscribers
-already connected keep seeing them) and the failure is logged once per outage (:func:`publish`).
-
 Published Topics:
-    /diagnostics (diagnostic_msgs/DiagnosticArray): every second. diagnostic_updater also reads its
-        own ``~diagnostic_period`` (s, default 1): a longer period publishes less often.
+    /diagnostics (diagnostic_msgs/DiagnosticArray): every ``~diagnostic_period`` seconds (default 1),
+        also while the master is down (subscribers already connected keep seeing them).
 """
 import collections
 
-import diagnostic_updater
-import rospy
 from diagnostic_msgs.msg import DiagnosticStatus
 
-from drone_sim import lifecycle
-from drone_sim.outage import OncePerOutage
 from exam.warning_link import LED_COLOURS
-
-#: Seconds between two updates of /diagnostics.
-PERIOD_S = 1.0
+from node_kit import lifecycle
 
 #: One input as diagnostics show it: topic, measured rate [Hz], age [s] or None, rejected readings.
 InputRow = collections.namedtuple('InputRow', 'topic rate age rejected')
@@ -78,39 +69,12 @@ def warning_status(stat, snapshot, link, mode, service):
 
 
 def start(snapshot, link_snapshot, mode, service, timeout):
-    """Publish both statuses every PERIOD_S seconds from a timer of their own; return the Updater.
+    """Add both statuses to the node's Updater, which node_kit publishes; return the Updater.
 
     :param snapshot: function() -> Snapshot, a copy of the node's state taken under its lock.
     :param link_snapshot: function() -> the warning link's snapshot() dict.
     """
-    updater = diagnostic_updater.Updater()
-    updater.setHardwareID(rospy.get_name())
+    updater = lifecycle.updater()
     updater.add('inputs', lambda stat: inputs_status(stat, snapshot(), timeout))
     updater.add('warning', lambda stat: warning_status(stat, snapshot(), link_snapshot(), mode, service))
-    guard = OncePerOutage('/diagnostics: reading the diagnostic_period parameter from the master',
-                          'the master is unreachable; the statuses are published every %.0f s anyway '
-                          '(connected subscribers keep them, a new one finds them once the master is '
-                          'back)' % PERIOD_S)
-    lifecycle.timer(PERIOD_S, lambda event: publish(updater, guard))
     return updater
-
-
-def publish(updater, guard):
-    """One update of ``updater`` that never raises: a timer thread that raises is gone for good.
-
-    :param guard: a :class:`drone_sim.outage.OncePerOutage`: the failure is logged once per outage.
-    """
-    try:
-        updater.update()
-    except Exception as err:  # ConnectionRefusedError, timeouts... from the master
-        line = guard.failed('%s: %s' % (type(err).__name__, err))
-        if line is not None:
-            rospy.logwarn(line)
-        try:
-            updater.force_update()  # publishes only: no master involved
-        except Exception as err:
-            rospy.logerr_throttle(60.0, '/diagnostics not published: %s: %s' % (type(err).__name__, err))
-        return
-    line = guard.succeeded()
-    if line is not None:
-        rospy.loginfo(line)

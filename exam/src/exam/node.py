@@ -4,7 +4,7 @@ This module is the ROS wiring only: it reads the parameters, creates the publish
 timers, and hands every event to pure logic: the physics in :mod:`exam.formulas`, the latest reading of
 each input in :mod:`exam.inputs`, the warning rule in :mod:`exam.debounce`, the service calls in
 :mod:`exam.warning_link`, what differs between the two drones in :mod:`exam.modes`. The parameter checks
-are :mod:`drone_sim.params` (shared with the simulators), and /diagnostics is :mod:`exam.diagnostics`.
+are :mod:`node_kit.params` (shared with the simulators), and /diagnostics is :mod:`exam.diagnostics`.
 
 How one reading travels (each step runs on the thread rospy gives it):
 
@@ -16,12 +16,12 @@ How one reading travels (each step runs on the thread rospy gives it):
    armed for the debouncer's ``deadline`` (question 14b), so the WARNING is not late by a reading.
 3. A periodic timer publishes the latest value at ``~rate`` Hz, only while every input is fresh; a stale
    input interrupts a pending excess.
-4. A 1 Hz timer publishes /diagnostics.
-5. A thread of :mod:`drone_sim.master_link` keeps the node registered across a master restart, and the
+4. A timer of :mod:`node_kit.lifecycle` publishes /diagnostics, every ``~diagnostic_period`` s.
+5. A thread of :mod:`node_kit.master_link` keeps the node registered across a master restart, and the
    connection to the warning service (:func:`exam.warning_link.service_link`) is opened ahead
    of the first call and kept, so a state decided while the master is down still reaches the drone.
 
-Every timer and callback goes through :mod:`drone_sim.lifecycle`, so a stop at any moment ends them
+Every timer and callback goes through :mod:`node_kit.lifecycle`, so a stop at any moment ends them
 all before rospy closes the publishers: no traceback at Ctrl-C.
 
 State shared by these threads (the caches, the value, the debouncer) is guarded by one lock, held only
@@ -35,6 +35,8 @@ ROS Parameters (private; a value that is given but unusable stops the node with 
     ~rate (float, Hz, default 10.0, > 0): publishing rate of the output topic.
     ~timeout (float, s, default 5.0, > 0): an input older than this is stale; nothing is published and
         no excess is timed until it is fresh again.
+    ~diagnostic_period (float, s, default 1.0, > 0): seconds between two publications of
+        /diagnostics (diagnostic_updater's parameter, read by :func:`node_kit.lifecycle.run`).
 
 Subscribed Topics:
     altitude mode: temperature (std_msgs/Float32, degC), pressure (std_msgs/Float32, Pa),
@@ -57,12 +59,12 @@ import threading
 import rospy
 from std_msgs.msg import Float32, String
 
-from drone_sim import lifecycle, master_link, params
 from exam import diagnostics, messages
 from exam.debounce import Debouncer, excess_news
 from exam.inputs import InputCache
 from exam.modes import MODES
 from exam.warning_link import LED_STATES, service_link
+from node_kit import lifecycle, master_link, params
 
 #: Seconds between two identical warnings on a 10 Hz path, so a fault does not flood /rosout.
 THROTTLE_S = 5.0
@@ -86,7 +88,7 @@ def read_params():
     """Every parameter, checked before anything is created.
 
     A value that is given but unusable stops the node: a typo in a launch file must not fly with a
-    threshold nobody chose. :raises drone_sim.params.ParamError: naming the parameter and the value.
+    threshold nobody chose. :raises node_kit.params.ParamError: naming the parameter and the value.
     """
     mode = MODES[params.one_of(*_param('mode', 'altitude'), choices=MODES)]
     return Params(mode=mode,
@@ -105,7 +107,7 @@ def _names(caches):
 class ExamNode(object):
     """Computes, publishes and watches one value (altitude or depth); see the module docstring.
 
-    :raises drone_sim.params.ParamError: a parameter is unusable (nothing has been created then).
+    :raises node_kit.params.ParamError: a parameter is unusable (nothing has been created then).
     """
 
     def __init__(self):

@@ -1,7 +1,7 @@
 """Delivers the wanted warning state to the drone's LED service, from a thread of its own.
 
 No rospy here: the node injects the function that opens a connection to the service
-(:func:`drone_sim.master_link.open_persistent`), so the delivery rules and the connection's are
+(:func:`node_kit.master_link.open_persistent`), so the delivery rules and the connection's are
 unit-tested with a fake service.
 
 Why a thread (exam question 13 done right): a ROS service call is a blocking round trip to another

@@ -66,32 +66,3 @@ def test_warning_pending_then_failing_service_is_an_error():
     assert values(stat)['LED wanted'] == 'RED'
     assert values(stat)['failed service calls'] == '2'
 
-
-class FlakyUpdater(object):
-    """diagnostic_updater.Updater's update() while the master is down: it raises; force_update works."""
-
-    def __init__(self):
-        self.master_up = False
-        self.published = 0
-
-    def update(self):
-        if not self.master_up:
-            raise ConnectionRefusedError(111, 'Connection refused')
-        self.published += 1
-
-    def force_update(self):
-        self.published += 1
-
-
-def test_an_update_while_the_master_is_down_never_raises_and_still_publishes():
-    from drone_sim.outage import OncePerOutage
-    from exam.diagnostics import publish
-    updater = FlakyUpdater()
-    guard = OncePerOutage('/diagnostics: reading ~diagnostic_period from the master', 'published anyway')
-    for _ in range(3):
-        publish(updater, guard)  # a timer thread that raised would be gone for good
-    assert updater.published == 3
-    assert guard.succeeded() is not None  # the failures were counted
-    updater.master_up = True
-    publish(updater, guard)
-    assert updater.published == 4

@@ -256,7 +256,7 @@ ROS_COMMAND = re.compile(r'\b(rosrun|roslaunch|rostest)\s+(?:--\S+\s+)*([a-z_]+)
 #: `$(find PKG)/path` in a launch file quoted by the docs.
 FIND = re.compile(r'\$\(find (\w+)\)/([\w/.-]+)')
 #: A path inside this repository, in backticks or a Markdown link: `lab/test/ops/replay.test`.
-REPO_PATH = re.compile(r'[`(]((?:exam|mydrone|submarinedrone|drone_sim|lab|tools|docs)/[\w./-]*)[`)#]')
+REPO_PATH = re.compile(r'[`(]((?:exam|mydrone|submarinedrone|drone_sim|node_kit|lab|tools|docs)/[\w./-]*)[`)#]')
 
 
 def named_things(text):

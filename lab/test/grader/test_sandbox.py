@@ -4,8 +4,9 @@ The class: ``a_saboteur`` (kills, reads and writes its classmate graded beside i
 good student's package: it must keep its 17 points), ``c_forger`` (an idle node that writes a real
 probe result where the grader used to read its own), ``d_escapee`` (prints its environment and a
 root-only file, leaves links and a FIFO where the grader copies logs from, starts detached children at
-build and run time). Their payloads live in lab/test/grader/hostile/ and do nothing as root. About 2
-minutes on two cores; the copy and refusal checks need no ROS.
+build and run time), ``e_snoop`` (no code: its launch file includes a root-only launch file whose node
+and parameter names carry a secret; issue 26 point 1). Their payloads live in lab/test/grader/hostile/
+and do nothing as root. About 2 minutes on two cores; the copy and refusal checks need no ROS.
 """
 import json
 import os
@@ -14,6 +15,7 @@ import shutil
 import signal
 import subprocess
 import tempfile
+import time
 
 import pytest
 
@@ -32,7 +34,22 @@ SECRET_DIR = '/tmp/exam-hostile-secret'
 #: In the command line of the escapee's detached children.
 DETACHED = 'exam-hostile-detached'
 CLASS = [('a_saboteur', os.path.join(HOSTILE, 'saboteur', 'exam')), ('b_victim', VICTIM),
-         ('c_forger', os.path.join(HOSTILE, 'forger', 'exam')), ('d_escapee', os.path.join(HOSTILE, 'escapee', 'exam'))]
+         ('c_forger', os.path.join(HOSTILE, 'forger', 'exam')), ('d_escapee', os.path.join(HOSTILE, 'escapee', 'exam')),
+         ('e_snoop', os.path.join(HOSTILE, 'snoop', 'exam'))]
+#: The root-only launch file the snoop includes (its launch file names it).
+SECRET_LAUNCH = os.path.join(SECRET_DIR, 'secret.launch')
+
+
+def write_secrets(token):
+    """SECRET_DIR (readable) with secret.txt and secret.launch (root's, mode 600), each carrying ``token``."""
+    shutil.rmtree(SECRET_DIR, ignore_errors=True)
+    os.makedirs(SECRET_DIR)
+    os.chmod(SECRET_DIR, 0o755)
+    for path, text in ((os.path.join(SECRET_DIR, 'secret.txt'), token),
+                       (SECRET_LAUNCH, '<launch><node pkg="exam" type="exam_node_%s.py" name="exam">'
+                                       '<param name="threshold_%s" value="1300"/></node></launch>\n' % (token, token))):
+        with open(os.open(path, os.O_WRONLY | os.O_CREAT, 0o600), 'w') as f:
+            f.write(text)
 
 
 def detached_children():
@@ -66,13 +83,8 @@ def hostile_class(tmp_path_factory):
     klass = root / 'class'
     for name, package in CLASS:
         shutil.copytree(package, str(klass / name / 'exam'), ignore=shutil.ignore_patterns('__pycache__'))
-    shutil.rmtree(SECRET_DIR, ignore_errors=True)
-    os.makedirs(SECRET_DIR)
-    os.chmod(SECRET_DIR, 0o755)
     secret_file = 'root-only-%s' % secrets.token_hex(8)
-    path = os.path.join(SECRET_DIR, 'secret.txt')
-    with open(os.open(path, os.O_WRONLY | os.O_CREAT, 0o600), 'w') as f:
-        f.write(secret_file)
+    write_secrets(secret_file)
     secret_var = 'grader-env-%s' % secrets.token_hex(8)
     saved = {k: os.environ.get(k) for k in ('EXAM_HOSTILE_SECRET', 'EXAM_HOSTILE_CLASS')}
     os.environ.update(EXAM_HOSTILE_SECRET=secret_var, EXAM_HOSTILE_CLASS='1')
@@ -109,6 +121,8 @@ def test_links_and_fifos_do_not_stop_the_class(hostile_class):
 def test_every_student_runs_in_a_box_of_its_own(hostile_class):
     boxes = []
     for name, record in sorted(hostile_class['records'].items()):
+        if name == 'e_snoop':
+            continue  # no code: nothing of it runs (its upload is read in a box: test_a_snoop_reads_nothing_root_can)
         ran = [hint for hint in record['for_the_teacher'] if hint.startswith('ran ') and ' as ' in hint]
         assert len(ran) == 1 and ran[0].startswith('ran in a bubblewrap sandbox as uid '), (name, ran)
         boxes.append(int(ran[0].split('as uid ')[1].split(':')[0]))
@@ -150,6 +164,119 @@ def test_secrets_never_reach_the_results(hostile_class):
     for path, text in files_under(hostile_class['out']):
         for secret in hostile_class['secrets']:
             assert secret not in text, path
+
+
+def read_as(record):
+    """The uids the grade record says its upload was read as."""
+    return [int(hint.split(' as uid ')[1].split(',')[0]) for hint in record['for_the_teacher']
+            if hint.startswith('the upload was read ') and ' as uid ' in hint]
+
+
+def test_a_snoop_reads_nothing_root_can(hostile_class):
+    """Its include of a root-only launch file is not there for the box that reads it: no node, no
+    parameter, nothing to run; the class went on around it."""
+    record = hostile_class['records']['e_snoop']
+    assert [uid for uid in read_as(record) if uid >= sandbox.BOX_UID_BASE] == read_as(record) != []
+    assert [h for h in record['for_the_teacher'] if 'include' in h and 'not found' in h], record['for_the_teacher']
+    assert record['total'] == 0.0
+
+
+def test_the_upload_is_read_as_the_box_uid(tmp_path):
+    """grade_submission of the snoop alone: the inspection runs as the box's uid, so the root-only
+    launch file it includes is never read (today's grader read it as root: the secret in its node's
+    type and parameter name reached the grade)."""
+    if os.geteuid() != 0 or sandbox.check() is not None:
+        pytest.skip('boxes need root and bubblewrap: %s' % sandbox.check())
+    token = 'root-only-%s' % secrets.token_hex(8)
+    write_secrets(token)
+    try:
+        record = runner.grade_submission(os.path.join(HOSTILE, 'snoop', 'exam'), str(tmp_path / 'out'), student='snoop')
+    finally:
+        shutil.rmtree(SECRET_DIR, ignore_errors=True)
+    assert token not in json.dumps(record)
+    for path, text in files_under(str(tmp_path / 'out')):
+        assert token not in text, path
+    assert read_as(record) and all(uid >= sandbox.BOX_UID_BASE for uid in read_as(record)), record['for_the_teacher']
+
+
+def test_reading_student_bytes_is_bounded(tmp_path):
+    """What reads a student's bytes is stopped at its bounds, and its record is one regular file:
+    a loop at the CPU bound, a sleeper at the wall clock, a memory hog at its address space, a link
+    where the record should be; each is that student's failure (InspectionFailed), never root's."""
+    from exam_lab.grader.score import records
+    if os.geteuid() != 0 or sandbox.check() is not None:
+        pytest.skip('boxes need root and bubblewrap: %s' % sandbox.check())
+    cases = [('while True: pass', (60.0, 2, 1 << 30), 'killed by signal'),
+             ('time.sleep(600)', (3.0, 60, 1 << 30), 'did not finish within 3 s'),
+             ('bytearray(2 << 30)', (60.0, 60, 1 << 30), 'MemoryError'),
+             ('os.symlink("/etc/shadow", "inspect.json")', (60.0, 60, 1 << 30), 'a link, not followed')]
+    for statement, bounds, words in cases:
+        work = tempfile.mkdtemp(prefix='exam-bounds-test-')
+        try:
+            os.chmod(work, 0o711)
+            for sub in ('upload', 'ws', 'ws/src'):
+                os.mkdir(os.path.join(work, sub), 0o755)
+            start = time.monotonic()
+            with sandbox.Box(work) as box:
+                boxed = runner.Boxed(box, work)
+                with pytest.raises(runner.InspectionFailed) as failed:
+                    boxed.run('timeit', ['-n', '1', '-r', '1', '-s', 'import os, time', statement],
+                              records.InspectRecord, bounds)
+                assert not box.leftovers()
+            assert words in str(failed.value), (statement, str(failed.value))
+            assert time.monotonic() - start < bounds[0] + 30.0
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
+
+
+def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
+    """A class zip is opened by a box's uid (boxed/intake), never root: its students come back as names
+    and folders inside the intake's own folder; an archive that climbs out is refused as a whole."""
+    if os.geteuid() != 0 or sandbox.check() is not None:
+        pytest.skip('boxes need root and bubblewrap: %s' % sandbox.check())
+    import zipfile
+    from exam_lab.grader.boxed import unpack
+    archive = str(tmp_path / 'class.zip')
+    with zipfile.ZipFile(archive, 'w') as zf:
+        for folder in ('Jane Doe_12_assignsubmission_file_', 'Bob_13_assignsubmission_file_'):
+            zf.writestr('%s/exam/package.xml' % folder, '<package><name>exam</name></package>')
+    work_dirs = []
+    try:
+        students = runner.class_students(archive, work_dirs)
+        assert [name for name, _ in students] == ['Bob', 'Jane Doe']
+        for _, folder in students:
+            assert folder.startswith(work_dirs[0] + '/') and os.stat(folder).st_uid >= sandbox.BOX_UID_BASE
+            assert os.path.isfile(os.path.join(folder, 'exam', 'package.xml'))
+        with zipfile.ZipFile(archive, 'a') as zf:
+            zf.writestr('../outside.txt', 'x')
+        with pytest.raises(unpack.UnpackError, match='unpacking it in its box failed'):
+            runner.class_students(archive, work_dirs)
+    finally:
+        for work in work_dirs:
+            shutil.rmtree(work, ignore_errors=True)
+
+
+def test_an_upload_is_staged_as_bytes_never_followed(tmp_path):
+    """What root does with an upload before its box reads it: a copy of its regular files, folders and
+    links (as links: never followed, even to a root-only file), no FIFO, within a size budget."""
+    upload, staged = tmp_path / 'upload', tmp_path / 'staged'
+    (upload / 'exam' / 'launch').mkdir(parents=True)
+    (upload / 'exam' / 'launch' / 'exam.launch').write_text('<launch/>')
+    (upload / 'exam' / 'node.py').write_text('#!/usr/bin/env python3\n')
+    (upload / 'exam' / 'node.py').chmod(0o700)
+    secret = tmp_path / 'secret.txt'
+    secret.write_text('root-only')
+    secret.chmod(0o600)
+    os.symlink(str(secret), str(upload / 'exam' / 'leak.txt'))
+    os.mkfifo(str(upload / 'exam' / 'fifo'))
+    sandbox.stage_upload(str(upload), str(staged))
+    assert sorted(os.listdir(str(staged / 'exam'))) == ['launch', 'leak.txt', 'node.py']
+    assert oct(os.stat(str(staged / 'exam' / 'node.py')).st_mode & 0o777) == '0o755', 'a script stays executable'
+    assert os.readlink(str(staged / 'exam' / 'leak.txt')) == str(secret)
+    assert (staged / 'exam' / 'launch' / 'exam.launch').read_text() == '<launch/>'
+    assert oct(os.stat(str(staged / 'exam' / 'launch' / 'exam.launch')).st_mode & 0o777) == '0o644'
+    with pytest.raises(sandbox.UploadRefused, match='larger than the grader takes'):
+        sandbox.stage_upload(str(upload), str(tmp_path / 'capped'), max_bytes=4)
 
 
 def test_the_results_take_only_regular_files_capped(tmp_path):

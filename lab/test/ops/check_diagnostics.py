@@ -4,7 +4,8 @@ failing warning service, and back.
 
 Runs in diagnostics.test. This checker is the drone itself (the harness's fake Drone, scripted
 in-process) and watches the two statuses the exam node publishes: "<node>: inputs" (each input's rate
-and age) and "<node>: warning" (value, threshold, state, service failures).
+and age) and "<node>: warning" (value, threshold, state, service failures), and that they travel with
+"<node>: master" in one array: the node has one Updater (issue 31).
 
 ROS Parameters:
     ~node (str, default "exam"): the exam node's name, prefix of its status names.
@@ -44,8 +45,13 @@ class DiagnosticsTest(unittest.TestCase):
         cls.delay = float(rospy.get_param('~delay'))
         cls.inputs_name = node + ': inputs'
         cls.warning_name = node + ': warning'
+        cls.master_name = node + ': master'
+        cls.prefix = node + ': '
         cls.lock = threading.Lock()
         cls.statuses = {}
+        # The names of the node's statuses in each array it published, less diagnostic_updater's
+        # "Node starting up" (an array of one status as each is added).
+        cls.arrays = []
         cls.sub = rospy.Subscriber('/diagnostics', DiagnosticArray, cls.on_diagnostics)
         cls.drone = Drone('altitude')
         cls.drone.start(1000.0)
@@ -53,9 +59,13 @@ class DiagnosticsTest(unittest.TestCase):
     @classmethod
     def on_diagnostics(cls, msg):
         now = time.monotonic()
+        names = {s.name for s in msg.status
+                 if s.name.startswith(cls.prefix) and s.message != 'Node starting up'}
         with cls.lock:
             for status in msg.status:
                 cls.statuses[status.name] = (now, status)
+            if names:
+                cls.arrays.append(names)
 
     def fresh_status(self, name, since, levels):
         """The status `name` received after `since` (monotonic s) if its level is in `levels`."""
@@ -75,6 +85,17 @@ class DiagnosticsTest(unittest.TestCase):
                 name, '/'.join(LEVEL_NAMES[level] for level in levels), within,
                 None if last is None else '%s %r' % (LEVEL_NAMES.get(last.level), last.message)))
         return status
+
+    def test_0_every_status_of_the_node_travels_in_one_array(self):
+        def with_master():
+            with self.lock:
+                found = [names for names in self.arrays if self.master_name in names]
+            return found if len(found) >= 3 else None
+        arrays = wait_for(with_master, SLACK + 10.0)
+        self.assertIsNotNone(arrays, 'fewer than 3 arrays with %r within %.0f s' % (self.master_name,
+                                                                                     SLACK + 10.0))
+        for names in arrays:
+            self.assertEqual(names, {self.inputs_name, self.warning_name, self.master_name})
 
     def test_1_healthy_is_ok_with_rates_ages_value_and_threshold(self):
         self.wait_level(self.inputs_name, (OK,), SLACK + 10.0)

@@ -37,20 +37,20 @@ def test_threshold_run_only_after_a_warning_in_the_long_excursion():
 
 def test_sheet_detection(tmp_path):
     from exam_lab.grader import runner
-    from exam_lab.grader.boxed import launch
+    from exam_lab.grader.boxed import inspect, launch
     pkg = tmp_path / 'exam'
     (pkg / 'launch').mkdir(parents=True)
     (pkg / 'package.xml').write_text('<package><name>exam</name><depend>mydrone</depend>'
                                      '<depend>submarinedrone</depend></package>')
-    assert runner.detect_sheet('depth', str(pkg), [])[0] == 'depth'
-    assert runner.detect_sheet(None, str(pkg), [])[0] == 'altitude'
-    assert 'SHEET=depth' in runner.detect_sheet(None, str(pkg), [])[1], 'an ambiguous package says how to choose'
+    assert inspect.detect_sheet('depth', str(pkg), [])[0] == 'depth'
+    assert inspect.detect_sheet(None, str(pkg), [])[0] == 'altitude'
+    assert 'SHEET=depth' in inspect.detect_sheet(None, str(pkg), [])[1], 'an ambiguous package says how to choose'
     (pkg / 'launch' / 'exam.launch').write_text('<launch><node pkg="submarinedrone" type="submarine_drone_node.py" '
                                                 'name="d"/><node pkg="exam" type="n.py" name="exam"/></launch>')
     analyses = [launch.analyse(p, str(pkg)) for p in launch.launch_files(str(pkg))]
-    assert runner.detect_sheet(None, str(pkg), analyses)[0] == 'depth'
+    assert inspect.detect_sheet(None, str(pkg), analyses)[0] == 'depth'
     (pkg / 'package.xml').write_text('<package><name>exam</name><exec_depend>mydrone</exec_depend></package>')
-    assert runner.detect_sheet(None, str(pkg), analyses)[0] == 'altitude', 'package.xml first'
+    assert inspect.detect_sheet(None, str(pkg), analyses)[0] == 'altitude', 'package.xml first'
     assert runner.margin_of(1300.0) == 130.0 and runner.margin_of(50.0) == 10.0
 
 

@@ -1,12 +1,15 @@
 """The layering rules of docs/architecture.md ("Layout: two wings"), read from the source with ast.
 
-- The answer (exam, mydrone, submarinedrone, drone_sim) never imports the lab (exam_lab), in its
+- The answer (exam, mydrone, submarinedrone, drone_sim, node_kit) never imports the lab (exam_lab), in its
   code, its scripts or its tests.
 - Pure modules import neither rospy nor any module that does (their unit tests run without a master,
   and the logic they hold is readable without ROS).
 - No import cycle among the project's modules.
 - The harness's oracle imports nothing of the answer: an oracle that reuses the code it checks cannot
   catch a wrong constant.
+- The node kit (node_kit) is below the simulators and the exam node: it imports none of them.
+- rospy's private names (``rospy.impl``, ``rospy.core``, a name with a leading underscore) are used
+  in one module only, node_kit.rospy_private, and its tests.
 """
 import ast
 import glob
@@ -15,12 +18,12 @@ import os
 import pytest
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
-ANSWER = ('exam', 'mydrone', 'submarinedrone', 'drone_sim')
+ANSWER = ('exam', 'mydrone', 'submarinedrone', 'drone_sim', 'node_kit')
 #: The modules that hold logic without ROS (module name -> its file).
-PURE = ['exam.formulas', 'exam.inputs', 'exam.debounce', 'exam.warning_link', 'drone_sim.params',
-        'drone_sim.led', 'drone_sim.noise', 'drone_sim.profile', 'drone_sim.outage', 'drone_sim.master_line',
-        'mydrone.atmosphere', 'mydrone.flights', 'submarinedrone.hydrostatics', 'submarinedrone.dives',
-        'exam_lab.harness.oracle', 'exam_lab.harness.wait']
+PURE = ['exam.formulas', 'exam.inputs', 'exam.debounce', 'exam.warning_link', 'drone_sim.led',
+        'drone_sim.noise', 'drone_sim.profile', 'node_kit.params', 'node_kit.gate', 'node_kit.outage',
+        'node_kit.master_line', 'mydrone.atmosphere', 'mydrone.flights', 'submarinedrone.hydrostatics',
+        'submarinedrone.dives', 'exam_lab.harness.oracle', 'exam_lab.harness.wait']
 #: Modules that talk to ROS (besides rospy itself); a pure module must not import them either.
 ROS = ('rospy', 'rosgraph', 'roslaunch', 'rosbag', 'diagnostic_updater')
 
@@ -37,12 +40,16 @@ def source_modules():
     return modules
 
 
+def nodes(path):
+    """Every node of a file's syntax tree."""
+    with open(path) as f:
+        return ast.walk(ast.parse(f.read(), path))
+
+
 def imports(path):
     """Every module name a file imports (absolute imports; `from a.b import c` gives a.b and a.b.c)."""
-    with open(path) as f:
-        tree = ast.parse(f.read(), path)
     names = set()
-    for node in ast.walk(tree):
+    for node in nodes(path):
         if isinstance(node, ast.Import):
             names.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
@@ -142,3 +149,70 @@ def test_every_grader_module_lives_in_a_trust_folder():
     top = [name for name in source_modules() if name.startswith(GRADER + '.') and name.count('.') == 2]
     assert sorted(top) == ['%s.%s' % (GRADER, f)
                            for f in sorted(set(NEVER_IMPORT) | {'boxed', 'judge', 'runner', 'engine'})]
+
+
+def test_the_node_kit_imports_no_simulator_nor_the_exam_node():
+    kit = [name for name in source_modules() if name.split('.')[0] == 'node_kit']
+    assert kit, 'no node_kit modules'
+    above = ('drone_sim', 'mydrone', 'submarinedrone', 'exam')
+    offending = ['%s imports %s' % (name, m) for name in kit for m in sorted(imports(source_modules()[name]))
+                 if m.split('.')[0] in above]
+    assert offending == []
+
+
+#: The one module that may use rospy's private names, and the tests that hold it to the installed rospy.
+ROSPY_PRIVATE = ('node_kit/src/node_kit/rospy_private.py', 'node_kit/test/unit/test_rospy_private.py')
+
+
+def attribute_chains(path):
+    """Every dotted name a file reads from a name (``rospy.core._shutdown_flag``, and its prefixes)."""
+    chains = set()
+    for node in nodes(path):
+        if isinstance(node, ast.Attribute):
+            parts = [node.attr]
+            value = node.value
+            while isinstance(value, ast.Attribute):
+                parts.append(value.attr)
+                value = value.value
+            if isinstance(value, ast.Name):
+                chains.add('.'.join([value.id] + parts[::-1]))
+    return chains
+
+
+def rospy_private_names(path):
+    """The rospy names ``path`` uses that rospy does not export: ``rospy.impl``, ``rospy.core``, or any
+    name with a leading underscore, in an import or an attribute chain starting at ``rospy``."""
+    def private(name):
+        parts = name.split('.')
+        return parts[0] == 'rospy' and len(parts) > 1 and (
+            parts[1] in ('impl', 'core') or any(p.startswith('_') for p in parts[1:]))
+    return sorted(name for name in imports(path) | attribute_chains(path) if private(name))
+
+
+def python_files():
+    """Every Python file of this repository's own packages, with neither the students' packages the
+    grader's tests and the report hold (a package.xml below the top level) nor the workspace .ws."""
+    files = []
+    for dirpath, dirnames, filenames in os.walk(REPO):
+        if os.path.dirname(dirpath) != REPO and dirpath != REPO and 'package.xml' in filenames:
+            dirnames[:] = []
+            continue
+        dirnames[:] = [d for d in dirnames if not d.startswith('.')]
+        files += [os.path.join(dirpath, f) for f in filenames if f.endswith('.py')]
+    return sorted(files)
+
+
+def test_rospy_private_names_are_used_in_node_kit_rospy_private_only():
+    offending = ['%s: %s' % (os.path.relpath(path, REPO), ', '.join(names)) for path in python_files()
+                 if os.path.relpath(path, REPO) not in ROSPY_PRIVATE
+                 for names in [rospy_private_names(path)] if names]
+    assert offending == []
+
+
+def test_the_private_name_check_finds_each_kind_of_use(tmp_path):
+    # The check itself must be able to fail.
+    sample = tmp_path / 'sample.py'
+    sample.write_text('import rospy\nfrom rospy.impl import registration\nimport rospy.core\n'
+                      'rospy.core._shutdown_flag = True\nrospy.get_param("~a")\nrospy._private()\n')
+    assert rospy_private_names(str(sample)) == ['rospy._private', 'rospy.core', 'rospy.core._shutdown_flag',
+                                                'rospy.impl', 'rospy.impl.registration']

@@ -1,15 +1,23 @@
-"""Grading a submission or a class: prepare, run the session (sandboxed), score, write.
+"""Grading a submission or a class: inspect (boxed), run the session (sandboxed), score, write.
 
-The runner itself never runs a student's code: it unpacks and reads (:mod:`~exam_lab.grader.boxed.unpack`,
-:mod:`~exam_lab.grader.boxed.launch`, :mod:`~exam_lab.grader.boxed.source`) a copy of the package that no
-student code can write, writes the derived launch files and the job, opens the submission's
-:class:`~exam_lab.grader.host.sandbox.Box`, and starts :mod:`exam_lab.grader.judge.session` as root inside
-``unshare --net`` (only loopback), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an
-overall time limit. Then :mod:`~exam_lab.grader.score.rubric` scores and :mod:`~exam_lab.grader.publish.report`
-writes; what reaches the results from the session's folder is copied as data (regular files only,
-each capped: :func:`~exam_lab.grader.host.sandbox.copy_results`).
+Root never parses a student's bytes. It stages the upload byte for byte (regular files, folders, links
+as links: :func:`~exam_lab.grader.host.sandbox.stage_upload`), opens the submission's
+:class:`~exam_lab.grader.host.sandbox.Box`, and runs :mod:`~exam_lab.grader.boxed.inspect` in it, as the
+box's uid, without network, within INSPECT_BOUNDS: unpacking, the package copied into the workspace,
+the teacher's fixes, launch and YAML analysis, the derived launch files (at the paths the run box sees),
+the source scan, PDF facts and comment statistics. Root reads back one capped, schema-checked record
+(:mod:`~exam_lab.grader.host.egress`, :mod:`~exam_lab.grader.score.records`) and plans the runs from it;
+the workspace stays the box uid's, read-only in the build and run box. A class archive is unpacked by
+:mod:`~exam_lab.grader.boxed.intake`, the similarity check runs in a box too. Then
+:mod:`exam_lab.grader.judge.session` runs in a network namespace with only loopback
+(:func:`~exam_lab.grader.host.sandbox.network_namespace`: ``unshare --net`` as root, a user namespace of
+its own too otherwise), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an overall time
+limit;
+:mod:`~exam_lab.grader.score.rubric` scores and :mod:`~exam_lab.grader.publish.report` writes; what reaches
+the results from the session's folder is copied as data (regular files only, each capped:
+:func:`~exam_lab.grader.host.sandbox.copy_results`).
 
-The simulators (``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
+The simulators (``node_kit``, ``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
 workspace (cached under ``$EXAM_WS/grader/underlay``, rebuilt when their sources change); each student's
 package is built alone in an overlay of its own on top of it, so a student's ``exam`` never meets ours.
 """
@@ -29,14 +37,15 @@ import time
 import traceback
 
 from exam_lab.grader import workspace
-from exam_lab.grader.boxed import documents, launch, similarity, source, unpack
+from exam_lab.grader.boxed import similarity, unpack
 
-from exam_lab.grader.host import sandbox
+from exam_lab.grader.host import egress, sandbox
+from exam_lab.grader.host.sandbox import BOX_WS
 
-from exam_lab.grader.score import rubric
+from exam_lab.grader.score import records, rubric
 
-from exam_lab.grader.publish import progress, report
-from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, PACKAGE, SHEETS
+from exam_lab.grader.publish import moodle, progress, report
+from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, SHEETS, margin_of
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
 #: Time limits, s: the student's catkin_make, the node's start (to registering with the master),
@@ -46,7 +55,12 @@ START_TIMEOUT = 20.0
 RUN_TIMEOUT = 90.0 + LATE_WARNING_S
 SESSION_TIMEOUT = 420.0 + 2 * LATE_WARNING_S
 #: The simulator packages of the underlay.
-SIMULATORS = ('drone_sim', 'mydrone', 'submarinedrone')
+SIMULATORS = ('node_kit', 'drone_sim', 'mydrone', 'submarinedrone')
+#: Bounds of the boxes that read student bytes: (wall clock s, CPU s, address space bytes). One upload's
+#: inspection (measured: 0.2 s a package, box included); a class archive's intake; the class's similarity check.
+INSPECT_BOUNDS = (60.0, 60, 1 << 30)
+INTAKE_BOUNDS = (300.0, 300, 1 << 30)
+SIMILARITY_BOUNDS = (900.0, 300, 3 << 30)
 
 #: Log lines worth the teacher's eye: warnings, errors, tracebacks.
 _ODD = re.compile(r'\[(WARN|ERROR|FATAL)\]|Traceback|Error\b|Exception\b')
@@ -57,7 +71,8 @@ _underlay_lock = threading.Lock()
 
 
 def can_isolate():
-    """True when this process may run a session in a network namespace of its own (root, unshare)."""
+    """True when this process may run a session in a network namespace of its own (as root with
+    unshare, otherwise with bubblewrap where ordinary users may make user namespaces)."""
     with _isolation_lock:
         return _can_isolate()
 
@@ -65,8 +80,8 @@ def can_isolate():
 def _can_isolate():
     if 'ok' not in _isolation:
         try:
-            _isolation['ok'] = os.geteuid() == 0 and shutil.which('unshare') is not None and \
-                subprocess.run(['unshare', '--net', 'true'], timeout=10).returncode == 0
+            _isolation['ok'] = subprocess.run(sandbox.network_namespace(['true']), stdout=subprocess.DEVNULL,
+                                              stderr=subprocess.DEVNULL, timeout=10).returncode == 0
         except (OSError, subprocess.SubprocessError):
             _isolation['ok'] = False
     return _isolation['ok']
@@ -78,9 +93,10 @@ def sandbox_refusal(unsandboxed=False):
     why = sandbox.check()
     if why is None or unsandboxed:
         return None
-    return ('refusing to run student code without its sandbox: %s. Run the grader as root on a machine '
-            'with bubblewrap and unprivileged user namespaces (docs/grading.md, "Isolation"), or pass '
-            '--unsandboxed-student-code-can-read-and-damage-my-files to accept that risk' % why)
+    return ('refusing to run student code without its sandbox: %s. Run the grader on a machine with '
+            'bubblewrap and unprivileged user namespaces, as root or as yourself (docs/grading.md, '
+            '"Isolation" and "Without root"), or pass --unsandboxed-student-code-can-read-and-damage-my-files '
+            'to accept that risk' % why)
 
 
 def _package_path(name):
@@ -128,133 +144,128 @@ def ensure_underlay(cache_dir):
             return setup
 
 
-def detect_sheet(wanted, package_dir, analyses):
-    """``(sheet, how it was chosen)``: given, else from package.xml, else the launch files, else the
-    topics the code names; altitude when nothing decides."""
-    if wanted:
-        return wanted, 'sheet %s given' % wanted
-    deps = [d for d in source.dependencies(package_dir) if d in (s.drone_pkg for s in SHEETS.values())]
-    by_deps = [name for name, s in SHEETS.items() if s.drone_pkg in deps]
-    if len(by_deps) == 1:
-        return by_deps[0], 'sheet %s: package.xml depends on %s' % (by_deps[0], SHEETS[by_deps[0]].drone_pkg)
-    by_launch = sorted(set(s for a in analyses for s in a.drone_sheets()))
-    if len(by_launch) == 1:
-        return by_launch[0], 'sheet %s: the launch files start %s' % (by_launch[0], SHEETS[by_launch[0]].drone_pkg)
-    by_code = source.sheets_in_code(package_dir)
-    if len(by_code) == 1:
-        return by_code[0], 'sheet %s: the code names its topics' % by_code[0]
-    return 'altitude', ('sheet altitude by default: the package could be either (depends on %s); '
-                        'give SHEET=depth to grade the other' % (', '.join(deps) or 'neither drone'))
+class InspectionFailed(Exception):
+    """The inspection of an upload crashed, overran its bounds or handed back no valid record."""
 
 
-def margin_of(threshold):
-    """How far beyond the threshold the probe flies (student units): 10 %, at least 10 m."""
-    return max(0.1 * abs(threshold), 10.0)
+def _grader_source():
+    """The folder that holds the grader's own Python package (``exam_lab``), which a box sees read-only."""
+    import exam_lab.grader
+    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(exam_lab.grader.__file__))))
 
 
-def prepare(submission, work, wanted_sheet, notes, fixes=None):
-    """Unpack and read a submission; write the workspace, the derived launch files and the job.
-    ``fixes`` receives what the grader changed in what the student uploaded (``notes`` when None).
+class Boxed(object):
+    """One of the grader's own modules run on student bytes in ``box``, as its uid, without network:
+    ``<work>/upload`` (staged by root, :func:`~exam_lab.grader.host.sandbox.stage_upload`) read-only at
+    ``/box/upload``, ``<work>/out`` writable at ``/box/out``, the grader's source read-only; its one
+    record is read back through :func:`~exam_lab.grader.host.egress.read_record`. Unsandboxed, the same
+    folders are used at their host paths.
 
-    :returns: ``(sheet, static, job)``; ``job`` is None when nothing can be run (no node script).
+    :param mounts: more ``(host, in the box, writable)``; ``(host, None, ...)`` keeps the host path.
     """
-    fixes = notes if fixes is None else fixes
-    uploads = []
-    pkg_source = unpack.open_submission(submission, os.path.join(work, 'unpacked'), notes, fixes, uploads=uploads)
-    name = unpack.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
-    workspace = os.path.join(work, 'ws')
-    pkg = os.path.join(workspace, 'src', name if re.match(r'^[A-Za-z][\w-]*$', name) else PACKAGE)
-    unpack.copy_package(pkg_source, pkg, fixes)
-    fixes.extend(source.fix_text(pkg))
-    box_env = sandbox.box_env({'PATH': os.environ.get('PATH', '/usr/bin:/bin')})  # $(env) sees the box's, not ours
-    analyses = [launch.analyse(path, pkg, name, box_env) for path in launch.launch_files(pkg)]
-    sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
-    notes.insert(0, how)
-    chosen = launch.choose(analyses, sheet)
-    scripts = source.node_scripts(pkg)
-    types, type_fixes = source.node_type_fixes(pkg, chosen.exam_nodes if chosen else [])
-    fixes.extend(type_fixes)
-    launched = [types.get(n.type_origin, n.type) for n in chosen.exam_nodes] if chosen \
-        else [os.path.basename(p) for p in scripts[:1]]
-    fixes.extend(source.make_runnable(pkg, launched))
-    static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses], 'package': name,
-              'package_dir': pkg, 'python2': source.python2_evidence(pkg),
-              'params_in_code': source.param_names(pkg), 'launch': None, 'threshold': None,
-              'uploads': uploads}
-    if static['python2']:
-        notes.append('Python 2 code, which ROS Noetic cannot run: %s' % ', '.join(static['python2']))
-    for analysis in analyses:
-        for problem in analysis.problems:
-            notes.append('launch: %s' % problem)
-    threshold_value = SHEETS[sheet].threshold
-    runs = []
-    if chosen is not None:
-        exam = chosen.exam_nodes[0]
-        static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),
-                            'exam_type': exam.type, 'exam_name': exam.name, 'package': name,
-                            'comments': chosen.comments(), 'exam_type_found': _executable_in(pkg, exam.type)}
-        param, why = launch.threshold_param(chosen, sheet)
-        static['threshold_reason'] = why
-        if param is not None:
-            threshold_value = launch.as_number(param.value)
-            static['threshold'] = {'name': param.name, 'value': param.value,
-                                   'where': param.origin.describe(pkg) if param.origin else '?'}
-            notes.append('threshold parameter: %s, set in %s' % (why, static['threshold']['where']))
-        main_launch = launch.derive(chosen, 'main', types)
-        namespace = chosen.drone_namespace(sheet)
+
+    def __init__(self, box, work, mounts=()):
+        self.box, self.work = box, work
+        self.out = os.path.join(work, 'out')
+        os.mkdir(self.out, 0o700)
+        if box.slot is not None:
+            os.chown(self.out, box.uid, box.uid)
+        self.source = _grader_source()
+        self.places = [(os.path.join(work, 'upload'), '/box/upload', False), (self.out, '/box/out', True),
+                       (self.source, self.source, False)] + [(h, b or h, w) for h, b, w in mounts]
+
+    def path(self, host):
+        """``host`` (below one of the mounted folders) as the box's process sees it."""
+        if not self.box.bwrap:
+            return host
+        for outside, inside, _ in self.places:
+            if host == outside or host.startswith(outside + '/'):
+                return inside + host[len(outside):]
+        raise ValueError('%s is not visible in the box' % host)
+
+    def run(self, module, args, record, bounds, python=sys.executable):
+        """Run ``python -m module args`` bounded by ``bounds`` (wall clock s, CPU s, address space
+        bytes); return the checked record ``record`` (a type of :mod:`~exam_lab.grader.score.records`)
+        it wrote as ``/box/out/<record.FILE>``.
+
+        :raises InspectionFailed: with the reason and the end of its log.
+        """
+        timeout, cpu, memory = bounds
+        # Only lowered: a box's process cannot raise its hard limits (sandbox.Box.argv's prlimit).
+        cpu, memory = min(cpu, sandbox.CPU_SECONDS), min(memory, sandbox.ADDRESS_SPACE_BYTES)
+        command = ['prlimit', '--as=%d' % memory, '--cpu=%d' % cpu, '--', python, '-m', module] + list(args)
+        env = {'PATH': '/usr/bin:/bin', 'PYTHONPATH': self.source, 'PYTHONDONTWRITEBYTECODE': '1'}
+        log = os.path.join(self.work, '%s.log' % module.rsplit('.', 1)[-1])
+        status, why = self.box.run(command, env, log, timeout, cwd=self.path(self.out),
+                                   mounts=self.places if self.box.bwrap else None, network=False)
+        if status == 0:
+            try:
+                return egress.read_record(os.path.join(self.out, record.FILE), record, record.MAX_BYTES)
+            except records.RecordError as err:
+                why = 'its record was refused: %s' % err
+        elif why is None:  # bwrap reports its child's death by signal N as exit 128 + N
+            signum = -status if status < 0 else status - 128 if status > 128 else None
+            why = 'it failed (exit %d)' % status if signum is None else \
+                'it was killed by signal %d (its bounds: %d s of CPU, %d MB of address space)' % (signum, cpu, memory >> 20)
+        tail = session_tail(sandbox.read_capped(log, 4096) or '')
+        raise InspectionFailed('%s%s' % (why, ': %s' % tail if tail else ''))
+
+
+def inspect(box, work, upload, wanted_sheet):
+    """Run :mod:`exam_lab.grader.boxed.inspect` on the staged ``upload`` (a path below ``<work>/upload``)
+    in ``box`` (:class:`Boxed`), bounded by INSPECT_BOUNDS; return its checked
+    :class:`~exam_lab.grader.score.records.InspectRecord`. The package is written, as the box's uid, to
+    the workspace the build box sees: ``<work>/ws/src`` (read-only there), or unsandboxed the box's
+    own copy.
+
+    :raises InspectionFailed: with the reason and the end of its log.
+    """
+    if box.bwrap:
+        os.chown(os.path.join(work, 'ws', 'src'), box.uid, box.uid)
+        boxed = Boxed(box, work, [(os.path.join(work, 'ws'), BOX_WS, True)])
+        ws = BOX_WS
     else:
-        static['threshold_reason'] = 'no launch file starts an exam node, so no parameter'
-        if not scripts:
-            return sheet, static, None
-        notes.append('no launch file starts an exam node: ran %s alone, without parameters'
-                     % os.path.relpath(scripts[0], pkg))
-        main_launch = os.path.join(pkg, '.grader-main-minimal.launch')
-        with open(main_launch, 'w') as f:
-            f.write('<launch><node pkg="%s" type="%s" name="exam" output="screen"/></launch>\n'
-                    % (name, os.path.basename(scripts[0])))
-        namespace = '/'
-        param = None
-    margin = margin_of(threshold_value)
-    plan = {'kind': 'main', 'sheet': sheet, 'threshold': threshold_value, 'margin': margin, 'delay': DELAY,
+        boxed, ws = Boxed(box, work), box.workspace
+    args = ['--upload', boxed.path(upload), '--ws', ws, '--out', boxed.path(boxed.out),
+            '--toplevel', os.path.join(_package_path('catkin'), 'cmake', 'toplevel.cmake')]
+    return boxed.run('exam_lab.grader.boxed.inspect', args + (['--sheet', wanted_sheet] if wanted_sheet else []),
+                     records.InspectRecord, INSPECT_BOUNDS)
+
+
+def plan_job(record):
+    """The session's job (:mod:`exam_lab.grader.judge.session`) from a checked inspection record: the
+    runs' plans are computed here, from its numbers; the launch files stay relative to the workspace.
+    None when there is nothing to run."""
+    if record.main_launch is None:
+        return None
+    sheet, threshold = record.sheet, record.threshold_value
+    margin = margin_of(threshold)
+    plan = {'kind': 'main', 'sheet': sheet, 'threshold': threshold, 'margin': margin, 'delay': DELAY,
             'start_timeout': START_TIMEOUT, 'output': SHEETS[sheet].output,
-            'late_warning': LATE_WARNING_S if source.calls_a_service(pkg) else 0.0}
-    runs.append({'tag': 'main', 'launch': main_launch, 'plan': plan})
-    if param is not None and param.origin is not None:
-        lowered = threshold_value - 2 * margin
-        threshold_changes = dict(types)
-        threshold_changes[param.origin] = lowered
-        runs.append({'tag': 'threshold', 'launch': launch.derive(chosen, 'threshold', threshold_changes),
+            'late_warning': LATE_WARNING_S if record.calls_service else 0.0}
+    runs = [{'tag': 'main', 'launch': record.main_launch, 'plan': plan}]
+    if record.threshold_launch is not None:
+        lowered = threshold - 2 * margin
+        runs.append({'tag': 'threshold', 'launch': record.threshold_launch,
                      'plan': dict(plan, kind='threshold', threshold=lowered,
-                                  targets={'start': lowered - margin, 'step': threshold_value - margin})})
-    elif param is not None:
-        static['threshold']['not_rewritable'] = 'its value comes from no literal the grader can change'
-    job = {'workspace': workspace, 'namespace': namespace, 'build_timeout': BUILD_TIMEOUT,
-           'run_timeout': RUN_TIMEOUT, 'runs': runs,
-           'handed_in_launch': os.path.relpath(chosen.path, os.path.join(workspace, 'src')) if chosen else None}
-    return sheet, static, job
-
-
-def _executable_in(pkg, name):
-    for dirpath, _, filenames in os.walk(pkg):
-        if name in filenames and os.access(os.path.join(dirpath, name), os.X_OK):
-            return True
-    return False
+                                  targets={'start': lowered - margin, 'step': threshold - margin})})
+    return {'namespace': record.namespace, 'build_timeout': BUILD_TIMEOUT, 'run_timeout': RUN_TIMEOUT, 'runs': runs,
+            'handed_in_launch': record.handed_in_launch}
 
 
 def run_session(job, work, underlay, isolate, box, on_step=None):
     """Run the session of one submission, its student steps in ``box``; return what it measured (or
     why it could not).
 
-    :param isolate: in a network namespace of its own with only loopback (needs root).
+    :param isolate: in a network namespace of its own with only loopback
+        (:func:`~exam_lab.grader.host.sandbox.network_namespace`).
     :param on_step: called with each step's name as the session starts it (:mod:`~exam_lab.grader.publish.progress`).
     """
     log_dir = os.path.join(work, 'logs')
     judge_home = os.path.join(work, 'judge')
     for folder in (log_dir, judge_home):
         os.makedirs(folder, mode=0o700, exist_ok=True)
-    ws = os.path.join(work, 'ws')
-    runs = [dict(run, launch=os.path.join(box.workspace, os.path.relpath(run['launch'], ws)))
-            for run in job['runs']]
+    runs = [dict(run, launch=os.path.join(box.workspace, run['launch'])) for run in job['runs']]
     job = dict(job, workspace=box.workspace, runs=runs, underlay=underlay, log_dir=log_dir,
                judge_home=judge_home, box=box.describe())
     job_path = os.path.join(work, 'job.json')
@@ -262,7 +273,7 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
         json.dump(job, f, indent=1, sort_keys=True)
     argv = [sys.executable, '-m', 'exam_lab.grader.judge.session', job_path]
     if isolate:
-        argv = ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + argv
+        argv = sandbox.network_namespace(argv)
     with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
         status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT, env=dict(os.environ, HOME=judge_home))
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
@@ -278,29 +289,20 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
     return {'build': None, 'runs': [], 'error': why, 'survivors': survivors}
 
 
-def _share_read_only(folder):
-    """Make the pristine package readable (never writable) by the box's user, which sees it read-only."""
-    for dirpath, dirnames, filenames in os.walk(folder):
-        os.chmod(dirpath, 0o755)
-        for name in filenames:
-            full = os.path.join(dirpath, name)
-            if os.path.isfile(full) and not os.path.islink(full):
-                os.chmod(full, 0o755 if os.stat(full).st_mode & 0o100 else 0o644)
-
-
 def session_tail(output):
     return '\n'.join(output.strip().splitlines()[-10:])
 
 
-def hints(static, session, notes, pkg, isolate, how_run=None):
-    """The for_the_teacher list: what the machine saw but does not score."""
+def hints(static, session, notes, comments, isolate, how_run=None):
+    """The for_the_teacher list: what the machine saw but does not score.
+
+    :param comments: the inspection's comment statistics (``{"comments", "code", "files"}``) or None.
+    """
     out = list(notes)
-    scripts = source.student_code(pkg) if pkg and os.path.isdir(pkg) else []
-    if scripts:
-        comments, code = source.comment_ratio(scripts)
+    if comments:
         out.append('comments (not scored): %d comment lines for %d lines of code (%.0f %%) in %s'
-                   % (comments, code, 100.0 * comments / max(code, 1),
-                      ', '.join(os.path.relpath(p, pkg) for p in scripts)))
+                   % (comments['comments'], comments['code'], 100.0 * comments['comments'] / max(comments['code'], 1),
+                      ', '.join(comments['files'])))
     probe = rubric.main_probe(session)
     if probe:
         for node, info in sorted(probe.get('graph', {}).items()):
@@ -319,7 +321,8 @@ def hints(static, session, notes, pkg, isolate, how_run=None):
         out.append('launch file graded: %s (of %s)' % (static['launch']['file'], ', '.join(static['launch_files'])))
     if (session or {}).get('build') is not None:  # something of the student's ran
         out.append('ran in a network namespace with only loopback' if isolate else
-                   'ran WITHOUT network isolation (needs root and unshare): the student code could reach the network')
+                   'ran WITHOUT network isolation (no network namespace could be made): the student code could '
+                   'reach the network')
         out.append(how_run or 'not run')
     if (session or {}).get('survivors'):
         out.append('%d processes of the student were still alive after its steps ended: killed'
@@ -329,14 +332,35 @@ def hints(static, session, notes, pkg, isolate, how_run=None):
 
 
 def _how_run(box):
+    if box.rootless:
+        return ('ran in a bubblewrap sandbox WITHOUT ROOT, as the grading user (uid %d): its own user, PID, '
+                'mount, IPC and UTS namespaces, a clean environment, only its workspace writable, none of '
+                'that user\'s files visible; limited per process in memory, CPU time and file size. Unlike '
+                'a box made by root: no uid of its own (boxes told apart by their PID namespaces and mounts), '
+                '%s, no size limit on its work folder (docs/grading.md, "Without root")'
+                % (box.uid, 'a cgroup delegated to the user' if box.cgroups else
+                   'no memory or process cgroup (processes counted in the session\'s user namespace)'))
     if box.bwrap:
         return ('ran in a bubblewrap sandbox as uid %d: its own user, PID, mount, IPC and UTS namespaces, '
                 'a clean environment, only its workspace writable; limited in memory, processes, CPU time '
                 'and file size' % box.uid)
     if box.slot is not None:
         return 'ran WITHOUT its sandbox (the teacher\'s flag) as uid %d, with resource limits only' % box.uid
+    try:
+        user = pwd.getpwuid(os.geteuid()).pw_name
+    except KeyError:  # a uid without an account (a container's, a test's)
+        user = 'uid %d' % os.geteuid()
     return ('ran WITHOUT its sandbox (the teacher\'s flag) as the grading user %s: it could read and change '
-            'that user\'s files' % pwd.getpwuid(os.geteuid()).pw_name)
+            'that user\'s files' % user)
+
+
+def _how_read(box, uid):
+    """What read the upload, as which uid (the one the inspection saw itself run as), within which bounds."""
+    timeout, _, memory = INSPECT_BOUNDS
+    where = 'in a bubblewrap box without network' if box.bwrap else \
+        'WITHOUT its sandbox (the teacher\'s flag), in a subprocess'
+    return ('the upload was read (unpacked, its launch files, code and PDFs analysed) %s as uid %d, within %.0f s '
+            'and %d MB' % (where, uid, timeout, memory >> 20))
 
 
 def _box_binds(underlay):
@@ -345,18 +369,6 @@ def _box_binds(underlay):
     sources = os.path.join(cache, 'src')
     return [cache] + [os.path.realpath(os.path.join(sources, name)) for name in sorted(os.listdir(sources))
                       if os.path.islink(os.path.join(sources, name))]
-
-
-def _prepare_workspace(work):
-    """The pristine workspace the box sees read-only: catkin's top-level CMakeLists.txt linked (catkin_make
-    cannot write src/ in the box), everything readable by the box's user, nothing writable by it."""
-    src = os.path.join(work, 'ws', 'src')
-    top = os.path.join(src, 'CMakeLists.txt')
-    if not os.path.lexists(top):
-        os.symlink(os.path.join(_package_path('catkin'), 'cmake', 'toplevel.cmake'), top)
-    _share_read_only(os.path.join(work, 'ws'))
-    if os.path.isdir(os.path.join(work, 'unpacked')):
-        os.chmod(os.path.join(work, 'unpacked'), 0o700)
 
 
 def could_not_grade(student, sheet, why, notes=()):
@@ -372,7 +384,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
 
     :param on_step: called with each step's name as it starts (unpack, build, main flight...).
-    :param extra: added to the record (:func:`exam_lab.grader.boxed.documents.submission_facts`).
+    :param extra: added to the record, over the inspection's facts (participant, folder, documents).
     :param unsandboxed: run it even where no sandbox can be made (the teacher's flag that names the
         risk); otherwise :class:`~exam_lab.grader.host.sandbox.SandboxUnavailable` is raised there.
     :param jobs: how many submissions are graded side by side: the box's part of the CPU.
@@ -386,27 +398,42 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     underlay = underlay or ensure_underlay(default_underlay())  # raises: the grader cannot run
     os.makedirs(out_dir, exist_ok=True)
     # In the system's temp folder, not under OUT (which may be private): the box's user must reach
-    # <work>/ws and <work>/box, and may not list <work>.
+    # <work>/upload, <work>/ws and <work>/box, and may not list <work>.
     work = tempfile.mkdtemp(prefix='exam-grade-')
     os.chmod(work, 0o711)
-    notes, fixes, static, session, chosen_sheet, pkg, how_run = [], [], {}, None, sheet, None, None
+    folder = os.path.basename(os.path.abspath(submission).rstrip('/'))
+    notes, fixes, static, session, chosen_sheet, comments, how_run = [], [], {}, None, sheet, None, None
+    facts = {'participant': moodle.participant_number(folder), 'folder': folder, 'documents': []}
     try:
         try:
             progress.report(on_step, 'unpack')
-            chosen_sheet, static, job = prepare(submission, work, sheet, notes, fixes)
-            pkg = static['package_dir']
-            if job is None:
-                session = {'build': None, 'runs': [], 'no_node': True,
-                           'error': 'no script of the package starts a ROS node'}
-            else:
-                _prepare_workspace(work)
-                with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None,
-                                 cpus=sandbox.box_cpus(jobs)) as box:
-                    notes.extend(box.notes)
+            upload = os.path.join(work, 'upload', folder if folder not in ('', '.', '..') else 'upload')
+            os.mkdir(os.path.dirname(upload), 0o755)
+            sandbox.stage_upload(os.path.realpath(submission), upload)  # the teacher's path: followed
+            for sub in ('ws', 'ws/src'):
+                os.mkdir(os.path.join(work, sub), 0o755)
+            with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None,
+                             cpus=sandbox.box_cpus(jobs)) as box:
+                notes.extend(box.notes)
+                found = inspect(box, work, upload, sheet)
+                notes.append(_how_read(box, found.uid))
+                notes.extend(found.notes)
+                fixes.extend(found.fixes)
+                facts, comments = found.facts, found.comments
+                if found.refused is not None:
+                    raise unpack.UnpackError(found.refused)
+                chosen_sheet, static = found.sheet, found.static
+                job = plan_job(found)
+                if job is None:
+                    session = {'build': None, 'runs': [], 'no_node': True,
+                               'error': 'no script of the package starts a ROS node'}
+                else:
                     how_run = _how_run(box)
                     session = run_session(job, work, underlay, isolate, box, on_step)
-        except unpack.UnpackError as err:
+        except (unpack.UnpackError, sandbox.UploadRefused) as err:
             session = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % err}
+        except InspectionFailed as err:
+            session = {'build': None, 'runs': [], 'error': 'the inspection of the upload failed: %s' % err}
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
             session = {'build': None, 'runs': [], 'error': 'the grader failed on this submission: %r' % err}
             notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
@@ -419,48 +446,76 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             if skipped:
                 notes.append('not copied to logs/ (not a regular file): %s' % ', '.join(skipped))
         record = report.grade_record(student, chosen_sheet, items,
-                                     hints(static, session, notes + fixes, pkg, isolate, how_run),
-                                     dict(extra or {}, seconds=round(time.monotonic() - start, 1),
-                                          doubts=rubric.doubts(static, session)),
+                                     hints(static, session, notes + fixes, comments, isolate, how_run),
+                                     dict(facts, **dict(extra or {}, seconds=round(time.monotonic() - start, 1),
+                                                        doubts=rubric.doubts(static, session))),
                                      rubric.status(static, session, fixes))
         report.write_grade(out_dir, record)
         return record
     finally:
         if not keep:
-            shutil.rmtree(work, ignore_errors=True)
+            shutil.rmtree(work, ignore_errors=True)  # never follows a link the box left (rmtree does not)
 
 
-def class_similarity(klass, out, records):
-    """The similarity check over a class's submissions (unpacked anew, as the runner did), each
-    named as its grade record names it; ``{"error"}`` when it could not run (the grades stand)."""
-    scratch = os.path.join(out, '.similarity-class')
-    try:
-        by_folder = {r.get('folder'): r['student'] for r in records}
-        submissions = [(by_folder.get(os.path.basename(folder), name), folder)
-                       for name, folder in unpack.list_students(klass, scratch)]
-        return similarity.check(submissions, out)
-    except Exception as err:  # a bug of the check must not cost the class its page
-        return {'error': repr(err)}
-    finally:
-        shutil.rmtree(scratch, ignore_errors=True)
+def _staged_work(prefix, sources, parent=None):
+    """A work folder for a box (in ``parent``, by default the system's temp folder: the box's user must
+    reach it), with each ``(name, path)`` of ``sources`` staged read-only as
+    ``<work>/upload/<index>/<name>``; returns ``(work, [staged paths])``."""
+    work = tempfile.mkdtemp(prefix=prefix, dir=parent)
+    os.chmod(work, 0o711)
+    staged = []
+    for sub in ('upload', 'ws', 'ws/src'):
+        os.mkdir(os.path.join(work, sub), 0o755)
+    for index, (name, path) in enumerate(sources):
+        os.mkdir(os.path.join(work, 'upload', str(index)), 0o755)
+        staged.append(os.path.join(work, 'upload', str(index), name if name not in ('', '.', '..') else 'upload'))
+        sandbox.stage_upload(path, staged[-1])
+    return work, staged
 
 
-def default_underlay():
-    return os.path.join(workspace(), 'grader', 'underlay')
+def class_students(class_path, work_dirs, scratch=None):
+    """``[(student, folder or archive)]`` of a class, each name unique (``Jane Doe``, ``Jane Doe_2``):
+    the students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`). A
+    folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.boxed.unpack.list_students`
+    opens no file of a folder); an archive is unpacked by :mod:`exam_lab.grader.boxed.intake` in a box of
+    its own (INTAKE_BOUNDS), in a work folder made in ``scratch`` (default: the system's temp folder) and
+    appended to ``work_dirs`` (the caller removes it once the students are graded).
+
+    :raises unpack.UnpackError: the archive could not be unpacked (why, and the end of the box's log).
+    """
+    class_path = os.path.abspath(class_path)
+    if not os.path.isfile(class_path):
+        return _unique(unpack.list_students(class_path, None))
+    if scratch:
+        os.makedirs(scratch, mode=0o711, exist_ok=True)
+    work, (staged,) = _staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch)
+    work_dirs.append(work)
+    with sandbox.Box(work, bwrap=sandbox.check() is None) as box:
+        boxed = Boxed(box, work)
+        try:
+            found = boxed.run('exam_lab.grader.boxed.intake', ['--class', boxed.path(staged), '--out',
+                                                                 boxed.path(boxed.out)], records.IntakeRecord,
+                              INTAKE_BOUNDS)
+        except InspectionFailed as err:
+            raise unpack.UnpackError('unpacking it in its box failed: %s' % err)
+    students = []
+    for student in found.students:
+        path = os.path.join(boxed.out, student['path'])
+        if os.path.realpath(path) != os.path.normpath(path) or not os.path.lexists(path):
+            raise unpack.UnpackError('the intake named %s, which is a link or missing' % student['path'])
+        students.append((student['name'], path))
+    return _unique(students)
 
 
-def class_students(class_path, scratch):
-    """``[(name, folder or archive)]`` of a class, each name unique (``Jane Doe``, ``Jane Doe_2``): the
-    students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`). A class
-    archive is unpacked below ``scratch``."""
-    names, seen = [], set()
-    for name, folder in unpack.list_students(class_path, scratch):
+def _unique(students):
+    named, seen = [], set()
+    for name, folder in students:
         unique, n = name, 2
         while unique in seen:
             unique, n = '%s_%d' % (name, n), n + 1
         seen.add(unique)
-        names.append((unique, folder))
-    return names
+        named.append((unique, folder))
+    return named
 
 
 def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
@@ -470,8 +525,7 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
     student with it: a local pool's thread and a Slurm task."""
     try:
         return grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
-                                on_step=on_step, extra=documents.submission_facts(folder), unsandboxed=unsandboxed,
-                                jobs=jobs)
+                                on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
     except Exception as err:  # anything: this student's row says so, the class goes on
         record = could_not_grade(name, sheet, '%r' % err,
                                  ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
@@ -480,6 +534,45 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
         except OSError:
             pass
         return record
+
+
+def class_similarity(klass, out, records_):
+    """The similarity check over a class's submissions, each named as its grade record names it, run in
+    a box (:mod:`exam_lab.grader.boxed.similarity` ``--class``: unpacking and comparing, SIMILARITY_BOUNDS)
+    and read back as a :class:`~exam_lab.grader.score.records.SimilarityRecord`; written to
+    ``out/similarity.json``. ``{"error"}`` when it could not run (the grades stand)."""
+    work_dirs = []
+    try:
+        by_folder = {r.get('folder'): r['student'] for r in records_}
+        submissions = [(by_folder.get(os.path.basename(folder), name), folder)
+                       for name, folder in class_students(klass, work_dirs)]
+        python = similarity.ensure_venv()  # as root: an installation, from PyPI, of no student's bytes
+        work, staged = _staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in submissions])
+        work_dirs.append(work)
+        similarity.boilerplate(os.path.join(work, 'upload', 'boilerplate'))
+        venv = os.path.dirname(os.path.dirname(python))
+        with sandbox.Box(work, [venv], bwrap=sandbox.check() is None) as box:
+            # copydetect imports matplotlib, which wants Debian's /etc/matplotlibrc
+            boxed = Boxed(box, work, [(path, None, False) for path in ('/etc/matplotlibrc',) if os.path.isfile(path)])
+            job = {'submissions': [[name, boxed.path(path)] for (name, _), path in zip(submissions, staged)],
+                   'boilerplate': boxed.path(os.path.join(work, 'upload', 'boilerplate')), 'python': python,
+                   'out': boxed.path(boxed.out)}
+            with open(os.path.join(work, 'upload', 'job.json'), 'w') as f:
+                json.dump(job, f)
+            result = boxed.run('exam_lab.grader.boxed.similarity', ['--class', boxed.path(f.name)],
+                               records.SimilarityRecord, SIMILARITY_BOUNDS, python=python).value
+    except Exception as err:  # a bug of the check, or its box failing, must not cost the class its page
+        result = {'error': str(err) if isinstance(err, (InspectionFailed, unpack.UnpackError)) else repr(err)}
+    finally:
+        for work in work_dirs:
+            shutil.rmtree(work, ignore_errors=True)
+    with open(os.path.join(out, 'similarity.json'), 'w') as f:
+        json.dump(result, f, indent=1, sort_keys=True)
+    return result
+
+
+def default_underlay():
+    return os.path.join(workspace(), 'grader', 'underlay')
 
 
 def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=None, unsandboxed=False):
@@ -492,9 +585,9 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
     if refusal:
         raise sandbox.SandboxUnavailable(refusal)
     os.makedirs(out_dir, exist_ok=True)
-    scratch = tempfile.mkdtemp(prefix='class-', dir=out_dir)
+    work_dirs = []
     try:
-        students = class_students(class_path, scratch)
+        students = class_students(class_path, work_dirs)
         underlay = ensure_underlay(default_underlay())
         isolate = can_isolate() if isolate is None else isolate
         records = [None] * len(students)
@@ -518,4 +611,5 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
         report.write_csv(os.path.join(out_dir, 'grades.csv'), records)
         return records
     finally:
-        shutil.rmtree(scratch, ignore_errors=True)
+        for work in work_dirs:
+            shutil.rmtree(work, ignore_errors=True)

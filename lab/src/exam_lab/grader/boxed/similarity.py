@@ -63,7 +63,7 @@ LAUNCH_TEMPLATES = [
 """,
 ]
 #: Packages whose code every student had (the sheets' drones).
-SHEET_PACKAGES = ('mydrone', 'submarinedrone', 'drone_sim')
+SHEET_PACKAGES = ('mydrone', 'submarinedrone', 'drone_sim', 'node_kit')
 
 
 class SimilarityError(Exception):
@@ -167,14 +167,18 @@ def boilerplate(target):
     return target
 
 
-def check(submissions, out_dir, python=None):
+def check(submissions, out_dir, python=None, shared=None, scratch_dir=None):
     """Compare every pair of ``submissions`` (``[(name, folder or zip)]``); write
     ``out_dir/similarity.json`` and return it: ``{"pairs": [...], "students", "threshold", "notes"}``
-    or ``{"error": why}`` when the detector could not run (the grades stand either way)."""
-    scratch = tempfile.mkdtemp(prefix='similarity-')
+    or ``{"error": why}`` when the detector could not run (the grades stand either way).
+
+    :param shared: the boilerplate folder (:func:`boilerplate`), made here when None.
+    :param scratch_dir: where the submissions are unpacked (the system's temp folder when None).
+    """
+    scratch = tempfile.mkdtemp(prefix='similarity-', dir=scratch_dir)
     try:
         staged, notes = stage(submissions, scratch)
-        job = {'students': staged, 'boilerplate': boilerplate(os.path.join(scratch, 'boilerplate')),
+        job = {'students': staged, 'boilerplate': shared or boilerplate(os.path.join(scratch, 'boilerplate')),
                'noise': NOISE, 'window': WINDOW, 'threshold': THRESHOLD, 'result': os.path.join(scratch, 'result.json')}
         with open(os.path.join(scratch, 'job.json'), 'w') as f:
             json.dump(job, f)
@@ -275,8 +279,13 @@ def compare(job):
 
 
 def main(argv):
+    if len(argv) == 2 and argv[0] == '--class':  # the whole check, in the class's box (the runner's)
+        with open(argv[1]) as f:
+            job = json.load(f)
+        check([tuple(s) for s in job['submissions']], job['out'], job['python'], job['boilerplate'], job['out'])
+        return 0
     if len(argv) != 1:
-        sys.stderr.write('usage: python -m exam_lab.grader.boxed.similarity JOB.json\n')
+        sys.stderr.write('usage: python -m exam_lab.grader.boxed.similarity [--class] JOB.json\n')
         return 2
     with open(argv[0]) as f:
         job = json.load(f)

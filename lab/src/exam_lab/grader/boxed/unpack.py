@@ -45,7 +45,7 @@ SKIPPED_DIRS = SKIPPED_ON_UNPACK + ('log', 'logs', '.vscode', '.idea')
 #: How deep below a submission the package may sit (the zip's top, one folder down, a workspace's src).
 MAX_DEPTH = 4
 #: Packages that are the simulators, never a student's answer (a whole workspace holds them too).
-SIMULATORS = ('drone_sim',) + tuple(drone_packages())
+SIMULATORS = ('node_kit', 'drone_sim') + tuple(drone_packages())
 #: File name endings of archives the grader opens, and the magic bytes of those it cannot.
 ARCHIVE_ENDINGS = ('.zip', '.tar', '.tar.gz', '.tgz', '.tar.bz2', '.tbz2', '.tar.xz', '.txz')
 _UNSUPPORTED = ((b'Rar!\x1a\x07', 'a RAR archive'), (b'7z\xbc\xaf\x27\x1c', 'a 7-Zip archive'),

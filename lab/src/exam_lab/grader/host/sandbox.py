@@ -21,6 +21,12 @@ runs through :meth:`Box.argv`::
   underlay and their sources; the student's package read-only; only the box's own work folder
   (``build/``, ``devel/``) writable. Fresh ``/proc``, ``/dev``, and private ``/tmp``, ``/var/tmp``,
   ``/dev/shm`` and HOME (size-capped tmpfs). No /root, /home, other students, grader output.
+- **Reading the upload** (:meth:`Box.run` with ``mounts`` and ``network=False``): the grader's own
+  readers of student bytes (``boxed/inspect``, ``boxed/intake``, the similarity check) run in the
+  same box, as its uid, in a network namespace without even loopback, seeing only the upload that
+  root staged byte for byte (:func:`stage_upload`, read-only), the folder they write (the workspace,
+  their output) and the grader's source (read-only). Root reads back one record
+  (:mod:`~exam_lab.grader.host.egress`).
 - **Environment**: empty (``--clearenv``) but for the variables :func:`box_env` lets through.
 - **Limits**: memory, processes and CPU by a cgroup of the box's own where the machine lets root make
   one (cgroup v1 ``memory`` + ``pids`` + ``cpu``, or v2), always ``prlimit`` (address space, processes,
@@ -33,6 +39,17 @@ runs through :meth:`Box.argv`::
   own: the master the student's nodes talk to is bounded in memory (``MASTER_MEMORY_BYTES``: the
   parameters they set are its memory), and both outweigh a box for CPU (``JUDGE_SHARES``), so a box
   that burns CPU cannot delay what measures its classmates.
+
+**Without root** (the teacher's own account, where the kernel lets an ordinary user make user
+namespaces: Debian 12, Ubuntu 20.04/22.04), the box is the same bubblewrap command started as the
+grading user itself, with the same namespaces, files, environment and ``prlimit`` bounds. What
+differs: it runs as the grading user's uid (it still sees only what it binds: none of that user's
+files), boxes are told apart by their PID namespaces and mounts rather than by uids, there is no
+cgroup unless the machine delegates a writable cgroup v2 subtree to the user (tried, untested), and
+the work folder has no tmpfs (each file is bounded by ``FILE_BYTES``). The session around it runs in a
+user and network namespace of its own (:func:`network_namespace`), so ``RLIMIT_NPROC`` counts the
+session's processes, not the rest of the user's, and a box run outside a session gets a network
+namespace of its own (only loopback: not even the host's abstract sockets, X11's or D-Bus's).
 
 :func:`check` says whether boxes can be made here at all; the runner refuses to grade when they
 cannot unless the teacher accepts the risk by name.
@@ -92,6 +109,10 @@ _checked = {}
 
 class SandboxUnavailable(RuntimeError):
     """The machine cannot make a box: the grader refuses to run student code (unless told to)."""
+
+
+class UploadRefused(ValueError):
+    """An upload too large or too deep to stage for its box (:func:`stage_upload`): that student's row."""
 
 
 def box_env(env, home=BOX_HOME):
@@ -306,6 +327,10 @@ class Box(object):
     :param bwrap: False for the unsandboxed mode the teacher asked for by name: same user and limits,
         no namespaces.
     :param cpus: the box's CPU quota in cores (:func:`box_cpus`); None: its weight only.
+
+    Opened by a grader that is not root, a box with ``bwrap`` is *rootless* (the module's docstring):
+    no slot, the grading user's uid (``owner``), and the network namespace it was opened in
+    (``netns``), to tell whether a command line is made inside a session's namespace or not.
     """
 
     def __init__(self, work, binds=(), bwrap=True, cpus=None):
@@ -321,11 +346,13 @@ class Box(object):
         self.mounted = False
         self.folder = os.path.join(work, 'box')
         self.notes = []
+        self.rootless, self.owner, self.netns = False, None, None
 
     def describe(self):
         """What the session needs to make this box's command lines (JSON): see :meth:`attached`."""
         return {'work': self.work, 'binds': self.binds, 'bwrap': self.bwrap, 'slot': self.slot,
-                'cgroups': self.cgroups, 'judge_cgroups': self.judge_cgroups, 'cpus': self.cpus}
+                'cgroups': self.cgroups, 'judge_cgroups': self.judge_cgroups, 'cpus': self.cpus,
+                'rootless': self.rootless, 'owner': self.owner, 'netns': self.netns}
 
     @classmethod
     def attached(cls, described):
@@ -333,6 +360,7 @@ class Box(object):
         box = cls(described['work'], described['binds'], described['bwrap'], described.get('cpus'))
         box.slot, box.cgroups = described['slot'], described['cgroups']
         box.judge_cgroups = described.get('judge_cgroups', {})
+        box.rootless, box.owner, box.netns = described['rootless'], described['owner'], described['netns']
         return box
 
     @property
@@ -342,7 +370,7 @@ class Box(object):
 
     @property
     def uid(self):
-        return BOX_UID_BASE + self.slot
+        return self.owner if self.rootless else BOX_UID_BASE + self.slot
 
     @property
     def judge_uid(self):
@@ -355,9 +383,9 @@ class Box(object):
         return BOX_WS if self.bwrap else os.path.join(self.folder, 'ws')
 
     def open(self):
+        if os.geteuid() != 0 and self.bwrap:
+            return self._open_rootless()
         if os.geteuid() != 0:  # unsandboxed and not root: the grading user's own rights, limits only
-            if self.bwrap:
-                raise SandboxUnavailable('a box needs root (a user of its own per submission)')
             os.makedirs(os.path.join(self.folder, 'ws', 'build'))
             os.makedirs(os.path.join(self.folder, 'ws', 'devel'))
             shutil.copytree(os.path.join(self.work, 'ws', 'src'), os.path.join(self.folder, 'ws', 'src'),
@@ -408,6 +436,24 @@ class Box(object):
                               'to is not bounded in memory')
         return self
 
+    def _open_rootless(self):
+        """The box of a grader that is not root: its folder (the grading user's, 0700), no uid of its
+        own, a cgroup only where a cgroup v2 subtree is delegated to the user."""
+        self.rootless, self.owner = True, os.geteuid()
+        self.netns = os.readlink('/proc/self/ns/net')
+        os.makedirs(self.folder, mode=0o700)
+        for sub in ('ws', 'ws/src', 'ws/build', 'ws/devel'):
+            os.mkdir(os.path.join(self.folder, sub))
+        self.notes.append('without root, the box\'s work folder is a plain folder, not a tmpfs of %d MB: '
+                          'each file is limited to %d MB, the folder is not' % (WORK_BYTES >> 20, FILE_BYTES >> 20))
+        self.cgroups = _make_cgroups('exam-box-%d-%s' % (self.owner, os.path.basename(self.work)), MEMORY_BYTES,
+                                     BOX_SHARES, PROCESSES, self.cpus)
+        if not self.cgroups:
+            self.notes.append('without root, no cgroup (none delegated to this user): memory limited per process '
+                              '(%d GB of address space), processes to %d in the session\'s user namespace'
+                              % (ADDRESS_SPACE_BYTES >> 30, PROCESSES))
+        return self
+
     def __enter__(self):
         return self.open()
 
@@ -415,9 +461,14 @@ class Box(object):
         self.close()
         return False
 
-    def argv(self, command, env, cwd=None):
+    def argv(self, command, env, cwd=None, mounts=None, network=True):
         """The command line that runs ``command`` in the box with ``env`` (filtered by :func:`box_env`)
-        and ``cwd`` (a path as the box sees it; default its workspace)."""
+        and ``cwd`` (a path as the box sees it; default its workspace).
+
+        :param mounts: ``[(host path, path in the box, writable)]`` instead of the workspace (the
+            inspection's upload, workspace and output); unsandboxed, commands get host paths instead.
+        :param network: False: a network namespace of the box's own, without even loopback.
+        """
         env = box_env(env, self.home)
         cwd = cwd or self.workspace
         limits = ['prlimit', '--as=%d' % ADDRESS_SPACE_BYTES, '--nproc=%d' % PROCESSES,
@@ -435,6 +486,8 @@ class Box(object):
         box = ['env', '-i', 'bwrap', '--unshare-user', '--unshare-pid', '--unshare-ipc', '--unshare-uts',
                '--unshare-cgroup-try', '--hostname', 'exam-box', '--die-with-parent', '--new-session',
                '--clearenv', '--ro-bind', '/usr', '/usr']
+        if self.rootless and os.readlink('/proc/self/ns/net') == self.netns:
+            box.append('--unshare-net')  # outside a session: the grading user's network is not the box's
         for link in ('bin', 'sbin', 'lib', 'lib32', 'lib64', 'libx32'):
             if os.path.islink('/' + link):
                 box += ['--symlink', os.readlink('/' + link), '/' + link]
@@ -450,9 +503,14 @@ class Box(object):
             box += ['--size', str(TMP_BYTES), '--tmpfs', path]
         for path in self.binds:  # after the private /tmp: an underlay may live in the host's /tmp
             box += ['--ro-bind', path, path]
-        box += ['--bind', os.path.join(self.folder, 'ws'), BOX_WS,
-                '--ro-bind', os.path.join(self.work, 'ws', 'src'), BOX_WS + '/src',
-                '--remount-ro', '/', '--chdir', cwd]
+        if mounts is None:
+            mounts = [(os.path.join(self.folder, 'ws'), BOX_WS, True),
+                      (os.path.join(self.work, 'ws', 'src'), BOX_WS + '/src', False)]
+        for host, inside, writable in mounts:
+            box += ['--bind' if writable else '--ro-bind', host, inside]
+        if not network and '--unshare-net' not in box:
+            box.append('--unshare-net')
+        box += ['--remount-ro', '/', '--chdir', cwd]
         for name, value in sorted(env.items()):
             box += ['--setenv', name, value]
         return join + limits + user + box + ['--'] + list(command)
@@ -465,8 +523,31 @@ class Box(object):
             return list(command)
         return _join(self.judge_cgroups.get(part, [])) + _as_user(self.judge_uid) + list(command)
 
+    def run(self, command, env, log, timeout, cwd=None, mounts=None, network=True):
+        """Run ``command`` in the box (:meth:`argv`) and wait at most ``timeout`` s of wall clock, its
+        output (stdout and stderr) in the file ``log`` (root's, outside the box); then end whatever of
+        the box's uid is left. Returns ``(exit status, None)``, or ``(None, why)`` when it was killed
+        at the deadline."""
+        argv = self.argv(command, env, cwd, mounts, network)
+        with open(log, 'wb') as out:
+            child = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
+                                     start_new_session=True)
+            try:
+                status, why = child.wait(timeout=timeout), None
+            except subprocess.TimeoutExpired:
+                status, why = None, 'did not finish within %.0f s' % timeout
+            finally:
+                try:
+                    os.killpg(child.pid, signal.SIGKILL)  # the unsandboxed mode's children, in its session
+                except OSError:
+                    pass
+                child.wait()
+        self.end()
+        return status, why
+
     def leftovers(self):
-        """Pids of the box's uid still alive (there should be none once its command ended)."""
+        """Pids of the box's uid still alive (there should be none once its command ended). A rootless
+        box has no uid of its own to look for: what it started died with its PID namespace."""
         return pids_of_uid(self.uid) if self.slot is not None else []
 
     def end(self):
@@ -475,6 +556,7 @@ class Box(object):
 
     def close(self):
         if self.slot is None:
+            _remove_cgroups(self.cgroups)
             shutil.rmtree(self.folder, ignore_errors=True)
             return
         self.end()
@@ -499,10 +581,25 @@ def check():
         return _checked['why']
 
 
+def network_namespace(argv):
+    """``argv`` run in a network namespace of its own with only loopback, up. As root ``unshare --net``;
+    otherwise bubblewrap makes it, with a user namespace of its own that keeps the grading user's uid
+    and shows every file as it is (the master, the probe and the box's steps run inside)."""
+    if os.geteuid() == 0:
+        return ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + list(argv)
+    return ['bwrap', '--unshare-user', '--unshare-net', '--dev-bind', '/', '/', '--'] + list(argv)
+
+
+#: Why a rootless box may fail, for the teacher.
+USERNS_HINT = ('without root, the kernel must let ordinary users make user namespaces: user.max_user_namespaces '
+               'above 0, kernel.unprivileged_userns_clone=1 where it exists (Debian 10, 11), and on Ubuntu '
+               '24.04 an AppArmor profile that allows bwrap')
+
+
 def _try_a_box():
-    if os.geteuid() != 0:
-        return 'the grader is not root: it needs root to give each submission a user of its own'
-    missing = [tool for tool in ('bwrap', 'setpriv', 'prlimit', 'unshare', 'ip') if shutil.which(tool) is None]
+    rootless = os.geteuid() != 0
+    tools = ('bwrap', 'prlimit') if rootless else ('bwrap', 'setpriv', 'prlimit', 'unshare', 'ip')
+    missing = [tool for tool in tools if shutil.which(tool) is None]
     if missing:
         return 'missing %s (Debian: apt-get install bubblewrap util-linux iproute2)' % ', '.join(missing)
     import tempfile
@@ -511,16 +608,73 @@ def _try_a_box():
         os.chmod(work, 0o711)
         os.makedirs(os.path.join(work, 'ws', 'src'))
         with Box(work) as box:
-            done = subprocess.run(box.argv(['sh', '-c', 'test "$(id -u)" != 0 && test ! -e /root'], {}),
+            argv = box.argv(['sh', '-c', 'test "$(id -u)" != 0 && test ! -e /root'], {})
+            # Rootless, as the session makes it: a box in a user and network namespace of its own.
+            done = subprocess.run(network_namespace(argv) if rootless else argv,
                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=30)
         if done.returncode != 0:
-            return 'bubblewrap could not make a box (exit %d): %s' % (
-                done.returncode, done.stdout.decode('utf-8', 'replace').strip()[-500:])
+            return 'bubblewrap could not make a box (exit %d): %s%s' % (
+                done.returncode, done.stdout.decode('utf-8', 'replace').strip()[-500:],
+                '; %s' % USERNS_HINT if rootless else '')
         return None
     except (OSError, subprocess.SubprocessError, SandboxUnavailable) as err:
         return 'a box could not be made: %s' % err
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+#: Most bytes and entries of one upload staged for a box (unpack's own budget applies inside).
+UPLOAD_BYTES = 256 << 20
+UPLOAD_FILES = 20000
+UPLOAD_DEPTH = 32
+
+
+def stage_upload(source, target, max_bytes=UPLOAD_BYTES, max_files=UPLOAD_FILES):
+    """Copy the upload ``source`` (a file or a folder) to ``target`` for a box to read, byte for byte and
+    without reading anything of it: regular files (opened with O_NOFOLLOW; executable ones stay so:
+    whether a script was, is a fact of the grade), folders and links (as
+    links, never followed); FIFOs, devices and sockets are left out. Everything is root's and
+    world-readable, nothing writable by a box. An upload over ``max_bytes``, ``max_files`` or
+    :data:`UPLOAD_DEPTH` folders deep raises :class:`UploadRefused`."""
+    budget = {'bytes': max_bytes, 'files': max_files}
+
+    def take(size):
+        budget['files'] -= 1
+        budget['bytes'] -= size
+        if budget['files'] < 0 or budget['bytes'] < 0:
+            raise UploadRefused('the upload is larger than the grader takes (%d MB, %d files)'
+                                % (max_bytes >> 20, max_files))
+
+    def copy_file(src, dest):
+        fd = os.open(src, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+        try:
+            info = os.fstat(fd)
+            if not stat.S_ISREG(info.st_mode):
+                return
+            take(info.st_size)
+            with os.fdopen(os.dup(fd), 'rb') as f, open(dest, 'xb') as g:
+                os.chmod(dest, 0o755 if info.st_mode & 0o111 else 0o644)  # a script keeps its x bit
+                shutil.copyfileobj(f, g)
+        finally:
+            os.close(fd)
+
+    def copy(src, dest, depth=0):
+        if depth > UPLOAD_DEPTH:
+            raise UploadRefused('the upload has folders more than %d deep' % UPLOAD_DEPTH)
+        info = os.lstat(src)
+        if stat.S_ISLNK(info.st_mode):
+            take(0)
+            os.symlink(os.readlink(src), dest)
+        elif stat.S_ISDIR(info.st_mode):
+            take(0)
+            os.mkdir(dest, 0o755)
+            os.chmod(dest, 0o755)
+            for name in sorted(os.listdir(src)):
+                copy(os.path.join(src, name), os.path.join(dest, name), depth + 1)
+        elif stat.S_ISREG(info.st_mode):
+            copy_file(src, dest)
+
+    copy(source.rstrip('/') or '/', target)
 
 
 #: What of a log reaches the results: its first and last LOG_PART bytes.

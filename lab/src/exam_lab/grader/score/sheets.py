@@ -75,3 +75,8 @@ def sheet_of_drone(pkg):
         if sheet.drone_pkg == pkg:
             return sheet.name
     return None
+
+
+def margin_of(threshold):
+    """How far beyond the threshold the probe flies (student units): 10 %, at least 10 m."""
+    return max(0.1 * abs(threshold), 10.0)

@@ -1,4 +1,4 @@
-"""The kept-open connection to the master (drone_sim.master_line), against a stand-in master.
+"""The kept-open connection to the master (node_kit.master_line), against a stand-in master.
 
 The stand-in is Python's own XML-RPC server in a process of its own, threaded and speaking HTTP/1.1 as
 rosmaster's (``rosgraph.xmlrpc``) does, so that its death is a real one: the kernel closes its
@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from drone_sim.master_line import KEEPALIVE_IDLE_S, MasterLine
+from node_kit.master_line import KEEPALIVE_IDLE_S, MasterLine
 
 STAND_IN = r'''
 import socketserver, sys

@@ -21,29 +21,42 @@ So everything a node runs by itself goes through this module, and one client hoo
 all before step 2 begins:
 
 - :func:`timer` instead of ``rospy.Timer``; :func:`guarded` for subscriber callbacks and service
-  handlers: they pass a :class:`drone_sim.gate.Gate`;
+  handlers: they pass a :class:`node_kit.gate.Gate`;
 - :func:`on_stop` for a node's threads (the warning link, the master link): told to end, in order.
 
 The hook closes the gate (no callback starts any more), waits up to ``DRAIN_TIMEOUT_S`` for those in
 progress, shuts the timers down, stops the threads, and only then raises ``is_shutdown()`` itself
 (rospy's own loops, such as its registration retries, end on it; see :func:`_stop`). :func:`run` is a
-node's whole life (init, build, spin), quiet when it is stopped while it starts. No ROS parameters,
-topics or services.
+node's whole life (init, build, spin), quiet when it is stopped while it starts.
+
+A node has one ``diagnostic_updater.Updater`` (:func:`updater`): the node adds its statuses, the
+master link adds "<node>: master", and one timer publishes them all with ``force_update`` every
+``~diagnostic_period`` seconds, read once at start. ``Updater.update`` is not used: it asks the master
+for ``~diagnostic_period`` at every update (rospy's ``get_param_cached`` never caches an unset one),
+which raises while the master is down; ``force_update`` publishes without asking anybody.
+
+ROS Parameters:
+    ~diagnostic_period (float, s, default 1.0, > 0): seconds between two publications of the node's
+        statuses on /diagnostics (diagnostic_updater's own parameter).
+
+Published Topics:
+    /diagnostics (diagnostic_msgs/DiagnosticArray): the node's statuses, "<node>: master" among them.
 """
 import functools
 import signal
 import sys
 import threading
 
+import diagnostic_updater
 import rospy
 
-from drone_sim import master_link, params
-from drone_sim.gate import Gate
+from node_kit import master_link, params, rospy_private
+from node_kit.gate import Gate
 
 #: Seconds the shutdown waits for callbacks in progress (a publish, a diagnostics update).
 DRAIN_TIMEOUT_S = 2.0
 
-#: Seconds between two "<node>: master" statuses on /diagnostics.
+#: Default seconds between two publications of the node's statuses on /diagnostics.
 STATUS_PERIOD_S = 1.0
 
 _gate = Gate()
@@ -53,6 +66,11 @@ _lock = threading.RLock()
 _timers = []
 _stops = []
 _installed = []
+# Not _lock: making the Updater registers its publisher with the master, which rospy retries until
+# is_shutdown() while the master is down, and _stop takes _lock before it raises that flag (a node
+# built as its master died hung until roslaunch's SIGKILL: 3 of 9 runs of test_stops.py).
+_updater_lock = threading.Lock()
+_updaters = []
 
 
 def _install():
@@ -112,6 +130,26 @@ def stopping():
     return _gate.closed
 
 
+def updater():
+    """The node's one ``diagnostic_updater.Updater`` (made at the first call, after ``init_node``):
+    add the node's statuses to it; :func:`run` publishes them."""
+    with _updater_lock:
+        if not _updaters:
+            made = diagnostic_updater.Updater()
+            made.setHardwareID(rospy.get_name())
+            _updaters.append(made)
+        return _updaters[0]
+
+
+def _publish_statuses(statuses):
+    """Publish every status of the node on /diagnostics (a timer's callback: never raises)."""
+    try:
+        statuses.force_update()
+    except Exception as err:
+        rospy.logerr_throttle(60.0, '/diagnostics: statuses not published: %s: %s'
+                              % (type(err).__name__, err))
+
+
 def _stop():
     """The node's first shutdown hook (step 1): everything of the node ends before rospy closes it."""
     left = _gate.close(DRAIN_TIMEOUT_S)
@@ -132,7 +170,7 @@ def _stop():
     # the master is away (a node built as its master dies) retries its registration inside the
     # topic manager's lock until is_shutdown(); step 2's close_all() waits for that lock, so with
     # the flag raised only after step 2 the node hung until roslaunch's SIGKILL.
-    rospy.core._shutdown_flag = True
+    rospy_private.raise_shutdown_flag()
 
 
 def _on_signal(signum, frame):
@@ -155,8 +193,8 @@ def run(name, build):
     node hung until roslaunch's SIGKILL (2 of 16 stops during start-up). On its own thread, the
     shutdown waits for the main thread to leave the lock instead.
 
-    A parameter that is unusable (:class:`drone_sim.params.ParamError`) is a fatal log naming the
-    node, and exit status 1.
+    A parameter that is unusable (:class:`node_kit.params.ParamError`), ``~diagnostic_period``
+    included, is a fatal log naming the node, and exit status 1.
     """
     with _lock:
         _install()
@@ -165,15 +203,18 @@ def run(name, build):
     try:
         rospy.init_node(name, disable_signals=True)  # the signals are _on_signal's
         master_link.quiet_master_outages()
+        status_period = params.positive_float(rospy.resolve_name('~diagnostic_period'),
+                                              rospy.get_param('~diagnostic_period', STATUS_PERIOD_S), 's')
         build()
-        link = master_link.start()
+        statuses = updater()
+        link = master_link.start(statuses)
         on_stop(link.stop)
-        timer(STATUS_PERIOD_S, link.publish_status)
+        timer(status_period, lambda event: _publish_statuses(statuses))
     except params.ParamError as err:
         rospy.logfatal('%s: %s', rospy.get_name(), err)
         sys.exit(1)
     except Exception:
-        if rospy.core.is_shutdown_requested():
+        if rospy_private.shutdown_begun():
             return
         raise
     rospy.spin()

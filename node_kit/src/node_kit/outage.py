@@ -1,7 +1,7 @@
 """What a node does when its master goes away and comes back: the rules, without rospy.
 
 ROS 1 nodes register with the master once, at start-up; a master that is killed and started again on
-the same port knows none of them. :mod:`drone_sim.master_link` asks the master when the connection it
+the same port knows none of them. :mod:`node_kit.master_link` asks the master when the connection it
 holds to it closes, once a second while it is down, every few seconds otherwise, and feeds each
 answer to :class:`MasterWatch`, which says what to do and what to log: the pure part,
 unit-tested with synthetic answers and times.
@@ -21,8 +21,7 @@ learnt the node's name again some other way (a parameter subscription, a new pub
 other registrations has another pid than the one the node registered with.
 
 Logging rule: one line when the outage starts, one when it ends, nothing in between, so that a master
-down for an hour does not flood the log. :class:`OncePerOutage` applies the same rule to any periodic
-task that fails while the master is away (the exam node's /diagnostics update).
+down for an hour does not flood the log.
 """
 
 KNOWN = 'known'
@@ -145,30 +144,3 @@ class MasterWatch(object):
         return 'ok', 'master up, re-registered %d times, last at %.3f' % (
             self._reregistrations, self._reregistered_at), values
 
-
-class OncePerOutage(object):
-    """Logs a periodic task's failures once per run of failures, and its recovery once.
-
-    :param what: what failed, for the messages (e.g. ``"/diagnostics: reading the diagnostic_period
-        parameter from the master"``).
-    :param meaning: what the failure means for the node, for the first message.
-    """
-
-    def __init__(self, what, meaning):
-        self._what = what
-        self._meaning = meaning
-        self._failures = 0
-
-    def failed(self, error):
-        """The task raised ``error`` (a message); returns the line to log, or None (already logged)."""
-        self._failures += 1
-        if self._failures > 1:
-            return None
-        return '%s failed (%s): %s; logged once until it works again' % (self._what, error, self._meaning)
-
-    def succeeded(self):
-        """The task worked; returns the line to log when it had been failing, else None."""
-        failures, self._failures = self._failures, 0
-        if not failures:
-            return None
-        return '%s works again, after %d failed attempts' % (self._what, failures)

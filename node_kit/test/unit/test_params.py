@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from drone_sim.params import ParamError, finite_float, non_negative_float, one_of, positive_float, seed
+from node_kit.params import ParamError, finite_float, non_negative_float, one_of, positive_float, seed
 
 
 def test_positive_float_accepts_and_casts():

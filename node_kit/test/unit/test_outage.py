@@ -1,7 +1,6 @@
 """A node's view of its master: what to do and log for each poll's answer (synthetic answers, no ROS)."""
 
-from drone_sim.outage import (KNOWN, REREGISTER, UNKNOWN, UNREACHABLE, MasterWatch, OncePerOutage,
-                              classify)
+from node_kit.outage import KNOWN, REREGISTER, UNKNOWN, UNREACHABLE, MasterWatch, classify
 
 URI = 'http://ground:11311/'
 
@@ -126,15 +125,3 @@ def test_status_up_down_and_re_registered():
     w.reregistered(20.0, 3, 4, 2, 5)
     assert w.status(21.0)[1] == 'master up, re-registered 2 times, last at 20.000'
 
-
-def test_once_per_outage_logs_the_first_failure_and_the_recovery():
-    guard = OncePerOutage('/diagnostics: reading ~diagnostic_period from the master', 'published anyway')
-    assert guard.succeeded() is None
-    assert guard.failed('ConnectionRefusedError: refused') == (
-        '/diagnostics: reading ~diagnostic_period from the master failed (ConnectionRefusedError: '
-        'refused): published anyway; logged once until it works again')
-    assert [guard.failed('refused') for _ in range(5)] == [None] * 5
-    assert guard.succeeded() == ('/diagnostics: reading ~diagnostic_period from the master works again, '
-                                 'after 6 failed attempts')
-    assert guard.succeeded() is None
-    assert guard.failed('refused') is not None  # the next outage is logged again

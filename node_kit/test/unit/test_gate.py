@@ -1,7 +1,7 @@
 """The gate a node's callbacks pass: closed at shutdown, it waits for those inside (threads, events)."""
 import threading
 
-from drone_sim.gate import Gate
+from node_kit.gate import Gate
 
 WAIT_S = 5.0
 

@@ -1,7 +1,7 @@
 """A gate that a node's callbacks pass through, closed once before rospy tears the node down. No rospy.
 
 Why (issue 19): rospy's shutdown closes every publisher *before* ``rospy.is_shutdown()`` turns true
-(:mod:`drone_sim.lifecycle` says exactly where), so a timer or a callback that publishes in that
+(:mod:`node_kit.lifecycle` says exactly where), so a timer or a callback that publishes in that
 window gets ``ROSException: publish() to a closed topic``, and its thread dies with a traceback. A
 guard per call site cannot close the window; ordering can: the gate is closed by the node's first
 shutdown hook, which rospy runs before it closes anything, and :meth:`Gate.close` returns only once

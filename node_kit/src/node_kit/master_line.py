@@ -1,6 +1,6 @@
 """One kept-open connection to the ROS master: how a node learns of its master's death without asking.
 
-A node that keeps itself registered across a master restart (:mod:`drone_sim.master_link`) must notice
+A node that keeps itself registered across a master restart (:mod:`node_kit.master_link`) must notice
 two things at once: the master went away, and a master answers again that does not know the node.
 Asking once a second costs the master one XML-RPC request per node per second: 200 nodes of a
 100-pair fleet took 22 % of its core that way (issue 19), for answers that were "nothing changed"
@@ -12,7 +12,7 @@ becomes readable at that instant. :meth:`MasterLine.wait` waits for exactly that
 
 So the node asks only when something happened: at start, when the connection closes, and (while the
 master is down) once a poll period until it answers again, which is as fast as polling once a second
-ever was. A heartbeat (a real call every ``HEARTBEAT_S`` of :mod:`drone_sim.master_link`) covers
+ever was. A heartbeat (a real call every ``HEARTBEAT_S`` of :mod:`node_kit.master_link`) covers
 what leaves the connection open: a master that hangs. TCP keepalive on the connection covers a
 master host that vanished from the network, in the kernels, costing the master's process nothing.
 

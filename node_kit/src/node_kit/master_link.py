@@ -6,8 +6,8 @@ existing connections keep flowing, but nobody can find it any more: no new subsc
 lookup, no ``rosnode list``, and its parameters are gone. :func:`start` runs a daemon thread that asks
 the master whether it is the master the node registered with and still knows the node (one multicall
 of ``getPid`` and ``lookupNode`` of its own name, with a short socket timeout: its cost does not grow
-with the graph, see :mod:`drone_sim.outage`), and follows :class:`drone_sim.outage.MasterWatch`. It
-asks over a connection it keeps open (:mod:`drone_sim.master_line`): a second after start, the instant the
+with the graph, see :mod:`node_kit.outage`), and follows :class:`node_kit.outage.MasterWatch`. It
+asks over a connection it keeps open (:mod:`node_kit.master_line`): a second after start, the instant the
 master's end closes that connection, once a second while the master is unreachable, and otherwise
 only every ``HEARTBEAT_S`` seconds, so a master that lives is almost never asked:
 
@@ -15,31 +15,34 @@ only every ``HEARTBEAT_S`` seconds, so a master that lives is almost never asked
 - master answers but does not know the node, or has another pid (it restarted): the node's private
   parameters are set again with the values it read at start-up (so ``rosparam get /exam/threshold`` is right
   again and a tool that reads them sees what the node runs with), then every publication, subscription
-  and service is registered again, as ``rospy.impl.registration.RegManager.start`` does at start-up, and
-  each subscription is told of the publishers the master returns (through the node's own XML-RPC
-  ``publisherUpdate``, the call a master makes); one info line says what was re-registered.
+  and service is registered again, as rospy's ``RegManager.start`` does at start-up, and each
+  subscription is told of the publishers the master returns (through the node's own XML-RPC
+  ``publisherUpdate``, the call a master makes); one info line says what was re-registered. The
+  topics are those the node's own XML-RPC API lists (``getPublications``, ``getSubscriptions``); the
+  services, which that API does not list, come from rospy's registry
+  (:func:`node_kit.rospy_private.served_services`).
 
 The link's state (up; down since; re-registered when, how many times) is the node's "<node>: master"
-status on /diagnostics, WARN while the master is down (:meth:`MasterLink.publish_status`).
+status on /diagnostics, WARN while the master is down: a task of the node's one Updater
+(:meth:`MasterLink.fill_status`), published with the node's other statuses.
 
 Two things rospy does that a master outage (or a peer's stop) turns into tracebacks in the node's log
-file, both settled here (:func:`quiet_master_outages`): rospy's rosout handler and diagnostic_updater
-read a parameter with ``get_param_cached`` at every log line and every update, and an unset
-parameter is never cached, so each read is a ``subscribeParam`` call to the master ("Unable to report
-rosout" and a traceback while it is down; a cost on the master while it is up): they are read once
-at start and put in rospy's cache. rosgraph's XML-RPC server and rospy's connection threads log a
-traceback when a peer goes away mid-request (a master killed while it tells the node of a publisher,
-a node that stops while this one connects to it): one line instead, with the error.
+file, both settled here (:func:`quiet_master_outages`): rospy's rosout handler reads a parameter with
+``get_param_cached`` at every log line, and an unset parameter is never cached, so each read is a
+``subscribeParam`` call to the master ("Unable to report rosout" and a traceback while it is down; a
+cost on the master while it is up): it is read once at start and put in rospy's cache. rosgraph's
+XML-RPC server and rospy's connection threads log a traceback when a peer goes away mid-request (a
+master killed while it tells the node of a publisher, a node that stops while this one connects to
+it): one line instead, with the error.
 
 :func:`open_persistent` serves the other side of a master outage: a service client whose connection
 is open before it is needed calls the service without asking the master.
 
-rospy internals used, all here (python3-rospy 1.15.15 of Debian 12; the same in ROS Noetic's 1.16):
-the topic and service managers of ``rospy.impl.registration`` and their ``get_publications``,
-``get_subscriptions`` and ``get_services`` (the lists RegManager.start registers); a ServiceProxy's
-``protocol``, ``buff_size`` and ``transport``, and ``rospy.impl.tcpros_base.TCPROSTransport`` (what
-``ServiceProxy.call`` does to open a persistent connection). Not restored: rospy's parameter
-subscriptions (``get_param_cached``); nothing of ours relies on them.
+rospy's private names used (the services' registry, the parameter cache, a persistent proxy's
+connection) are all in :mod:`node_kit.rospy_private`, each with why no public API does it. The calls
+to the master are plain XML-RPC with a socket timeout, not rospy's master proxy, whose calls wait
+forever. Not restored: rospy's parameter subscriptions (``get_param_cached``); nothing of ours relies
+on them.
 
 No ROS parameters, topics or services of its own.
 """
@@ -49,20 +52,18 @@ import threading
 import time
 import xmlrpc.client
 
-import diagnostic_updater
 import rosgraph
 import rospy
 from diagnostic_msgs.msg import DiagnosticStatus
-from rospy.impl import paramserver, registration
-from rospy.impl.tcpros_base import TCPROSTransport
 
-from drone_sim.master_line import MasterLine
-from drone_sim.outage import REREGISTER, UNREACHABLE, MasterWatch, classify
+from node_kit import rospy_private
+from node_kit.master_line import MasterLine
+from node_kit.outage import REREGISTER, UNREACHABLE, MasterWatch, classify
 
 #: Seconds between two polls of the master.
 POLL_PERIOD_S = 1.0
 #: Seconds between two polls while the master is up and the connection to it held (see
-#: :mod:`drone_sim.master_line`): only a master that hangs, its connection open, waits for one; it is
+#: :mod:`node_kit.master_line`): only a master that hangs, its connection open, waits for one; it is
 #: noticed within HEARTBEAT_S + CALL_TIMEOUT_S. Each poll costs the master about 0.4 ms of CPU in a
 #: fleet; measured with 100 pairs (200 nodes) on one master, its CPU was 11.2 % of a core at 1 s,
 #: 5.5 % at 2 s and 3.2 % at 5 s (docs/benchmarks.md).
@@ -71,9 +72,9 @@ HEARTBEAT_S = 2.0
 CALL_TIMEOUT_S = 2.0
 #: Caller id of the node's call to its own publisherUpdate (what a master would send).
 MASTER_CALLER_ID = '/master'
-#: Parameters read with get_param_cached at every log line (rospy's rosout) and every update
-#: (diagnostic_updater), with the default each uses when they are unset.
-CACHED_PARAMS = (('/rosout_disable_topics_generation', False), ('~diagnostic_period', 1))
+#: Parameters rospy reads with get_param_cached at every log line (its rosout handler), with the
+#: default it uses when they are unset.
+CACHED_PARAMS = (('/rosout_disable_topics_generation', False),)
 #: Errors that say a peer went away (refused, reset, cut before rospy's handshake): rosgraph's XML-RPC
 #: server and rospy's connection threads log them with a traceback.
 DROPPED = ('ConnectionResetError', 'ConnectionRefusedError', 'BrokenPipeError', 'ConnectionAbortedError',
@@ -116,7 +117,7 @@ def _value(call, what):
 class MasterLink(object):
     """The polling thread of one node; see the module docstring. Create it with :func:`start`."""
 
-    def __init__(self, poll_period=POLL_PERIOD_S, heartbeat=HEARTBEAT_S):
+    def __init__(self, updater, poll_period=POLL_PERIOD_S, heartbeat=HEARTBEAT_S):
         self._master_uri = rosgraph.get_master_uri()
         self._name = rospy.get_name()
         self._node_uri = rospy.get_node_uri()
@@ -126,9 +127,7 @@ class MasterLink(object):
         self._params = _private_params()
         self._watch = MasterWatch(self._master_uri, self._name)
         self._known_pid = None  # pid of the master the node is registered with, once seen
-        self._updater = diagnostic_updater.Updater()
-        self._updater.setHardwareID(self._name)
-        self._updater.add('master', self._fill_status)
+        updater.add('master', self.fill_status)
         self._poll_period = poll_period
         self._heartbeat = heartbeat
         self._line = MasterLine(self._master_uri, CALL_TIMEOUT_S)
@@ -164,7 +163,7 @@ class MasterLink(object):
                 # Returns early when the master's end closes the held connection: ask it at once.
                 self._line.wait(delay, self._wake_in)
                 with self._lock:
-                    if self._stopped.is_set() or rospy.core.is_shutdown_requested():
+                    if self._stopped.is_set() or rospy_private.shutdown_begun():
                         return
                     try:
                         self._poll()
@@ -201,23 +200,14 @@ class MasterLink(object):
             self._known_pid = pid
             self._tell(self._watch.reregistered, time.time(), *counts)
 
-    def _fill_status(self, stat):
+    def fill_status(self, stat):
+        """Fill ``stat`` with the link's state (the Updater's "master" task)."""
         with self._lock_status:
             level, summary, values = self._watch.status(time.time())
         for key, value in values:
             stat.add(key, value)
         stat.summary(LEVELS[level], summary)
         return stat
-
-    def publish_status(self, event=None):
-        """Publish the "<node>: master" status on /diagnostics (a timer's callback: never raises).
-
-        ``force_update``: it publishes without asking the master for ``~diagnostic_period``.
-        """
-        try:
-            self._updater.force_update()
-        except Exception as err:
-            rospy.logerr_throttle(60.0, '/diagnostics: master status not published: %s' % _describe(err))
 
     def _tell(self, method, *args):
         """Give the watch one observation (``method(*args)``); log and return what it decided."""
@@ -236,12 +226,12 @@ class MasterLink(object):
         # Parameters first: whoever finds the node through the master then finds its parameters too.
         for key, value in sorted(params.items()):
             _value(master.setParam(caller, self._namespace + '/' + key, value), 'setParam %s' % key)
-        topics, services = registration.get_topic_manager(), registration.get_service_manager()
-        publications, subscriptions = topics.get_publications(), topics.get_subscriptions()
-        served = services.get_services()
+        node = _proxy(uri)
+        publications = _value(node.getPublications(caller), 'getPublications')
+        subscriptions = _value(node.getSubscriptions(caller), 'getSubscriptions')
+        served = rospy_private.served_services()
         for topic, data_type in publications:
             _value(master.registerPublisher(caller, topic, data_type, uri), 'registerPublisher %s' % topic)
-        node = _proxy(uri)
         for topic, data_type in subscriptions:
             publishers = _value(master.registerSubscriber(caller, topic, data_type, uri),
                                 'registerSubscriber %s' % topic)
@@ -258,7 +248,7 @@ def _private_params():
     """The node's private parameters, asked of the master itself, or None when it cannot be asked now.
 
     Not ``rospy.get_param('~')``: that answers from rospy's parameter cache when the cache holds any
-    key of the node's namespace (``~diagnostic_period``, see :func:`quiet_master_outages`).
+    key of the node's namespace (one that rospy or a library read with ``get_param_cached``).
     """
     try:
         return _value(_proxy(rosgraph.get_master_uri()).getParam(rospy.get_name(),
@@ -281,7 +271,7 @@ class _PeerGone(logging.Filter):
         head, found, rest = text.partition('Traceback (most recent call last)')
         if found:
             last = rest.strip().splitlines()[-1]
-            if last.split(':')[0].split('.')[-1] in DROPPED or rospy.core.is_shutdown_requested():
+            if last.split(':')[0].split('.')[-1] in DROPPED or rospy_private.shutdown_begun():
                 record.msg, record.args = '%s%s' % (head or 'connection closed by its peer: ', last), ()
         return True
 
@@ -289,10 +279,9 @@ class _PeerGone(logging.Filter):
 def quiet_master_outages():
     """Keep rospy from calling the master at every log line and from logging a dropped peer as a
     traceback (see the module docstring). Call right after ``init_node``, before the node logs."""
-    cache = paramserver.get_param_server_cache()
     try:
         for key, default in CACHED_PARAMS:
-            cache.set(rospy.resolve_name(key), rospy.get_param(key, default))
+            rospy_private.cache_param(key, rospy.get_param(key, default))
     except Exception:  # the master went away already: rospy asks it again later, as it always did
         pass
     for name in PEER_LOGGERS:
@@ -303,11 +292,14 @@ def _describe(err):
     return '%s: %s' % (type(err).__name__, err)
 
 
-def start(poll_period=POLL_PERIOD_S):
+def start(updater, poll_period=POLL_PERIOD_S):
     """Start watching the master for the running node (call it once the node is built, its parameters
     read); returns the :class:`MasterLink`, whose ``stop`` must run before rospy unregisters the node
-    (:func:`drone_sim.lifecycle.run` calls it from the node's first shutdown hook)."""
-    link = MasterLink(poll_period)
+    (:func:`node_kit.lifecycle.run` calls it from the node's first shutdown hook).
+
+    :param updater: the node's diagnostic_updater.Updater: the link adds its "master" status to it.
+    """
+    link = MasterLink(updater, poll_period)
     link.start()
     return link
 
@@ -327,14 +319,5 @@ def open_persistent(name, service_class):
     proxy = rospy.ServiceProxy(name, service_class, persistent=True)
     uri = _value(_proxy(rosgraph.get_master_uri()).lookupService(rospy.get_name(), proxy.resolved_name),
                  'lookupService %s' % proxy.resolved_name)
-    host, port = rospy.core.parse_rosrpc_uri(uri)
-    # As ServiceProxy.call does for its first call (tcpros_service.py).
-    transport = TCPROSTransport(proxy.protocol, proxy.resolved_name)
-    transport.buff_size = proxy.buff_size
-    try:
-        transport.connect(host, port, uri)
-    except Exception:
-        transport.close()
-        raise
-    proxy.transport = transport
+    rospy_private.connect_persistent(proxy, uri)
     return proxy, uri

@@ -1,0 +1,76 @@
+#!/usr/bin/env python3
+"""A student's own check: grade one's exam package as the teacher's grader does, on one's own machine.
+
+    check.py --package DIR_OR_ZIP [--sheet altitude|depth]
+
+(``make check PACKAGE=<dir|zip> [SHEET=...]``; docs/grading.md, "A student's own check".) The same code
+as the teacher's grade (``runner.grade_submission``): the package built on top of the same drones'
+simulators, run against the same probe, scored by the same rubric, as an ordinary user without root
+or sudo, in about a minute (plus about a minute, once, to build the simulators). Prints only what the
+teacher chose to show (lab/check_visibility.ini: the points, or the points and the evidence; never the
+threshold run nor its hidden value) and keeps nothing of the grade.
+
+No sandbox is needed for one's own code on one's own machine: the grader's box is used where it can be
+made without root (bubblewrap, with unprivileged user namespaces, as on Debian 12 and Ubuntu 20.04),
+otherwise the package runs as you, with the box's limits, without asking for the teacher's flag.
+
+Exits 0 when the check ran, whatever the points; 1 when it could not (a missing package, the
+simulators not building, a bad setting file).
+"""
+import argparse
+import os
+import shutil
+import sys
+import tempfile
+
+from exam_lab.grader import runner
+
+from exam_lab.grader.host import sandbox
+
+from exam_lab.grader.publish import progress, student_view
+from exam_lab.grader.score.sheets import SHEETS
+
+#: The teacher's choice of what the check shows.
+SETTING = os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), 'check_visibility.ini')
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--package', required=True, help='your exam package: its folder, or the zip you upload')
+    parser.add_argument('--sheet', choices=list(SHEETS), help='default: detected from the package')
+    args = parser.parse_args(argv)
+    if not os.path.exists(args.package):
+        sys.stderr.write('check: %s does not exist\n' % args.package)
+        return 1
+    try:
+        show = student_view.read_setting(SETTING)
+    except ValueError as err:
+        sys.stderr.write('check: %s\n' % err)
+        return 1
+    why = sandbox.check()
+    if why is None:
+        print('check: your package runs in the grader\'s sandbox (bubblewrap), as on the teacher\'s machine.')
+    else:
+        print('check: your package runs as you, without the grader\'s sandbox (%s): none is needed for your '
+              'own code on your own machine.' % why)
+    out = tempfile.mkdtemp(prefix='exam-check-')
+    try:
+        print('check: building the simulators (once: about a minute the first time)...')
+        underlay = runner.ensure_underlay(runner.default_underlay())
+        print('check: grading %s (about a minute)...' % args.package)
+        record = runner.grade_submission(args.package, out, args.sheet, student='your package', underlay=underlay,
+                                         on_step=progress.StepProgress(), unsandboxed=why is not None)
+        threshold_run = os.path.exists(os.path.join(out, 'logs', 'plan-threshold.json'))
+    except RuntimeError as err:
+        sys.stderr.write('check: %s\n' % err)
+        return 1
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+    print('\nyour package, sheet %s (%s):' % (SHEETS[record['sheet']].seed, record['sheet']))
+    for line in student_view.lines(record, show, threshold_run):
+        print(line)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

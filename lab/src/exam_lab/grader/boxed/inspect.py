@@ -1,0 +1,157 @@
+"""Read one submission, as its box's uid: the only place the upload's bytes are opened before the build.
+
+The runner starts it in the submission's box (:meth:`exam_lab.grader.host.sandbox.Box.run`), without
+network, with a wall-clock, CPU and memory bound::
+
+    python3 -m exam_lab.grader.boxed.inspect --upload U --ws /box/ws --out /box/out [--sheet S] [--toplevel T]
+
+It unpacks the upload (:mod:`~exam_lab.grader.boxed.unpack`, scratch under ``OUT``), copies the package
+into ``WS/src/<name>``, makes the teacher's fixes (:mod:`~exam_lab.grader.boxed.source`), analyses the
+launch files and writes the derived ones (:mod:`~exam_lab.grader.boxed.launch`), reads the PDF facts
+(:mod:`~exam_lab.grader.boxed.documents`) and the comment statistics, and writes ``OUT/inspect.json``:
+one :class:`~exam_lab.grader.score.records.InspectRecord`, which root checks before using anything of it.
+
+``WS`` is the workspace at the path the build and run box sees it (``/box/ws``), so every path written
+into a derived launch file is valid there. ``T`` (catkin's toplevel.cmake) is linked as
+``WS/src/CMakeLists.txt``. An upload that cannot be opened safely is a record with ``refused``; any
+other failure exits non-zero with its traceback on stderr (the runner keeps a capped copy).
+"""
+import argparse
+import os
+import re
+import sys
+
+from exam_lab.grader.boxed import documents, launch, source, unpack
+from exam_lab.grader.host import sandbox
+from exam_lab.grader.score import records
+from exam_lab.grader.score.sheets import PACKAGE, SHEETS, margin_of
+
+
+def detect_sheet(wanted, package_dir, analyses):
+    """``(sheet, how it was chosen)``: given, else from package.xml, else the launch files, else the
+    topics the code names; altitude when nothing decides."""
+    if wanted:
+        return wanted, 'sheet %s given' % wanted
+    deps = [d for d in source.dependencies(package_dir) if d in (s.drone_pkg for s in SHEETS.values())]
+    by_deps = [name for name, s in SHEETS.items() if s.drone_pkg in deps]
+    if len(by_deps) == 1:
+        return by_deps[0], 'sheet %s: package.xml depends on %s' % (by_deps[0], SHEETS[by_deps[0]].drone_pkg)
+    by_launch = sorted(set(s for a in analyses for s in a.drone_sheets()))
+    if len(by_launch) == 1:
+        return by_launch[0], 'sheet %s: the launch files start %s' % (by_launch[0], SHEETS[by_launch[0]].drone_pkg)
+    by_code = source.sheets_in_code(package_dir)
+    if len(by_code) == 1:
+        return by_code[0], 'sheet %s: the code names its topics' % by_code[0]
+    return 'altitude', ('sheet altitude by default: the package could be either (depends on %s); '
+                        'give SHEET=depth to grade the other' % (', '.join(deps) or 'neither drone'))
+
+
+def _executable_in(pkg, name):
+    for dirpath, _, filenames in os.walk(pkg):
+        if name in filenames and os.access(os.path.join(dirpath, name), os.X_OK):
+            return True
+    return False
+
+
+def inspect(upload, ws, out, wanted_sheet=None):
+    """The record (a dict, :class:`~exam_lab.grader.score.records.InspectRecord`'s fields) of the
+    submission ``upload``; its package is written to ``ws/src/<name>``, scratch goes below ``out``."""
+    notes, fixes = [], []
+    record = {'uid': os.getuid(), 'refused': None, 'sheet': wanted_sheet or 'altitude', 'notes': notes,
+              'fixes': fixes, 'static': None, 'threshold_value': SHEETS[wanted_sheet or 'altitude'].threshold,
+              'calls_service': False, 'namespace': '/', 'main_launch': None, 'threshold_launch': None,
+              'handed_in_launch': None,
+              'comments': None, 'facts': documents.submission_facts(upload)}
+    uploads = []
+    try:
+        pkg_source = unpack.open_submission(upload, os.path.join(out, 'unpacked'), notes, fixes, uploads=uploads)
+    except unpack.UnpackError as err:
+        record['refused'] = str(err)
+        return record
+    name = unpack.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
+    pkg = os.path.join(ws, 'src', name if re.match(r'^[A-Za-z][\w-]*$', name) else PACKAGE)
+    unpack.copy_package(pkg_source, pkg, fixes)
+    fixes.extend(source.fix_text(pkg))
+    box_env = sandbox.box_env({'PATH': '/usr/bin:/bin'})  # what $(env) reads in the run box, nothing of ours
+    analyses = [launch.analyse(path, pkg, name, box_env) for path in launch.launch_files(pkg)]
+    sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
+    notes.insert(0, how)
+    chosen = launch.choose(analyses, sheet)
+    scripts = source.node_scripts(pkg)
+    types, type_fixes = source.node_type_fixes(pkg, chosen.exam_nodes if chosen else [])
+    fixes.extend(type_fixes)
+    launched = [types.get(n.type_origin, n.type) for n in chosen.exam_nodes] if chosen \
+        else [os.path.basename(p) for p in scripts[:1]]
+    fixes.extend(source.make_runnable(pkg, launched))
+    static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses], 'package': name,
+              'python2': source.python2_evidence(pkg), 'params_in_code': source.param_names(pkg),
+              'launch': None, 'threshold': None, 'uploads': uploads}
+    record.update(sheet=sheet, static=static, threshold_value=SHEETS[sheet].threshold,
+                  calls_service=source.calls_a_service(pkg))
+    if static['python2']:
+        notes.append('Python 2 code, which ROS Noetic cannot run: %s' % ', '.join(static['python2']))
+    for analysis in analyses:
+        for problem in analysis.problems:
+            notes.append('launch: %s' % problem)
+    code = source.student_code(pkg)
+    if code:
+        comments, lines = source.comment_ratio(code)
+        record['comments'] = {'comments': comments, 'code': lines, 'files': [os.path.relpath(p, pkg) for p in code]}
+    if chosen is not None:
+        exam = chosen.exam_nodes[0]
+        static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),
+                            'exam_type': exam.type, 'exam_name': exam.name, 'package': name,
+                            'comments': chosen.comments(), 'exam_type_found': _executable_in(pkg, exam.type)}
+        param, why = launch.threshold_param(chosen, sheet)
+        static['threshold_reason'] = why
+        if param is not None:
+            value = launch.as_number(param.value)
+            if value is not None:
+                record['threshold_value'] = value
+            static['threshold'] = {'name': param.name, 'value': param.value,
+                                   'where': param.origin.describe(pkg) if param.origin else '?'}
+            notes.append('threshold parameter: %s, set in %s' % (why, static['threshold']['where']))
+        record['main_launch'] = os.path.relpath(launch.derive(chosen, 'main', types), ws)
+        record['handed_in_launch'] = os.path.relpath(chosen.path, os.path.join(ws, 'src'))
+        record['namespace'] = chosen.drone_namespace(sheet)
+        if param is not None and param.origin is not None:
+            margin = margin_of(record['threshold_value'])
+            lowered = record['threshold_value'] - 2 * margin
+            changes = dict(types)
+            changes[param.origin] = lowered
+            record['threshold_launch'] = os.path.relpath(launch.derive(chosen, 'threshold', changes), ws)
+        elif param is not None:
+            static['threshold']['not_rewritable'] = 'its value comes from no literal the grader can change'
+    else:
+        static['threshold_reason'] = 'no launch file starts an exam node, so no parameter'
+        if scripts:
+            notes.append('no launch file starts an exam node: ran %s alone, without parameters'
+                         % os.path.relpath(scripts[0], pkg))
+            minimal = os.path.join(pkg, '.grader-main-minimal.launch')
+            with open(minimal, 'w') as f:
+                f.write('<launch><node pkg="%s" type="%s" name="exam" output="screen"/></launch>\n'
+                        % (name, os.path.basename(scripts[0])))
+            record['main_launch'] = os.path.relpath(minimal, ws)
+    return record
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--upload', required=True)
+    parser.add_argument('--ws', required=True, help='the workspace, at the path the run box sees it')
+    parser.add_argument('--out', required=True)
+    parser.add_argument('--sheet', choices=sorted(SHEETS))
+    parser.add_argument('--toplevel', help="catkin's toplevel.cmake, linked as WS/src/CMakeLists.txt")
+    args = parser.parse_args(argv)
+    if os.getuid() == 0:
+        sys.stderr.write('inspect: refusing to read a student\'s upload as root\n')
+        return 2
+    os.makedirs(os.path.join(args.ws, 'src'), exist_ok=True)
+    if args.toplevel:
+        os.symlink(args.toplevel, os.path.join(args.ws, 'src', 'CMakeLists.txt'))
+    records.write(args.out, records.InspectRecord, inspect(args.upload, args.ws, args.out, args.sheet))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,39 @@
+"""Unpack a class archive ("download all submissions"), as a box's uid: one folder or archive per student.
+
+The runner starts it in a box of its own, without network, bounded in time and memory::
+
+    python3 -m exam_lab.grader.boxed.intake --class /box/upload/<class.zip> --out /box/out
+
+and reads back ``OUT/intake.json``, an :class:`~exam_lab.grader.score.records.IntakeRecord`: each
+student's name and the path of its submission relative to ``OUT``. (A class that is a folder is not
+unpacked: root lists its entries by name, and stages each student's upload for that student's box.)
+"""
+import argparse
+import os
+import sys
+
+from exam_lab.grader.boxed import unpack
+from exam_lab.grader.score import records
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--class', dest='klass', required=True, help='the class archive')
+    parser.add_argument('--out', required=True, help='the folder to unpack into, and to write intake.json in')
+    args = parser.parse_args(argv)
+    if os.getuid() == 0:
+        sys.stderr.write('intake: refusing to unpack a class archive as root\n')
+        return 2
+    try:
+        students = unpack.list_students(args.klass, args.out)
+    except unpack.UnpackError as err:
+        sys.stderr.write('intake: the class archive cannot be opened safely: %s\n' % err)
+        return 3
+    records.write(args.out, records.IntakeRecord, {
+        'uid': os.getuid(), 'students': [{'name': name, 'path': os.path.relpath(path, args.out)}
+                                         for name, path in students]})
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

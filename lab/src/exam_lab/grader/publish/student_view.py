@@ -1,0 +1,95 @@
+"""What a student's own check (``make check``, lab/scripts/check.py) prints of a grade record: what the
+teacher chose to show, in one setting (lab/check_visibility.ini, ``[check] show``):
+
+- ``points``: each item and its points, the total and the status;
+- ``evidence``: also each item's evidence (its first line: the measured numbers) and the status's reason.
+
+Never shown, whatever the setting: the threshold run. For question 14a the grader runs the node a
+second time with its launch file's threshold lowered to a value the student is not told; when that run
+took place, Q14a's evidence (which names the value and what was flown) gives way to a sentence that
+names none, the ``runs`` item's words about that run are left out, and so is a status reason about it.
+The teacher's notes (``for_the_teacher``) are the teacher's. No rospy here.
+"""
+import configparser
+
+from exam_lab.grader.publish.report import NOT_SCORED, _points
+
+#: The values of the setting.
+SHOW = ('points', 'evidence')
+
+#: Q14a when the threshold run took place, by its points (full, part, none): no value, no flight.
+Q14A_WORDS = ('the node obeyed its launch file\'s threshold parameter: run again with the parameter changed '
+              '(to a value not shown), it warned',
+              'part of the point: the code reads the launch file\'s threshold parameter, but the node was not '
+              'seen obeying it when the grader changed it (to a value not shown)',
+              'the node was not seen obeying its launch file\'s threshold parameter when the grader changed it '
+              '(to a value not shown)')
+#: How the grader's words name the threshold run (rubric: '<tag> run: ...', 'in the <tag> run ...').
+THRESHOLD_RUN = 'threshold run'
+
+
+def read_setting(path):
+    """The ``show`` value of the setting file ``path``; ValueError naming the file and the value when it
+    is missing or not one of :data:`SHOW`."""
+    parser = configparser.ConfigParser()
+    try:
+        with open(path) as f:
+            parser.read_file(f)
+    except (OSError, configparser.Error) as err:
+        raise ValueError('cannot read the check\'s setting %s: %s' % (path, err))
+    show = parser.get('check', 'show', fallback=None)
+    if show not in SHOW:
+        raise ValueError('%s: [check] show = %s; expected one of %s' % (path, show, ', '.join(SHOW)))
+    return show
+
+
+def _runs_words(evidence):
+    """The ``runs`` item's first line without the threshold run's problems: ``builds (2 s); but: main
+    run: ...; threshold run: ...``, the runs in order, so everything from the first problem of the
+    threshold run on is its own (a probe's log tail included)."""
+    head, _, problems = evidence.partition('; but: ')
+    parts = problems.split('; ') if problems else []
+    cut = [i for i, part in enumerate(parts) if part.startswith(THRESHOLD_RUN)]
+    if not cut:
+        return evidence
+    kept = parts[:cut[0]] + ['a problem in the threshold run (its details are the teacher\'s)']
+    return '%s; but: %s' % (head, '; '.join(kept))
+
+
+def student_evidence(entry, threshold_run):
+    """The first line of an item's evidence as the student may read it."""
+    first = entry['evidence'].split('\n', 1)[0]
+    if not threshold_run:
+        return first
+    if entry['id'] == 'Q14a':
+        if entry['points'] >= entry['max']:
+            return Q14A_WORDS[0]
+        return Q14A_WORDS[1] if entry['points'] > 0 else Q14A_WORDS[2]
+    if entry['id'] == 'runs':
+        return _runs_words(first)
+    return first
+
+
+def lines(record, show, threshold_run):
+    """The lines to print for ``record`` with the setting ``show``.
+
+    :param threshold_run: True when the grader ran the threshold run (its plan is in the logs).
+    """
+    if show not in SHOW:
+        raise ValueError('show = %r; expected one of %s' % (show, ', '.join(SHOW)))
+    rows = [['item', 'points'] + (['evidence'] if show == 'evidence' else [])]
+    for entry in record['items']:
+        row = [entry['id'], '%s / %s' % (_points(entry['points']), _points(entry['max']))]
+        if show == 'evidence':
+            row.append(student_evidence(entry, threshold_run))
+        rows.append(row)
+    rows.append(['total', '%s / %s' % (_points(record['total']), _points(record['max']))] +
+                ([''] if show == 'evidence' else []))
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]) - 1)]
+    out = ['  '.join([cell.ljust(w) for cell, w in zip(r, widths)] + [r[-1]]).rstrip() for r in rows]
+    status = 'status: %s' % record.get('status', '')
+    reason = record.get('status_reason') or ''
+    if show == 'evidence' and reason and not (threshold_run and THRESHOLD_RUN in reason):
+        status += ' - %s' % reason
+    out += ['', status, 'not scored by the machine (the teacher grades them): %s' % NOT_SCORED]
+    return out

@@ -1,0 +1,119 @@
+"""What a box hands back is data root checks: one regular file, capped, never followed, of the record's
+schema (issue 26 point 1). No ROS, no box: the records are written here as a hostile box would."""
+import json
+import os
+
+import pytest
+
+from exam_lab.grader.host import egress
+from exam_lab.grader.score import records
+
+
+def inspect_record(**changes):
+    record = {'uid': 61003, 'refused': None, 'sheet': 'altitude', 'notes': ['sheet altitude given'], 'fixes': [],
+              'static': {'launch_files': ['launch/exam.launch'], 'package': 'exam', 'python2': [],
+                         'params_in_code': ['threshold'], 'threshold_reason': 'threshold = 1300',
+                         'launch': {'file': 'launch/exam.launch', 'starts_drone': True, 'exam_type': 'exam_node.py',
+                                    'exam_name': 'exam', 'package': 'exam', 'comments': 2, 'exam_type_found': True},
+                         'threshold': {'name': '/threshold', 'value': 1300, 'where': 'launch/exam.launch'}},
+              'threshold_value': 1300.0, 'calls_service': True, 'namespace': '/',
+              'main_launch': 'src/exam/launch/.grader-main-exam.launch',
+              'threshold_launch': 'src/exam/launch/.grader-threshold-exam.launch',
+              'handed_in_launch': 'exam/launch/exam.launch',
+              'comments': {'comments': 3, 'code': 40, 'files': ['scripts/exam_node.py']},
+              'facts': {'participant': 1234, 'folder': 'Jane Doe_1234_assignsubmission_file_', 'documents': []}}
+    record.update(changes)
+    return record
+
+
+def write(tmp_path, value, name='inspect.json'):
+    path = tmp_path / name
+    path.write_bytes(value if isinstance(value, bytes) else json.dumps(value).encode())
+    return str(path)
+
+
+def test_a_good_record_is_read(tmp_path):
+    record = egress.read_record(write(tmp_path, inspect_record()), records.InspectRecord)
+    assert record.uid == 61003 and record.threshold_value == 1300.0
+    assert record.static['launch']['exam_type'] == 'exam_node.py'
+    assert record.main_launch == 'src/exam/launch/.grader-main-exam.launch'
+
+
+@pytest.mark.parametrize('change, words', [
+    ({'uid': '0'}, 'uid: an integer expected'),
+    ({'sheet': 'rm -rf'}, 'sheet:'),
+    ({'notes': 'one note'}, 'notes: a list expected'),
+    ({'notes': ['x'] * (records.MAX_ITEMS + 1)}, 'items'),
+    ({'notes': ['x' * (records.MAX_TEXT + 1)]}, 'characters'),
+    ({'threshold_value': True}, 'threshold_value: a number expected'),
+    ({'calls_service': 1}, 'calls_service: true or false'),
+    ({'main_launch': '/etc/shadow'}, 'not a path inside the workspace'),
+    ({'threshold_launch': 'src/../../../root/x.launch'}, 'not a path inside the workspace'),
+    ({'main_launch': None}, 'a threshold run without a main run'),
+    ({'extra': 1}, "unexpected key(s) 'extra'"),
+    ({'facts': {'participant': None, 'folder': 'x'}}, 'documents is missing'),
+])
+def test_a_record_of_an_unexpected_shape_is_refused(tmp_path, change, words):
+    with pytest.raises(records.RecordError) as refused:
+        egress.read_record(write(tmp_path, inspect_record(**change)), records.InspectRecord)
+    assert words in str(refused.value)
+
+
+def test_nested_fields_are_checked_too(tmp_path):
+    record = inspect_record()
+    record['static']['launch']['comments'] = -1
+    with pytest.raises(records.RecordError, match=r'static\.launch\.comments: -1 is outside'):
+        egress.read_record(write(tmp_path, record), records.InspectRecord)
+    del record['static']['launch']
+    with pytest.raises(records.RecordError, match='launch is missing'):
+        egress.read_record(write(tmp_path, record), records.InspectRecord)
+
+
+def test_not_json_and_non_numbers_are_refused(tmp_path):
+    for raw in (b'{"uid": 1', b'\xff\xfe', b'[]', json.dumps(inspect_record()).replace('1300.0', 'NaN').encode()):
+        with pytest.raises(records.RecordError):
+            egress.read_record(write(tmp_path, raw), records.InspectRecord)
+
+
+def test_an_oversized_record_is_refused_unread(tmp_path):
+    path = write(tmp_path, inspect_record(notes=['x' * 1000] * 200))
+    with pytest.raises(records.RecordError, match='bytes \\(at most 100000\\)'):
+        egress.read_record(path, records.InspectRecord, max_bytes=100000)
+
+
+def test_links_fifos_and_missing_files_are_refused(tmp_path):
+    secret = write(tmp_path, inspect_record(), name='root-only.json')
+    os.chmod(secret, 0o600)
+    os.symlink(secret, str(tmp_path / 'inspect.json'))
+    with pytest.raises(records.RecordError, match='a link, not followed'):
+        egress.read_record(str(tmp_path / 'inspect.json'), records.InspectRecord)
+    os.mkfifo(str(tmp_path / 'fifo.json'))
+    with pytest.raises(records.RecordError, match='not a regular file'):  # and never blocks
+        egress.read_record(str(tmp_path / 'fifo.json'), records.InspectRecord)
+    with pytest.raises(records.RecordError, match='missing'):
+        egress.read_record(str(tmp_path / 'none.json'), records.InspectRecord)
+
+
+def test_an_intake_names_only_students_inside_its_folder(tmp_path):
+    good = {'uid': 61000, 'students': [{'name': 'Jane Doe', 'path': 'class/Jane Doe_1_assignsubmission_file_'}]}
+    assert egress.read_record(write(tmp_path, good, 'intake.json'), records.IntakeRecord).students[0]['name'] == \
+        'Jane Doe'
+    for student in ({'name': '../../etc', 'path': 'class/x'}, {'name': 'x/y', 'path': 'class/x'},
+                    {'name': '..', 'path': 'class/x'}, {'name': 'Jane', 'path': '/root'},
+                    {'name': 'Jane', 'path': 'class/../../x'}):
+        with pytest.raises(records.RecordError):
+            egress.read_record(write(tmp_path, dict(good, students=[student]), 'intake.json'), records.IntakeRecord)
+
+
+def test_similarity_html_holds_only_the_highlight(tmp_path):
+    match = {'file_a': 'a.py', 'file_b': 'b.py', 'sim_a': 0.9, 'sim_b': 0.8,
+             'html_a': "x = 1 <span class='highlight-red'>y &lt;= 2</span>", 'html_b': 'z'}
+    good = {'pairs': [{'a': 'A', 'b': 'B', 'score_a': 0.9, 'score_b': 0.8, 'files': [match]}], 'students': 2,
+            'threshold': 0.5, 'detector': 'copydetect 0.5.0', 'scores': [['A', 'B', 0.9, 0.8]], 'notes': []}
+    read = egress.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
+    assert read.value['pairs'][0]['files'][0]['html_a'] == match['html_a']
+    match['html_b'] = '<script>alert(1)</script>'
+    with pytest.raises(records.RecordError, match='markup other than'):
+        egress.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
+    assert egress.read_record(write(tmp_path, {'error': 'no venv', 'notes': []}, 'similarity.json'),
+                              records.SimilarityRecord).value == {'error': 'no venv', 'notes': []}
