@@ -172,3 +172,4 @@ def test_a_badly_filled_hand_csv_stops_the_worksheet_with_every_problem(tmp_path
     err = capsys.readouterr().err
     assert "column Q5: 'two'" in err and "column comments: '9'" in err
     assert not (out / 'ws-whole.csv').exists()
+

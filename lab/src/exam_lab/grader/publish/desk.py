@@ -99,6 +99,13 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         else:
             lines.append('similarity: %d pair(s) flagged of %d student(s) (%s)'
                          % (len(pairs), similar.get('students', 0), os.path.join(out, 'index.html#similarity')))
+    kept = os.path.join(out, 'page.json')  # the class's name, for a page made again (make rescore)
+    if title:
+        with open(kept, 'w') as f:
+            json.dump({'title': title}, f)
+    elif os.path.isfile(kept):
+        with open(kept) as f:
+            title = json.load(f).get('title')
     title = 'Exam grades: %s' % (records[0]['student'] if single and records else title or os.path.basename(out))
     try:
         content = page.render(records, title, entries, pairs, notes)
