@@ -343,7 +343,8 @@ def _how_run(box):
     if box.bwrap:
         return ('ran in a bubblewrap sandbox as uid %d: its own user, PID, mount, IPC and UTS namespaces, '
                 'a clean environment, only its workspace writable; limited in memory, processes, CPU time '
-                'and file size' % box.uid)
+                'and file size%s; the master and the probe ran as the judge\'s uid %d, not root'
+                % (box.uid, ', %g core(s) of CPU' % box.cpus if box.cpus and box.cgroups else '', box.judge_uid))
     if box.slot is not None:
         return 'ran WITHOUT its sandbox (the teacher\'s flag) as uid %d, with resource limits only' % box.uid
     try:
