@@ -22,6 +22,7 @@ import argparse
 import datetime
 import json
 import os
+import resource
 import shutil
 import sys
 import tempfile
@@ -71,11 +72,18 @@ def timings(out_dir, student):
     return result
 
 
+def children_cpu():
+    """CPU seconds (user + system) of every process this one has waited for, its descendants' too: a
+    grading's boxes, judges and tools all end before it returns, so the difference around it is its CPU."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def grade(folder, out, jobs):
-    start = time.monotonic()
+    """Grade the class in ``folder``: ``(wall s, CPU s of the whole class, {student: record})``."""
+    start, cpu = time.monotonic(), children_cpu()
     records = runner.grade_class(folder, out, jobs=jobs)
-    wall = time.monotonic() - start
-    return wall, {r['student']: r for r in records}
+    return time.monotonic() - start, children_cpu() - cpu, {r['student']: r for r in records}
 
 
 def points(record):
@@ -104,24 +112,24 @@ def main(argv=None):
     alone_dir = os.path.join(out, 'alone-class')
     os.makedirs(alone_dir)
     alone_students = make_class(alone_dir, len(kinds), kinds)
-    wall, records = grade(alone_dir, os.path.join(out, 'alone'), 1)
+    wall, cpu, records = grade(alone_dir, os.path.join(out, 'alone'), 1)
     for student, kind in alone_students.items():
         results['alone'][kind] = {'points': points(records[student]), 'seconds': records[student]['seconds'],
                                   'timing': timings(os.path.join(out, 'alone'), student)}
-    results['alone_wall'] = wall
+    results['alone_wall'], results['alone_cpu'] = wall, cpu
 
     for jobs in [int(j) for j in args.jobs.split(',')]:
         folder = os.path.join(out, 'class-%d' % jobs)
         os.makedirs(folder)
         students = make_class(folder, args.students, kinds)
-        wall, records = grade(folder, os.path.join(out, 'graded-%d' % jobs), jobs)
+        wall, cpu, records = grade(folder, os.path.join(out, 'graded-%d' % jobs), jobs)
         rows = []
         for student, kind in sorted(students.items()):
             rows.append({'student': student, 'kind': kind, 'points': points(records[student]),
                          'same_points': points(records[student]) == results['alone'][kind]['points'],
                          'seconds': records[student]['seconds'],
                          'timing': timings(os.path.join(out, 'graded-%d' % jobs), student)})
-        results['classes'].append({'jobs': jobs, 'students': args.students, 'wall': wall, 'rows': rows})
+        results['classes'].append({'jobs': jobs, 'students': args.students, 'wall': wall, 'cpu': cpu, 'rows': rows})
         print('JOBS=%d: %d students in %.0f s' % (jobs, args.students, wall), file=sys.stderr)
 
     results['load_end'] = list(os.getloadavg())
@@ -149,18 +157,19 @@ def render(results):
     """The "The grader" section of docs/benchmarks.md."""
     alone = results['alone']
     one = [v['seconds'] for v in alone.values()]
-    rows = ['| graded | wall time | per student | same points as alone | rate [Hz] | WARNING after [s] | '
-            'NORMAL after [s] |', '|---|---|---|---|---|---|---|']
-    rows.append('| each of %d packages alone (JOBS=1) | %.0f s | %.0f-%.0f s | (reference) | %s | %s | %s |' % (
-        len(alone), results['alone_wall'], min(one), max(one),
+    rows = ['| graded | wall time | per student | CPU per student | same points as alone | rate [Hz] | '
+            'WARNING after [s] | NORMAL after [s] |', '|---|---|---|---|---|---|---|---|']
+    rows.append('| each of %d packages alone (JOBS=1) | %.0f s | %.0f-%.0f s | %s | (reference) | %s | %s | %s |' % (
+        len(alone), results['alone_wall'], min(one), max(one), _cpu(results.get('alone_cpu'), len(alone)),
         _spread([v['timing']['hz'] for v in alone.values()]),
         _spread([v['timing']['warning_s'] for k, v in alone.items() if k != 'no_delay']),
         _spread([v['timing']['normal_s'] for v in alone.values()])))
     for klass in results['classes']:
         graded = klass['rows']
-        rows.append('| class of %d, JOBS=%d | %.0f s | %.0f-%.0f s | %d of %d | %s | %s | %s |' % (
+        rows.append('| class of %d, JOBS=%d | %.0f s | %.0f-%.0f s | %s | %d of %d | %s | %s | %s |' % (
             klass['students'], klass['jobs'], klass['wall'], min(r['seconds'] for r in graded),
-            max(r['seconds'] for r in graded), len([r for r in graded if r['same_points']]), len(graded),
+            max(r['seconds'] for r in graded), _cpu(klass.get('cpu'), len(graded)),
+            len([r for r in graded if r['same_points']]), len(graded),
             _spread([r['timing']['hz'] for r in graded]),
             _spread([r['timing']['warning_s'] for r in graded if r['kind'] != 'no_delay']),
             _spread([r['timing']['normal_s'] for r in graded])))
@@ -200,6 +209,12 @@ def render(results):
         'for; a run\'s timing only suffers if a build starves a 10 Hz loop for more than 0.2 s, which did not '
         'happen at JOBS=3 either. JOBS=2 is the default; JOBS=3 is a third faster here.', '',
         '| package | points alone | wall time alone |', '|---|---|---|'] + kinds)
+
+
+def _cpu(seconds, students):
+    """The mean CPU of one student's grading (its box, its judge, the grader's own work), or '-' for a
+    run recorded before it was measured."""
+    return '-' if seconds is None else '%.0f s' % (seconds / max(students, 1))
 
 
 def _total(points):
