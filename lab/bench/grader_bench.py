@@ -177,6 +177,8 @@ def render(results):
         '%s %s instead of %s' % (item, r['points'][item], alone[r['kind']]['points'][item])
         for item in sorted(r['points']) if r['points'][item] != alone[r['kind']]['points'][item]))
         for k in results['classes'] for r in k['rows'] if not r['same_points']]
+    largest = max([abs(sum(r['points'].values()) - sum(alone[r['kind']]['points'].values()))
+                   for k in results['classes'] for r in k['rows']] or [0.0])
     kinds = ['| %s | %s | %.0f s |' % (kind, _total(v['points']), v['seconds']) for kind, v in sorted(alone.items())]
     when = results.get('date', '?')
     load = ''
@@ -200,7 +202,8 @@ def render(results):
         + rows + ['',
         'Goals: one submission in at most 90 s, a class of 20 in at most 10 minutes. %s' % (
             'Every student got the points of its package alone.' if not differ else
-            'Points that differed: %s.' % '; '.join(differ)), '',
+            'Points that differed: %s. The largest difference of a total: %s point(s).' % (
+                '; '.join(differ), _total({'': largest}))), '',
         'Why side by side stays fair: each student has a master, a network namespace and processes of its own, '
         'so the only thing shared is the CPU, and the rubric\'s timings need little of it. The spreads above '
         'are those of a correct 10 Hz node whatever the load: the WARNING comes between the first tick after '
