@@ -8,7 +8,7 @@ ENV := source tools/env.sh
 # `make test TESTS=run_tests_exam` runs one catkin test target instead of all of them.
 TESTS ?= run_tests
 
-.PHONY: help deps build run run-submarine run-simple test report bench soak mutation grade check clean
+.PHONY: help deps build run run-submarine run-simple test report bench soak mutation grade rescore worksheet check clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
@@ -22,6 +22,9 @@ help:
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
 	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv> [WORKSHEET_SCALE=1]] [ENGINE=local|slurm] [SLURM_ARGS='...']"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
+	@echo "make rescore OUT=<dir> [WORKSHEET=...]  today's rubric on a run's kept measurements (seconds, no ROS)"
+	@echo "make worksheet OUT=<dir> WORKSHEET=<Moodle grading worksheet.csv>"
+	@echo "                    the whole grade (machine + OUT/hand.csv) into the worksheet, on its scale"
 	@echo "make check PACKAGE=<dir|zip> [SHEET=altitude|depth]"
 	@echo "                    a student's own check of their package, as an ordinary user (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
@@ -68,6 +71,16 @@ grade: build
 	  $(if $(SHEET),--sheet "$(SHEET)") $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)") \
 	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") $(if $(WORKSHEET_SCALE),--worksheet-scale) \
 	  $(if $(ENGINE),--engine "$(ENGINE)") $(if $(SLURM_ARGS),--slurm-args "$(SLURM_ARGS)")
+
+# make rescore OUT=<make grade's OUT> [WORKSHEET=...]: today's rubric on the measurements the run kept
+rescore: build
+	@$(ENV) && exec python3 lab/scripts/rescore.py --out "$(OUT)" $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") \
+	  $(if $(WORKSHEET_SCALE),--worksheet-scale)
+
+# make worksheet OUT=<make grade's OUT> WORKSHEET=<Moodle's worksheet>: the machine's and the hand points
+# (OUT/hand.csv, filled by the teacher) as one grade on the worksheet's scale
+worksheet: build
+	@$(ENV) && exec python3 lab/scripts/worksheet.py --out "$(OUT)" --worksheet "$(WORKSHEET)"
 
 # make check PACKAGE=<dir or zip> [SHEET=altitude|depth]: a student's own check, without root or sudo.
 # It builds the workspace but installs nothing: a student's machine has ROS already, not the teacher's tools.

@@ -22,6 +22,7 @@ import argparse
 import datetime
 import json
 import os
+import resource
 import shutil
 import sys
 import tempfile
@@ -71,11 +72,18 @@ def timings(out_dir, student):
     return result
 
 
+def children_cpu():
+    """CPU seconds (user + system) of every process this one has waited for, its descendants' too: a
+    grading's boxes, judges and tools all end before it returns, so the difference around it is its CPU."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def grade(folder, out, jobs):
-    start = time.monotonic()
+    """Grade the class in ``folder``: ``(wall s, CPU s of the whole class, {student: record})``."""
+    start, cpu = time.monotonic(), children_cpu()
     records = runner.grade_class(folder, out, jobs=jobs)
-    wall = time.monotonic() - start
-    return wall, {r['student']: r for r in records}
+    return time.monotonic() - start, children_cpu() - cpu, {r['student']: r for r in records}
 
 
 def points(record):
@@ -104,24 +112,24 @@ def main(argv=None):
     alone_dir = os.path.join(out, 'alone-class')
     os.makedirs(alone_dir)
     alone_students = make_class(alone_dir, len(kinds), kinds)
-    wall, records = grade(alone_dir, os.path.join(out, 'alone'), 1)
+    wall, cpu, records = grade(alone_dir, os.path.join(out, 'alone'), 1)
     for student, kind in alone_students.items():
         results['alone'][kind] = {'points': points(records[student]), 'seconds': records[student]['seconds'],
                                   'timing': timings(os.path.join(out, 'alone'), student)}
-    results['alone_wall'] = wall
+    results['alone_wall'], results['alone_cpu'] = wall, cpu
 
     for jobs in [int(j) for j in args.jobs.split(',')]:
         folder = os.path.join(out, 'class-%d' % jobs)
         os.makedirs(folder)
         students = make_class(folder, args.students, kinds)
-        wall, records = grade(folder, os.path.join(out, 'graded-%d' % jobs), jobs)
+        wall, cpu, records = grade(folder, os.path.join(out, 'graded-%d' % jobs), jobs)
         rows = []
         for student, kind in sorted(students.items()):
             rows.append({'student': student, 'kind': kind, 'points': points(records[student]),
                          'same_points': points(records[student]) == results['alone'][kind]['points'],
                          'seconds': records[student]['seconds'],
                          'timing': timings(os.path.join(out, 'graded-%d' % jobs), student)})
-        results['classes'].append({'jobs': jobs, 'students': args.students, 'wall': wall, 'rows': rows})
+        results['classes'].append({'jobs': jobs, 'students': args.students, 'wall': wall, 'cpu': cpu, 'rows': rows})
         print('JOBS=%d: %d students in %.0f s' % (jobs, args.students, wall), file=sys.stderr)
 
     results['load_end'] = list(os.getloadavg())
@@ -149,18 +157,19 @@ def render(results):
     """The "The grader" section of docs/benchmarks.md."""
     alone = results['alone']
     one = [v['seconds'] for v in alone.values()]
-    rows = ['| graded | wall time | per student | same points as alone | rate [Hz] | WARNING after [s] | '
-            'NORMAL after [s] |', '|---|---|---|---|---|---|---|']
-    rows.append('| each of %d packages alone (JOBS=1) | %.0f s | %.0f-%.0f s | (reference) | %s | %s | %s |' % (
-        len(alone), results['alone_wall'], min(one), max(one),
+    rows = ['| graded | wall time | per student | CPU per student | same points as alone | rate [Hz] | '
+            'WARNING after [s] | NORMAL after [s] |', '|---|---|---|---|---|---|---|---|']
+    rows.append('| each of %d packages alone (JOBS=1) | %.0f s | %.0f-%.0f s | %s | (reference) | %s | %s | %s |' % (
+        len(alone), results['alone_wall'], min(one), max(one), _cpu(results.get('alone_cpu'), len(alone)),
         _spread([v['timing']['hz'] for v in alone.values()]),
         _spread([v['timing']['warning_s'] for k, v in alone.items() if k != 'no_delay']),
         _spread([v['timing']['normal_s'] for v in alone.values()])))
     for klass in results['classes']:
         graded = klass['rows']
-        rows.append('| class of %d, JOBS=%d | %.0f s | %.0f-%.0f s | %d of %d | %s | %s | %s |' % (
+        rows.append('| class of %d, JOBS=%d | %.0f s | %.0f-%.0f s | %s | %d of %d | %s | %s | %s |' % (
             klass['students'], klass['jobs'], klass['wall'], min(r['seconds'] for r in graded),
-            max(r['seconds'] for r in graded), len([r for r in graded if r['same_points']]), len(graded),
+            max(r['seconds'] for r in graded), _cpu(klass.get('cpu'), len(graded)),
+            len([r for r in graded if r['same_points']]), len(graded),
             _spread([r['timing']['hz'] for r in graded]),
             _spread([r['timing']['warning_s'] for r in graded if r['kind'] != 'no_delay']),
             _spread([r['timing']['normal_s'] for r in graded])))
@@ -168,6 +177,8 @@ def render(results):
         '%s %s instead of %s' % (item, r['points'][item], alone[r['kind']]['points'][item])
         for item in sorted(r['points']) if r['points'][item] != alone[r['kind']]['points'][item]))
         for k in results['classes'] for r in k['rows'] if not r['same_points']]
+    largest = max([abs(sum(r['points'].values()) - sum(alone[r['kind']]['points'].values()))
+                   for k in results['classes'] for r in k['rows']] or [0.0])
     kinds = ['| %s | %s | %.0f s |' % (kind, _total(v['points']), v['seconds']) for kind, v in sorted(alone.items())]
     when = results.get('date', '?')
     load = ''
@@ -191,7 +202,8 @@ def render(results):
         + rows + ['',
         'Goals: one submission in at most 90 s, a class of 20 in at most 10 minutes. %s' % (
             'Every student got the points of its package alone.' if not differ else
-            'Points that differed: %s.' % '; '.join(differ)), '',
+            'Points that differed: %s. The largest difference of a total: %s point(s).' % (
+                '; '.join(differ), _total({'': largest}))), '',
         'Why side by side stays fair: each student has a master, a network namespace and processes of its own, '
         'so the only thing shared is the CPU, and the rubric\'s timings need little of it. The spreads above '
         'are those of a correct 10 Hz node whatever the load: the WARNING comes between the first tick after '
@@ -200,6 +212,12 @@ def render(results):
         'for; a run\'s timing only suffers if a build starves a 10 Hz loop for more than 0.2 s, which did not '
         'happen at JOBS=3 either. JOBS=2 is the default; JOBS=3 is a third faster here.', '',
         '| package | points alone | wall time alone |', '|---|---|---|'] + kinds)
+
+
+def _cpu(seconds, students):
+    """The mean CPU of one student's grading (its box, its judge, the grader's own work), or '-' for a
+    run recorded before it was measured."""
+    return '-' if seconds is None else '%.0f s' % (seconds / max(students, 1))
 
 
 def _total(points):

@@ -283,3 +283,33 @@ def test_our_node_on_the_depth_sheet(tmp_path):
     record = runner.grade_submission(OUR_EXAM, str(tmp_path / 'depth'), sheet='depth')
     got = {i['id']: i['points'] for i in record['items']}
     assert got == FULL, '\n'.join(i['evidence'] for i in record['items'])
+
+
+def test_rescoring_the_class_from_its_measurements_moves_nothing_and_a_rubric_change_moves_only_its_item(
+        graded, monkeypatch):
+    """make rescore on the class just graded: today's rubric on the measurements kept, no run again
+    (seconds); then a tighter 14b window, as a rubric correction would: only Q14b moves."""
+    import time
+    from exam_lab.grader.score import rubric
+    out, records = graded
+    started = time.monotonic()
+    again, changes = runner.rescore(str(out))
+    assert time.monotonic() - started < 30.0
+    assert changes == []
+    by_name = {r['student']: r for r in again}
+    assert set(by_name) == set(records)
+    for name, record in records.items():
+        assert [(i['id'], i['points']) for i in by_name[name]['items']] == \
+            [(i['id'], i['points']) for i in record['items']], name
+        assert by_name[name]['provenance']['how'] == 'rescore' and by_name[name]['previous']['total'] == record['total']
+    monkeypatch.setattr(rubric, 'WARNING_LATE_S', -0.5)  # WARNING due before the delay: nobody's on time
+    again, changes = runner.rescore(str(out))
+    moved = [line for line in changes if 'Q14b' in line]
+    assert moved and all('Q14b' in line for line in changes), changes
+    for line in changes:
+        items = line.split('(', 1)[1]
+        assert all(part.split()[0] in ('Q14b', 'status') for part in items.rstrip(')').split('; ')), line
+    with open(os.path.join(str(out), 'grades.csv')) as f:
+        assert any(row.startswith('good_student') for row in f)
+    monkeypatch.undo()
+    runner.rescore(str(out))  # leave the class as graded, for the tests after this one

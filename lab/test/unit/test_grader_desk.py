@@ -12,7 +12,7 @@ import pytest
 
 from exam_lab.grader.boxed import documents
 
-from exam_lab.grader.publish import desk, flightplot, gradescope, page, progress, report
+from exam_lab.grader.publish import desk, flightplot, gradescope, hand, page, progress, report
 from exam_lab.grader.score.sheets import ITEMS
 
 T0 = 1000.0
@@ -171,6 +171,9 @@ def test_finish_writes_the_desk_for_a_class(tmp_path):
         got = parsed(f.read())
     assert got.images == ['Jane Doe/flight.png', 'Paul/flight.png']
     assert os.path.isfile(os.path.join(out, 'ws-filled.csv'))
+    # hand.csv beside grades.csv, one empty row per student for the teacher's 13 points.
+    assert any(l.startswith('hand points: %s' % os.path.join(out, 'hand.csv')) for l in lines)
+    assert sorted(hand.read(os.path.join(out, 'hand.csv'))) == ['Jane Doe', 'Paul']
 
 
 def test_pdf_pages(tmp_path):

@@ -44,7 +44,7 @@ from exam_lab.grader.host.sandbox import BOX_WS
 
 from exam_lab.grader.score import records, rubric
 
-from exam_lab.grader.publish import moodle, progress, report
+from exam_lab.grader.publish import moodle, progress, provenance, report
 from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, SHEETS, margin_of
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
@@ -343,7 +343,8 @@ def _how_run(box):
     if box.bwrap:
         return ('ran in a bubblewrap sandbox as uid %d: its own user, PID, mount, IPC and UTS namespaces, '
                 'a clean environment, only its workspace writable; limited in memory, processes, CPU time '
-                'and file size' % box.uid)
+                'and file size%s; the master and the probe ran as the judge\'s uid %d, not root'
+                % (box.uid, ', %g core(s) of CPU' % box.cpus if box.cpus and box.cgroups else '', box.judge_uid))
     if box.slot is not None:
         return 'ran WITHOUT its sandbox (the teacher\'s flag) as uid %d, with resource limits only' % box.uid
     try:
@@ -371,12 +372,73 @@ def _box_binds(underlay):
                       if os.path.islink(os.path.join(sources, name))]
 
 
+#: What a run measured, kept beside grade.json: all the rubric reads, so a grade can be made again
+#: from it with today's rubric (:func:`rescore`) without running the package again.
+MEASUREMENTS = 'measurements.json'
+
+
+def score(measured, how='run'):
+    """The grade record of one submission from what its run measured (:data:`MEASUREMENTS`): the one
+    place the rubric is applied, by a run and by a rescore alike. ``how`` goes into its provenance."""
+    static, session = measured['static'], measured['session']
+    extra = dict(measured['extra'], doubts=rubric.doubts(static, session), provenance=provenance.stamp(how))
+    return report.grade_record(measured['student'], measured['sheet'], rubric.score(measured['sheet'], static, session),
+                               hints(static, session, measured['notes'] + measured['fixes'], measured['comments'],
+                                     measured['isolate'], measured['how_run']),
+                               extra, rubric.status(static, session, measured['fixes']))
+
+
+def graded_folders(out):
+    """The folders of a run's OUT holding a grade made from measurements: OUT itself for one
+    submission, else one per student (in the order of their names)."""
+    if os.path.isfile(os.path.join(out, MEASUREMENTS)):
+        return [out]
+    return sorted(os.path.join(out, name) for name in os.listdir(out)
+                  if os.path.isfile(os.path.join(out, name, MEASUREMENTS)))
+
+
+def rescore(out):
+    """Apply today's rubric to the measurements a run kept in ``out``: no ROS, no box, seconds for a
+    class. Each grade.json/grade.md is written again, with the points it had (``previous``); a class's
+    grades.csv too.
+
+    :returns: ``(records, changes)``; ``changes``: one line per student whose points or status moved,
+        saying which items moved and from what to what.
+    """
+    records, changes = [], []
+    folders = graded_folders(out)
+    for folder in folders:
+        with open(os.path.join(folder, MEASUREMENTS)) as f:
+            measured = json.load(f)
+        old = {}
+        if os.path.isfile(os.path.join(folder, 'grade.json')):
+            with open(os.path.join(folder, 'grade.json')) as f:
+                old = json.load(f)
+        record = score(measured, how='rescore')
+        before = {i['id']: i['points'] for i in old.get('items', [])}
+        record['previous'] = {'total': old.get('total'), 'status': old.get('status'), 'items': before,
+                              'provenance': old.get('provenance')}
+        moved = ['%s %s -> %s' % (i['id'], report.points_text(before.get(i['id'])), report.points_text(i['points']))
+                 for i in record['items'] if before.get(i['id']) != i['points']]
+        if old.get('status') != record['status']:
+            moved.append('status %s -> %s' % (old.get('status'), record['status']))
+        if moved:
+            changes.append('%s: %s -> %s (%s)' % (record['student'], report.points_text(old.get('total')),
+                                                 report.points_text(record['total']), '; '.join(moved)))
+        report.write_grade(folder, record)
+        records.append(record)
+    if folders and folders != [out]:
+        report.write_csv(os.path.join(out, 'grades.csv'), records)
+    return records, changes
+
+
 def could_not_grade(student, sheet, why, notes=()):
     """The record of a submission the grader could not grade: every item 0, and why."""
     sheet = sheet or 'altitude'
     session = {'build': None, 'runs': [], 'error': 'could not grade: %s' % why}
     return report.grade_record(student, sheet, rubric.score(sheet, {}, session),
-                               list(notes) + [session['error']], {'seconds': 0.0}, rubric.status({}, session))
+                               list(notes) + [session['error']], {'seconds': 0.0, 'provenance': provenance.stamp()},
+                               rubric.status({}, session))
 
 
 def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False,
@@ -437,19 +499,18 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
             session = {'build': None, 'runs': [], 'error': 'the grader failed on this submission: %r' % err}
             notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
-        chosen_sheet = chosen_sheet or 'altitude'
-        items = rubric.score(chosen_sheet, static, session)
         logs = os.path.join(out_dir, 'logs')
         shutil.rmtree(logs, ignore_errors=True)
         if os.path.isdir(os.path.join(work, 'logs')):
             skipped = sandbox.copy_results(os.path.join(work, 'logs'), logs)
             if skipped:
                 notes.append('not copied to logs/ (not a regular file): %s' % ', '.join(skipped))
-        record = report.grade_record(student, chosen_sheet, items,
-                                     hints(static, session, notes + fixes, comments, isolate, how_run),
-                                     dict(facts, **dict(extra or {}, seconds=round(time.monotonic() - start, 1),
-                                                        doubts=rubric.doubts(static, session))),
-                                     rubric.status(static, session, fixes))
+        measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session,
+                    'notes': notes, 'fixes': fixes, 'comments': comments, 'isolate': isolate, 'how_run': how_run,
+                    'extra': dict(facts, **dict(extra or {}, seconds=round(time.monotonic() - start, 1)))}
+        with open(os.path.join(out_dir, MEASUREMENTS), 'w') as f:
+            json.dump(measured, f, indent=1, sort_keys=True)
+        record = score(measured)
         report.write_grade(out_dir, record)
         return record
     finally:

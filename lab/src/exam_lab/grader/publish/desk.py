@@ -13,7 +13,7 @@ import html
 import json
 import os
 
-from exam_lab.grader.publish import flightplot, gradescope, moodle, page
+from exam_lab.grader.publish import flightplot, gradescope, hand, moodle, page
 from exam_lab.grader.score import safe_text
 
 
@@ -69,6 +69,13 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
     for record in records:
         entry = entries[record['student']] = _student(out, record, single)
         lines += ['%s: %s' % (record['student'], problem) for problem in entry['problems']]
+    try:
+        added = hand.write(os.path.join(out, hand.FILE), records)
+        lines.append('hand points: %s (%d new row(s)): fill in the %d points the machine does not judge, '
+                     'then make worksheet OUT=%s WORKSHEET=<Moodle worksheet>' % (
+                         os.path.join(out, hand.FILE), added, hand.HAND_MAX, out))
+    except (hand.HandError, OSError) as err:  # the teacher's file as it is: never overwritten blindly
+        lines.append('hand.csv NOT written: %s' % err)
     if worksheet:
         base = os.path.splitext(os.path.basename(worksheet))[0]
         target = os.path.join(out, '%s-filled.csv' % base)
@@ -92,6 +99,13 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         else:
             lines.append('similarity: %d pair(s) flagged of %d student(s) (%s)'
                          % (len(pairs), similar.get('students', 0), os.path.join(out, 'index.html#similarity')))
+    kept = os.path.join(out, 'page.json')  # the class's name, for a page made again (make rescore)
+    if title:
+        with open(kept, 'w') as f:
+            json.dump({'title': title}, f)
+    elif os.path.isfile(kept):
+        with open(kept) as f:
+            title = json.load(f).get('title')
     title = 'Exam grades: %s' % (records[0]['student'] if single and records else title or os.path.basename(out))
     try:
         content = page.render(records, title, entries, pairs, notes)

@@ -177,13 +177,25 @@ def feedback(record, maximum=None, scaled=None):
     lines = []
     for entry in record['items']:
         line = '%s %s/%s' % (entry['id'], _points(entry['points']), _points(entry['max']))
-        if entry['points'] < entry['max'] and entry.get('evidence'):
+        if entry.get('by') == 'hand':
+            line += ' (by hand)' if entry['id'] not in record.get('missing', ()) else ': not given yet'
+        elif entry['points'] < entry['max'] and entry.get('evidence'):
             why = safe_text.clean(entry['evidence']).split('\n', 1)[0]
             line += ': ' + (why if len(why) <= 200 else why[:197] + '...')
         lines.append(line)
-    head = ('Machine-graded by running the package: %s / %s points (%s). Not scored by the machine: '
-            'comments, code quality and the report.' % (_points(record['total']), _points(record['max']),
-                                                        ', '.join(ITEMS)))
+    if 'machine_total' in record:  # the whole grade (exam_lab.grader.publish.hand.combine)
+        head = ('%s / %s points: %s of %s by the machine, running the package (%s), and %s of %s by the '
+                'teacher (the report\'s questions, comments, code quality).' % (
+                    _points(record['total']), _points(record['max']), _points(record['machine_total']),
+                    _points(sum(e['max'] for e in record['items'] if e.get('by') != 'hand')), ', '.join(ITEMS),
+                    _points(record['total'] - record['machine_total']),
+                    _points(sum(e['max'] for e in record['items'] if e.get('by') == 'hand'))))
+        if record.get('remark'):
+            head += ' ' + safe_text.one_line(record['remark'])
+    else:
+        head = ('Machine-graded by running the package: %s / %s points (%s). Not scored by the machine: '
+                'comments, code quality and the report.' % (_points(record['total']), _points(record['max']),
+                                                            ', '.join(ITEMS)))
     if maximum is not None and abs(maximum - record['max']) > 1e-9:
         head += (' The grade is these points scaled to %s (x %s/%s).' % (_points(maximum), _points(maximum),
                                                                         _points(record['max']))
@@ -250,6 +262,9 @@ def fill(text, records, scale=False):
         if status not in GRADED:
             summary['kept'].append((student, 'status "%s": %s' % (status, record.get('status_reason', ''))))
             continue
+        if record.get('missing'):
+            summary['kept'].append((student, 'hand points not given yet in hand.csv: %s' % ', '.join(record['missing'])))
+            continue
         if fields[grade][1].strip() or fields[comments][1].strip():
             summary['kept'].append((student, 'the worksheet already has a grade or a feedback for it'))
             continue
@@ -309,8 +324,8 @@ def summary_lines(summary, target):
         if abs(top - machine[0]) < 1e-9:
             continue
         if summary.get('scaled'):
-            lines.append('  SCALED: the worksheet\'s maximum grade is %s: each grade written is the machine\'s '
-                         'points x %s/%s' % (_points(top), _points(top), _points(machine[0])))
+            lines.append('  SCALED: the worksheet\'s maximum grade is %s: each grade written is the points out of '
+                         '%s x %s/%s' % (_points(top), _points(machine[0]), _points(top), _points(machine[0])))
         else:
             lines.append('  NOT SCALED: the worksheet\'s maximum grade is %s, the grades written are the machine\'s '
                          'points out of %s (comments, code quality and the report are yours to add); '

@@ -21,6 +21,11 @@ def _points(x):
     return ('%.1f' % x).rstrip('0').rstrip('.')
 
 
+def points_text(x):
+    """Points as the teacher reads them (``15.5``, ``17``); ``-`` for none."""
+    return '-' if x is None else _points(x)
+
+
 def grade_record(student, sheet, items, for_the_teacher, extra=None, status=('graded', '')):
     """The content of grade.json; ``status`` is ``(status, reason)`` (see :func:`rubric.status`)."""
     record = {'student': student, 'sheet': sheet, 'total': sum(i['points'] for i in items),
@@ -65,6 +70,15 @@ def markdown(record):
     details = [e for e in record['items'] if '\n' in e['evidence']]
     for entry in details:
         lines += ['', '### %s: details' % entry['id'], '', '```', entry['evidence'].split('\n', 1)[1], '```']
+    made = record.get('provenance')
+    if made:
+        lines += ['', '%s by the grader %s, rubric %s, on %s, %s.' % (
+            'Rescored' if made.get('how') == 'rescore' else 'Graded', made.get('grader'), made.get('rubric'),
+            made.get('machine'), made.get('date'))]
+        previous = record.get('previous')
+        if previous and previous.get('total') is not None and previous.get('total') != record['total']:
+            lines[-1] += ' Before: %s / %s (%s).' % (_points(previous['total']), _points(record['max']),
+                                                   previous.get('status'))
     lines += ['', '## For the teacher', '']
     lines += ['- %s' % hint.replace('\n', ' ') for hint in record['for_the_teacher']]
     return '\n'.join(lines) + '\n'

@@ -35,6 +35,19 @@ ITEMS = collections.OrderedDict([
     ('Q14b', (3.0, 'WARNING after 5 s beyond the threshold, not for less, NORMAL at once')),
 ])
 
+#: What the machine does not judge, scored by the teacher by hand (sheet 000's notes, for both sheets):
+#: the report's questions 4-9, the comments and the code quality. With ITEMS: 17 + 13 = 30 points.
+HAND_ITEMS = collections.OrderedDict([
+    ('Q4', (1.0, 'report: the running nodes listed (half without a comment)')),
+    ('Q5', (2.0, 'report: the drone node\'s information, each line explained (1 if lines are not)')),
+    ('Q6', (1.0, 'report: the topics listed and /rosout\'s role explained (0 without it)')),
+    ('Q7', (1.0, 'report: the message type of the first input topic (half without a comment)')),
+    ('Q8', (1.0, 'report: a few messages and their rate (0.5 if the command is right, the rate wrong)')),
+    ('Q9', (1.0, 'report: the package created and explained (0 if nothing is explained)')),
+    ('comments', (4.0, 'the code is commented throughout, clearly (half if few, 0 if clearly not enough)')),
+    ('quality', (2.0, 'code quality: algorithmically well written, following good practice')),
+])
+
 
 #: The requests the sheets name for the warning service (the drone refuses any other string).
 REQUESTS = ('WARNING', 'NORMAL')

@@ -1,0 +1,52 @@
+#!/usr/bin/env python3
+"""Grade a class again with today's rubric, from the measurements its run kept: nothing is run again.
+
+    rescore.py --out OUT [--worksheet WORKSHEET.csv [--worksheet-scale]]     (make rescore OUT=...)
+
+For each student of OUT (or the one submission graded there), the rubric is applied to the
+measurements.json that ``make grade`` kept beside its grade.json; grade.json (with the points it had,
+``previous``, and its provenance), grade.md, grades.csv, the page, results.json and hand.csv (the
+teacher's points kept) are written again, and each student whose points or status moved is printed
+with the items that moved. No ROS, no sandbox, no root. A change of the rubric that needs measurements
+the run did not make (a new flight, another input) needs make grade again (docs/grading.md).
+"""
+import argparse
+import json
+import os
+import sys
+
+from exam_lab.grader import runner
+from exam_lab.grader.publish import desk, report
+from exam_lab.grader.score import safe_text
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--out', required=True, help='the folder make grade wrote')
+    parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV) to fill again")
+    parser.add_argument('--worksheet-scale', action='store_true', help="scale to the worksheet's maximum grade")
+    args = parser.parse_args(argv)
+    out = os.path.abspath(args.out)
+    if not os.path.isdir(out) or not runner.graded_folders(out):
+        print('rescore: no measurements.json in %s (graded before measurements were kept? run make grade '
+              'again)' % out, file=sys.stderr)
+        return 1
+    records, changes = runner.rescore(out)
+    print(report.table(records))
+    print('%d of %d student(s) changed:' % (len(changes), len(records)) if changes else
+          'no point changed for any of the %d student(s)' % len(records))
+    for line in changes:
+        print('  ' + safe_text.one_line(line))
+    single = runner.graded_folders(out) == [out]
+    similar = None
+    if not single and os.path.isfile(os.path.join(out, 'similarity.json')):
+        with open(os.path.join(out, 'similarity.json')) as f:
+            similar = json.load(f)
+    for line in desk.finish(out, records, single=single, similar=similar, worksheet=args.worksheet,
+                            scale=args.worksheet_scale):
+        print(line)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""The whole grade into Moodle's worksheet: the machine's points (OUT's grade.json files) and the
+teacher's hand points (OUT/hand.csv), on the worksheet's own scale (docs/grading.md).
+
+    worksheet.py --out OUT --worksheet WORKSHEET.csv     (make worksheet OUT=... WORKSHEET=...)
+
+Writes OUT/<worksheet>-whole.csv, each grade out of the worksheet's maximum grade (30 points scaled),
+each feedback comment listing every item, the machine's and the teacher's. A student whose hand
+points are not all given, or whose status waits for the teacher, is left as it was and listed. Exits
+0 when the file was written, 1 when it could not be (hand.csv or the worksheet unreadable: every
+problem is printed). No ROS, no sandbox, no root: it reads records only.
+"""
+import argparse
+import glob
+import json
+import os
+import sys
+
+from exam_lab.grader.publish import hand, moodle
+from exam_lab.grader.score import safe_text
+
+
+def records_in(out):
+    """The grade records of a run's OUT: one per student folder, or the single submission's."""
+    paths = sorted(glob.glob(os.path.join(out, '*', 'grade.json'))) or \
+        [p for p in [os.path.join(out, 'grade.json')] if os.path.isfile(p)]
+    records = []
+    for path in paths:
+        with open(path) as f:
+            records.append(json.load(f))
+    return records
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--out', required=True, help='the folder make grade wrote (grade.json files, hand.csv)')
+    parser.add_argument('--worksheet', required=True, help="Moodle's offline grading worksheet (CSV)")
+    args = parser.parse_args(argv)
+    records = records_in(args.out)
+    if not records:
+        print('worksheet: no grade.json in %s: run make grade first' % args.out, file=sys.stderr)
+        return 1
+    path = os.path.join(args.out, hand.FILE)
+    try:
+        hands = hand.read(path) if os.path.isfile(path) else {}
+    except hand.HandError as err:
+        print('worksheet: %s' % safe_text.clean(str(err)), file=sys.stderr)
+        return 1
+    if not os.path.isfile(path):
+        print('worksheet: no %s: every student\'s hand points are missing (make grade writes it)' % path)
+    whole = [hand.combine(record, hands.get(record['student'])) for record in records]
+    target = os.path.join(args.out, '%s-whole.csv' % os.path.splitext(os.path.basename(args.worksheet))[0])
+    try:
+        summary = moodle.fill_file(args.worksheet, target, whole, scale=True)
+    except (moodle.WorksheetError, OSError) as err:
+        print('worksheet: NOT filled: %s' % safe_text.clean(str(err)), file=sys.stderr)
+        return 1
+    for line in moodle.summary_lines(summary, target):
+        print(line)
+    missing = [r for r in whole if r['missing']]
+    if missing:
+        print('%d student(s) without all their hand points (left without a grade; fill %s and run this again):'
+              % (len(missing), path))
+        for record in missing:
+            print('  %s: %s' % (safe_text.one_line(record['student']), ', '.join(record['missing'])))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

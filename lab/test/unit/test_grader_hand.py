@@ -1,0 +1,175 @@
+"""hand.csv: the teacher's 13 points beside the machine's 17, written, filled in a spreadsheet, read
+back; nothing the teacher wrote is lost, and nothing missing counts as 0 silently."""
+import csv
+
+import pytest
+
+from exam_lab.grader.publish import hand
+from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
+
+
+def record(student, total, participant=None):
+    items = [{'id': item, 'points': top, 'max': top, 'evidence': 'ok'} for item, (top, _) in ITEMS.items()]
+    items[-1]['points'] -= 17.0 - total
+    return {'student': student, 'sheet': 'altitude', 'total': total, 'max': 17.0, 'items': items,
+            'participant': participant, 'status': 'graded'}
+
+
+def fill(path, cells, delimiter=','):
+    """Fill cells {(student, column): text} as a spreadsheet would save the file."""
+    with open(path, newline='', encoding='utf-8-sig') as f:
+        rows = list(csv.DictReader(f))
+    for row in rows:
+        for (student, column), text in cells.items():
+            if row['student'] == student:
+                row[column] = text
+    with open(path, 'w', newline='', encoding='utf-8-sig') as f:
+        writer = csv.DictWriter(f, list(rows[0]), delimiter=delimiter)
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def test_the_sheets_thirty_points():
+    assert sum(p for p, _ in ITEMS.values()) + sum(p for p, _ in HAND_ITEMS.values()) == 30.0
+
+
+def test_written_empty_with_the_maxima_and_the_machines_subtotal(tmp_path):
+    path = str(tmp_path / hand.FILE)
+    assert hand.write(path, [record('Jane Doe', 17.0, 101), record('Paul Martin', 15.5, 102)]) == 2
+    with open(path, newline='') as f:
+        rows = list(csv.DictReader(f))
+    assert rows[0]['student'] == hand.MAX_ROW and rows[0]['comments'] == '4' and rows[0]['machine'] == '17'
+    assert [(r['student'], r['participant'], r['machine']) for r in rows[1:]] == \
+        [('Jane Doe', '101', '17'), ('Paul Martin', '102', '15.5')]
+    assert all(r[item] == '' for r in rows[1:] for item in HAND_ITEMS)
+    hands = hand.read(path)
+    assert all(value is None for h in hands.values() for value in h.points.values())
+
+
+def test_filled_in_a_spreadsheet_with_a_decimal_comma_and_semicolons(tmp_path):
+    path = str(tmp_path / hand.FILE)
+    hand.write(path, [record('Jane Doe', 17.0)])
+    cells = {('Jane Doe', item): str(top).replace('.', ',') for item, (top, _) in HAND_ITEMS.items()}
+    cells[('Jane Doe', 'Q5')] = '1,5'
+    cells[('Jane Doe', 'remark')] = 'report in French; Q5: two lines unexplained'
+    fill(path, cells, delimiter=';')
+    jane = hand.read(path)['Jane Doe']
+    assert jane.points['Q5'] == 1.5 and jane.points['comments'] == 4.0
+    combined = hand.combine(record('Jane Doe', 17.0), jane)
+    assert combined['total'] == 29.5 and combined['max'] == 30.0 and combined['missing'] == []
+    assert combined['machine_total'] == 17.0 and combined['remark'].startswith('report in French')
+    assert [i['id'] for i in combined['items']] == list(ITEMS) + list(HAND_ITEMS)
+
+
+def test_a_point_not_filled_in_is_missing_not_zero(tmp_path):
+    path = str(tmp_path / hand.FILE)
+    hand.write(path, [record('Jane Doe', 15.5)])
+    fill(path, {('Jane Doe', 'Q4'): '1', ('Jane Doe', 'comments'): '0'})
+    combined = hand.combine(record('Jane Doe', 15.5), hand.read(path)['Jane Doe'])
+    assert combined['total'] == 16.5
+    assert combined['missing'] == ['Q5', 'Q6', 'Q7', 'Q8', 'Q9', 'quality']  # comments: a real 0
+    no_row = hand.combine(record('Paul Martin', 12.0), None)
+    assert no_row['missing'] == list(HAND_ITEMS) and no_row['total'] == 12.0
+
+
+@pytest.mark.parametrize('cell', ['5', '-1', 'abc', '1.5.2', '4,5'])
+def test_a_cell_out_of_range_or_not_a_number_is_refused_with_its_place(tmp_path, cell):
+    path = str(tmp_path / hand.FILE)
+    hand.write(path, [record('Jane Doe', 17.0)])
+    fill(path, {('Jane Doe', 'comments'): cell})
+    with pytest.raises(hand.HandError) as caught:
+        hand.read(path)
+    assert 'line 3 (Jane Doe), column comments' in str(caught.value) and repr(cell) in str(caught.value)
+
+
+def test_writing_again_keeps_everything_the_teacher_wrote(tmp_path):
+    path = str(tmp_path / hand.FILE)
+    hand.write(path, [record('Jane Doe', 15.5), record('Paul Martin', 10.0)])
+    fill(path, {('Jane Doe', 'Q6'): '1', ('Jane Doe', 'remark'): 'seen'})
+    with open(path) as f:
+        text = f.read().replace('remark', 'remark,my column', 1).replace('seen', 'seen,kept', 1)
+    with open(path, 'w') as f:
+        f.write(text)
+    # A rescore: Jane's machine points changed, Ada is new, Paul is no longer in the run.
+    assert hand.write(path, [record('Jane Doe', 17.0), record('Ada Lovelace', 9.0)]) == 1
+    with open(path, newline='') as f:
+        rows = {r['student']: r for r in csv.DictReader(f)}
+    assert rows['Jane Doe']['Q6'] == '1' and rows['Jane Doe']['remark'] == 'seen'
+    assert rows['Jane Doe']['my column'] == 'kept' and rows['Jane Doe']['machine'] == '17'
+    assert set(rows) == {hand.MAX_ROW, 'Jane Doe', 'Paul Martin', 'Ada Lovelace'}
+
+
+def test_a_student_twice_or_a_renamed_column_is_refused(tmp_path):
+    path = str(tmp_path / hand.FILE)
+    hand.write(path, [record('Jane Doe', 17.0)])
+    with open(path) as f:
+        lines = f.read().splitlines()
+    with open(path, 'w') as f:
+        f.write('\n'.join(lines + [lines[-1]]) + '\n')
+    with pytest.raises(hand.HandError, match='Jane Doe is already on another line'):
+        hand.read(path)
+    with open(path, 'w') as f:
+        f.write('\n'.join([lines[0].replace('quality', 'Quality')] + lines[1:]) + '\n')
+    with pytest.raises(hand.HandError, match='no column quality'):
+        hand.read(path)
+
+
+def worksheet_script():
+    import importlib.util
+    import os
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    spec = importlib.util.spec_from_file_location('worksheet_script', os.path.join(repo, 'lab', 'scripts',
+                                                                                    'worksheet.py'))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+WORKSHEET = '\ufeff' + '\r\n'.join([
+    'Identifier,"Full name",Status,Grade,"Maximum grade","Grade can be changed","Last modified (grade)",'
+    '"Feedback comments"',
+    '"Participant 101","Jane Doe","Submitted for grading",,20.00,Yes,-,',
+    '"Participant 102","Paul Martin","Submitted for grading",,20.00,Yes,-,',
+]) + '\r\n'
+
+
+def test_the_whole_grade_on_the_worksheets_scale_and_nothing_missing_taken_as_zero(tmp_path, capsys):
+    import json
+    out = tmp_path / 'out'
+    jane, paul = record('Jane Doe', 17.0, 101), record('Paul Martin', 15.5, 102)
+    for r in (jane, paul):
+        (out / r['student']).mkdir(parents=True)
+        (out / r['student'] / 'grade.json').write_text(json.dumps(r))
+    hand.write(str(out / hand.FILE), [jane, paul])
+    cells = {('Jane Doe', item): str(top) for item, (top, _) in HAND_ITEMS.items()}
+    cells[('Jane Doe', 'quality')] = '1'
+    cells[('Paul Martin', 'Q4')] = '1'
+    fill(str(out / hand.FILE), cells)
+    (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8', newline='')
+    assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 0
+    printed = capsys.readouterr().out
+    filled = (out / 'ws-whole.csv').read_text(encoding='utf-8-sig')
+    rows = {r['Full name']: r for r in csv.DictReader(filled.splitlines())}
+    # Jane: 17 + 12 = 29 of 30 on a worksheet out of 20.
+    assert rows['Jane Doe']['Grade'] == '19.33'
+    comment = rows['Jane Doe']['Feedback comments']
+    assert '29 / 30 points: 17 of 17 by the machine' in comment and 'quality 1/2 (by hand)' in comment
+    # Paul's hand points are not all given: no grade, and he is named with what is missing.
+    assert rows['Paul Martin']['Grade'] == '' and rows['Paul Martin']['Feedback comments'] == ''
+    assert 'Paul Martin: Q5, Q6, Q7, Q8, Q9, comments, quality' in printed
+    assert 'hand points not given yet' in printed
+
+
+def test_a_badly_filled_hand_csv_stops_the_worksheet_with_every_problem(tmp_path, capsys):
+    import json
+    out = tmp_path / 'out'
+    (out / 'Jane Doe').mkdir(parents=True)
+    (out / 'Jane Doe' / 'grade.json').write_text(json.dumps(record('Jane Doe', 17.0, 101)))
+    hand.write(str(out / hand.FILE), [record('Jane Doe', 17.0, 101)])
+    fill(str(out / hand.FILE), {('Jane Doe', 'Q5'): 'two', ('Jane Doe', 'comments'): '9'})
+    (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8')
+    assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
+    err = capsys.readouterr().err
+    assert "column Q5: 'two'" in err and "column comments: '9'" in err
+    assert not (out / 'ws-whole.csv').exists()
+

@@ -1,0 +1,31 @@
+"""make rescore: today's rubric on the measurements a run kept (issue 29 point 2), no ROS, no box."""
+import json
+
+from exam_lab.grader import runner
+from exam_lab.grader.score import rubric
+
+from test_grader_rubric import STATIC, measured
+
+
+def test_rescore_applies_todays_rubric_to_the_kept_measurements(tmp_path, monkeypatch):
+    """Two students' measurements (synthetic, as a run keeps them): no change with the same rubric; a
+    tighter WARNING window moves the late student's Q14b only, with its previous points kept."""
+    late = [[-2.0, 'NORMAL'], [8.5 + 5.4, 'WARNING'], [16.0 + 0.08, 'NORMAL']]
+    for name, session in (('on_time', measured()), ('late', measured(calls=late))):
+        folder = tmp_path / name
+        folder.mkdir()
+        kept = {'student': name, 'sheet': 'altitude', 'static': STATIC, 'session': session, 'notes': [],
+                'fixes': [], 'comments': None, 'isolate': True, 'how_run': 'test', 'extra': {'seconds': 40.0}}
+        (folder / runner.MEASUREMENTS).write_text(json.dumps(kept))
+        (folder / 'grade.json').write_text(json.dumps(runner.score(kept)))
+    records, changes = runner.rescore(str(tmp_path))
+    assert changes == [] and [r['total'] for r in records] == [17.0, 17.0]
+    monkeypatch.setattr(rubric, 'WARNING_LATE_S', 0.3)
+    records, changes = runner.rescore(str(tmp_path))
+    assert changes == ['late: 17 -> 15.5 (Q14b 3 -> 1.5)']  # the delay's 1.5 of 14b
+    late_record = json.loads((tmp_path / 'late' / 'grade.json').read_text())
+    assert late_record['previous']['items']['Q14b'] == 3.0 and late_record['provenance']['how'] == 'rescore'
+    assert late_record['provenance']['rubric'] and late_record['provenance']['grader']
+    assert (tmp_path / 'grades.csv').is_file()
+    grade_md = (tmp_path / 'late' / 'grade.md').read_text()
+    assert 'Rescored by the grader' in grade_md and 'Before: 17 / 17 (graded)' in grade_md
