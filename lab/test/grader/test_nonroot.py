@@ -180,7 +180,7 @@ def test_make_check_shows_the_evidence_never_the_threshold_run(graded, user):
     table = {line.split()[0]: line for line in lines if line.split() and line.split()[0] in list(ITEMS) + ['total']}
     assert sorted(table) == sorted(list(ITEMS) + ['total']), output
     assert table['total'].split()[1:4] == ['17', '/', '17'], output
-    assert 'subscribes to /pressure, /temperature' in table['Q10'], 'the evidence is shown'
+    assert 'subscribes to /pressure (std_msgs/Float32), /temperature' in table['Q10'], 'the evidence is shown'
     assert table['Q14a'].endswith(student_view.Q14A_WORDS[0]), table['Q14a']
     # The hidden value is also one of the main run's check points of Q11 (an altitude the formula must
     # give): there it says nothing of the threshold run. Nowhere else.
