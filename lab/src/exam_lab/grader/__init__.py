@@ -4,7 +4,8 @@
 
 The folder a module lives in says who runs it, on whose bytes (docs/grading.md, "Isolation"):
 
-- ``boxed/`` -- as a box's uid, never root, on the student's bytes: :mod:`~.boxed.unpack` (safe
+- ``boxed/`` -- as a box's uid, never root, on the student's bytes: :mod:`~.boxed.inspect` (reads one
+  upload and writes its record), :mod:`~.boxed.intake` (a class archive), :mod:`~.boxed.unpack` (safe
   unzipping, finding the package, a class's students), :mod:`~.boxed.source` (what the sources say;
   the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it,
   the derived launch files the grader runs), :mod:`~.boxed.documents` (participant number, PDF
@@ -13,17 +14,22 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   one submission: the student's steps in its box, the master and the probe outside) and
   :mod:`~.judge.probe` (rospy: plays the drone with the harness's fake drone, measures).
 - ``host/`` -- root: :mod:`~.host.sandbox` (the box: bubblewrap, a uid of its own, limits; the
-  capped, regular-file-only copy of what a box leaves).
+  capped, regular-file-only copy of what a box leaves) and :mod:`~.host.egress` (the only reader of a
+  box's record: capped, never a link, checked against its schema).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima) and
   :mod:`~.score.rubric` (points, evidence and status from the measurements), :mod:`~.score.safe_text`
-  (student-derived text without control characters, for every record and output).
+  (student-derived text without control characters, for every record and output), :mod:`~.score.records`
+  (the typed records that cross the boundary, with their schemas).
 - ``publish/`` -- what the teacher reads, from records only: :mod:`~.publish.report` (grade.json,
   grade.md, grades.csv, the terminal table), :mod:`~.publish.desk` (writes the rest into OUT),
   :mod:`~.publish.page` (index.html), :mod:`~.publish.flightplot`, :mod:`~.publish.moodle` (the
   offline grading worksheet), :mod:`~.publish.gradescope` (results.json), :mod:`~.publish.progress`
-  (k of n, the time left; a run's steps).
-- :mod:`~exam_lab.grader.runner` -- one submission or a class, top to bottom: inspect, box, judge,
-  score, publish.
+  (k of n, the time left; a run's steps), :mod:`~.publish.hand` (the teacher's hand points, hand.csv),
+  :mod:`~.publish.provenance` (what made a grade), :mod:`~.publish.student_view` (what ``make check``
+  shows a student).
+- :mod:`~exam_lab.grader.runner` -- one submission or a class, top to bottom: stage, inspect (boxed),
+  build and run (box and judge), score (:func:`~exam_lab.grader.runner.score`, also for a rescore),
+  publish.
 - ``engine/`` -- the host, as the teacher: where else a class is graded, each student by the runner
   (:mod:`~.engine.slurm`: an array job on a Slurm cluster).
 """
