@@ -42,7 +42,9 @@ def main(argv=None):
     what.add_argument('--class', dest='klass', help='a folder (or zip) with one sub-folder per student')
     parser.add_argument('--sheet', choices=list(SHEETS), help='default: detected from the package')
     parser.add_argument('--out', help='output folder (default: $EXAM_WS/grades/<name>)')
-    parser.add_argument('--jobs', type=int, default=2, help='students graded side by side (class)')
+    parser.add_argument('--jobs', type=int, default=None,
+                        help='students graded side by side (class; default: %d per core, %d here)'
+                        % (runner.JOBS_PER_CORE, runner.default_jobs()))
     parser.add_argument('--unsandboxed-student-code-can-read-and-damage-my-files', dest='unsandboxed',
                         action='store_true', help='grade even where no sandbox can be made (never as root: '
                         'as root the code runs as a user of its own, with limits)')
@@ -56,6 +58,8 @@ def main(argv=None):
     parser.add_argument('--slurm-args', default='', help="sbatch's options for the cluster, e.g. "
                         "'--partition=short --account=ros101' (with --engine slurm)")
     args = parser.parse_args(argv)
+    if args.jobs is not None and args.jobs < 1:
+        parser.error('--jobs (JOBS) must be 1 or more, not %d' % args.jobs)
     if args.engine == 'slurm' and not args.klass:
         parser.error('--engine slurm grades a class (--class): one array task per student')
     target = args.submission or args.klass
@@ -80,13 +84,14 @@ def main(argv=None):
                                     scale=args.worksheet_scale):
                 say(line)
         else:
-            shown = progress.ClassProgress(args.jobs)
+            jobs = args.jobs or runner.default_jobs()
+            shown = progress.ClassProgress(jobs)
             try:
                 if args.engine == 'slurm':
                     records = slurm.grade_class(args.klass, out, args.sheet, progress=shown,
                                                 unsandboxed=args.unsandboxed, sbatch_args=shlex.split(args.slurm_args))
                 else:
-                    records = runner.grade_class(args.klass, out, args.sheet, args.jobs, progress=shown,
+                    records = runner.grade_class(args.klass, out, args.sheet, jobs, progress=shown,
                                                  unsandboxed=args.unsandboxed)
             finally:
                 shown.close()

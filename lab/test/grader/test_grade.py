@@ -202,13 +202,17 @@ def test_what_the_teacher_reads_of_each_status(graded):
 FAIR_EXPECTED = {
     'lowercase_service': {'Q13': 2.0},    # "warning"/"normal": refused by the drone, on time: half of 13, once
     'duplicate_names': {'Q12': 0.0},      # roslaunch refuses the file as handed in (two nodes named /mydrone)
-    'float64_temperature': {'Q10': 1.0},  # /temperature as Float64: rospy refuses it, the node keeps 20 degC
+    'float64_temperature': {'Q10': 1.0},  # /temperature as Float64: rospy refuses it; the drone speaks Float64
+    'float64_pressure': {'Q10': 1.0},     # /pressure as Float64, the input that moves: Q10 alone, the rest flown
+    'led_colours': {'Q13': 2.0},          # "RED"/"GREEN" (depth sheet): read as WARNING/NORMAL, half of 13 once
     'two_uploads': {},                    # exam.zip (14:52, no delay) and exam_v2.zip (16:58, complete)
 }
 FAIR_STATUS = {'lowercase_service': 'needs a hand grade', 'duplicate_names': 'graded with fixes',
-               'float64_temperature': 'graded', 'two_uploads': 'graded'}
+               'float64_temperature': 'graded with fixes', 'float64_pressure': 'graded with fixes',
+               'led_colours': 'needs a hand grade', 'two_uploads': 'graded'}
+FAIR_SHEETS = {'led_colours': 'depth'}
 #: Who must be in the page's "needs the teacher" box, whatever the status.
-FAIR_DOUBTS = ('lowercase_service', 'duplicate_names', 'two_uploads')
+FAIR_DOUBTS = ('lowercase_service', 'duplicate_names', 'led_colours', 'two_uploads')
 
 
 def dated_zip(source, path, when):
@@ -223,7 +227,7 @@ def dated_zip(source, path, when):
 
 @pytest.fixture(scope='module')
 def fair(tmp_path_factory):
-    """A class of four graded with JOBS=2, and its desk (the page) written."""
+    """A class of six graded with JOBS=3 (two rounds, as four at JOBS=2), and its desk (the page) written."""
     from exam_lab.grader.publish import desk
     root = tmp_path_factory.mktemp('fair')
     klass = root / 'class'
@@ -239,7 +243,7 @@ def fair(tmp_path_factory):
             shutil.copytree(os.path.join(SUBMISSIONS, name, 'exam'), str(folder / 'exam'),
                             ignore=shutil.ignore_patterns('__pycache__', '.grader-*'))
     out = root / 'out'
-    records = runner.grade_class(str(klass), str(out), jobs=2)
+    records = runner.grade_class(str(klass), str(out), jobs=3)
     desk.finish(str(out), records, title='ROS-Exam altitude')
     return out, {r['student']: r for r in records}
 
@@ -249,6 +253,7 @@ def test_fair_each_package_gets_what_a_teacher_gives(fair, name):
     _, records = fair
     record = records[name]
     assert_graded(record, FAIR_EXPECTED[name], FAIR_STATUS[name])
+    assert record['sheet'] == FAIR_SHEETS.get(name, 'altitude')
     assert bool(record['doubts']) == (name in FAIR_DOUBTS), record['doubts']
 
 
@@ -266,6 +271,14 @@ def test_fair_evidence_is_what_happened(fair):
     types = evidence['float64_temperature']
     assert '/temperature as std_msgs/Float64, but rospy refused the connection' in types['Q10'], types['Q10']
     assert 'subscribes /temperature (std_msgs/Float32)' not in ' '.join(records['float64_temperature']['for_the_teacher'])
+    moving = evidence['float64_pressure']
+    assert '/pressure as std_msgs/Float64, but rospy refused' in moving['Q10'], moving['Q10']
+    assert 'published it as std_msgs/Float64' in moving['Q10'], moving['Q10']
+    assert 'values agree with equation (1)' in moving['Q11'] and 'WARNING 5.' in moving['Q14b'], moving
+    assert 'the drone published /pressure as std_msgs/Float64' in records['float64_pressure']['status_reason']
+    colours = evidence['led_colours']
+    assert 'refused its 2 call(s) with "GREEN", "RED"' in colours['Q13'], colours['Q13']
+    assert 'WARNING while above, NORMAL once back below' in colours['Q13'], colours['Q13']
     uploads = ' '.join(records['two_uploads']['doubts'])
     assert "graded 'exam_v2.zip', the newest by its files' dates" in uploads, uploads
     assert "'exam.zip' (files dated 2026-06-12 14:52)" in uploads, uploads

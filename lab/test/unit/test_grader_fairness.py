@@ -1,5 +1,8 @@
 """One mistake, one loss; evidence never false; a status for every student. The rubric, the probe's
 leg check and the status on synthetic measurements (the stale-reading case included)."""
+import importlib.util
+import os
+
 import pytest
 
 from exam_lab.grader.boxed import launch, source
@@ -190,3 +193,25 @@ def test_reports_say_the_status():
     assert report.needing_the_teacher([record, dict(record, student='Bob', status='graded')]) == [
         'Ann: not graded - refused: x']
     assert record['status'] == 'not graded' and record['status_reason'] == 'refused: x'
+
+
+def test_jobs_default_two_per_core_within_memory():
+    """JOBS when the teacher gives none: two gradings per core (make bench's grader stage measured that
+    no point moves), fewer when the memory cannot hold them, never 0."""
+    from exam_lab.grader import runner
+    gib = 1 << 30
+    assert runner.default_jobs(cores=2, memory=24 * gib) == 4
+    assert runner.default_jobs(cores=16, memory=8 * gib) == 8
+    assert runner.default_jobs(cores=1, memory=gib // 2) == 1
+    assert runner.default_jobs() >= 1
+
+
+def test_grade_refuses_jobs_below_one(capsys):
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'scripts', 'grade.py')
+    spec = importlib.util.spec_from_file_location('grade_script', path)
+    grade = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(grade)
+    with pytest.raises(SystemExit) as stopped:
+        grade.main(['--class', '/nonexistent', '--jobs', '0'])
+    assert stopped.value.code == 2
+    assert '--jobs (JOBS) must be 1 or more, not 0' in capsys.readouterr().err

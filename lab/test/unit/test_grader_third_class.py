@@ -6,7 +6,7 @@ import zipfile
 
 from exam_lab.grader.boxed import unpack
 from exam_lab.grader.publish import flightplot, moodle, page, report
-from exam_lab.grader.score import rubric
+from exam_lab.grader.score import rubric, sheets
 from exam_lab.harness import oracle
 
 from test_grader_rubric import STATIC, lost, measured
@@ -42,9 +42,30 @@ def test_refused_calls_in_a_loop_cost_both_halves_and_other_words_are_named():
     session = measured(calls=calls)
     session['runs'][0]['probe']['answers'] = answered(calls, False)
     assert lost(session)['Q13'] == 3.0
-    never = measured(calls=[[13.55, 'RED'], [16.08, 'GREEN']], threshold_run=False)
+    never = measured(calls=[[13.55, 'BEEP'], [16.08, 'STOP BEEP']], threshold_run=False)
     q13 = [i for i in rubric.score('altitude', STATIC, never) if i['id'] == 'Q13'][0]['evidence']
-    assert '"GREEN", "RED"' in q13 and 'mean neither' in q13, q13
+    assert '"BEEP", "STOP BEEP"' in q13 and 'mean neither' in q13, q13
+
+
+def test_the_leds_colours_are_read_as_the_statuses_they_set():
+    """"RED" / "GREEN" (the LED the call sets), or "Alert" / "ok": what the node meant is clear, so
+    the calls are judged on their times and the words cost Q13's half once, as "warning" does."""
+    for warning, normal in (('RED', 'GREEN'), ('Alert!', 'ok'), ('ALT WARN', 'normale')):
+        session = measured(calls=[[13.55, warning], [16.08, normal]])
+        main = session['runs'][0]['probe']
+        main['answers'] = answered(main['calls'], False)
+        threshold = session['runs'][1]['probe']
+        threshold['calls'] = [[8.02, warning]]
+        threshold['answers'] = answered(threshold['calls'], False)
+        assert lost(session) == {'Q13': 2.0}, (warning, lost(session))
+        assert rubric.status(STATIC, session)[0] == rubric.HAND_GRADE
+
+
+def test_request_meaning():
+    assert [sheets.request_meaning(r) for r in ('WARNING', ' normal ', "'Warning'", 'WARNING!', 'warning: too high',
+                                                'red', 'Vert', 'depth warn')] == \
+        ['WARNING', 'NORMAL', 'WARNING', 'WARNING', 'WARNING', 'WARNING', 'NORMAL', 'WARNING']
+    assert [sheets.request_meaning(r) for r in ('NOT NORMAL', 'BEEP', '', None, 'WARNINGS', '42')] == [None] * 6
 
 
 def test_roslaunch_refusing_the_file_as_handed_in():
@@ -90,6 +111,23 @@ def test_a_refused_subscription_costs_q10_not_q11():
     wrong = float64_session()
     wrong['runs'][0]['probe']['formula'][1]['published'] += 30.0  # no constant explains these values
     assert lost(wrong) == {'Q10': 1.0, 'Q11': 1.5}
+
+
+def test_a_refused_moving_input_published_in_the_nodes_type_costs_q10_once():
+    """/pressure as Float64: the probe publishes it as Float64 once rospy refused it, and the node flies
+    (the values, the warning and its timing judged): Q10 loses the input, the fix is named."""
+    session = measured()
+    session['runs'][0]['probe']['input_types'] = {
+        '/temperature': {'type': 'std_msgs/Float32', 'connected': True, 'refused': None, 'adapted': None},
+        '/pressure': {'type': 'std_msgs/Float64', 'connected': True, 'adapted': 'std_msgs/Float64',
+                      'refused': 'rospy refused the connection: the node asked for std_msgs/Float64, the '
+                                 'drone publishes std_msgs/Float32'}}
+    assert lost(session) == {'Q10': 1.0}
+    q10 = [i for i in rubric.score('altitude', STATIC, session) if i['id'] == 'Q10'][0]['evidence']
+    assert 'published it as std_msgs/Float64' in q10 and '(0/1)' in q10, q10
+    status, reason = rubric.status(STATIC, session)
+    assert status == rubric.GRADED_WITH_FIXES, status
+    assert 'the drone published /pressure as std_msgs/Float64' in reason and 'std_msgs/Float32' in reason, reason
 
 
 def dated_zip(path, when, content=b'<package><name>exam</name></package>'):

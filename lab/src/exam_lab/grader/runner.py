@@ -636,9 +636,32 @@ def default_underlay():
     return os.path.join(workspace(), 'grader', 'underlay')
 
 
-def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=None, unsandboxed=False):
-    """Grade every student of a class, ``jobs`` side by side; write each one's grade and grades.csv.
-    One student the grader cannot grade is that student's row ("could not grade"), never the class's.
+#: Gradings side by side per core when JOBS is not given. A grading mostly waits (its flight is timed),
+#: and each box's CPU is bounded to cores/JOBS, so two per core keep every point: measured by `make
+#: bench`'s grader stage on a class of 60 (docs/benchmarks.md, "The grader").
+JOBS_PER_CORE = 2
+#: Memory one grading is counted for when JOBS is not given: its processes use a few hundred MB (the
+#: bounds are higher: the box 2 GB, the master 384 MB, the probe 512 MB).
+JOB_MEMORY_BYTES = 1 << 30
+
+
+def default_jobs(cores=None, memory=None):
+    """JOBS when the teacher gives none: JOBS_PER_CORE per core this process may run on, no more than
+    the memory holds at JOB_MEMORY_BYTES each, at least 1."""
+    if cores is None:
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, 'sched_getaffinity') else (os.cpu_count() or 1)
+    if memory is None:
+        try:
+            memory = os.sysconf('SC_PAGE_SIZE') * os.sysconf('SC_PHYS_PAGES')
+        except (ValueError, OSError):
+            memory = JOB_MEMORY_BYTES * JOBS_PER_CORE * cores
+    return max(1, min(JOBS_PER_CORE * cores, memory // JOB_MEMORY_BYTES))
+
+
+def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progress=None, unsandboxed=False):
+    """Grade every student of a class, ``jobs`` side by side (default :func:`default_jobs`); write each
+    one's grade and grades.csv. One student the grader cannot grade is that student's row ("could not
+    grade"), never the class's.
 
     :param progress: told of the run as it goes (:class:`exam_lab.grader.publish.progress.ClassProgress`).
     """
@@ -646,6 +669,7 @@ def grade_class(class_path, out_dir, sheet=None, jobs=2, isolate=None, progress=
     if refusal:
         raise sandbox.SandboxUnavailable(refusal)
     os.makedirs(out_dir, exist_ok=True)
+    jobs = jobs or default_jobs()
     work_dirs = []
     try:
         students = class_students(class_path, work_dirs)

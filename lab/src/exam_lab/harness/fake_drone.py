@@ -23,7 +23,7 @@ import time
 import unittest
 
 import rospy
-from std_msgs.msg import Float32, String
+from std_msgs.msg import Float32, Float64, String
 
 from mydrone.srv import AltitudeWarning
 from submarinedrone.srv import DepthWarning
@@ -37,6 +37,10 @@ AIR_TEMPERATURE = 15.0
 REMOTE_PRESSURE = oracle.P0
 #: The statuses of the sheets and the LED colour each sets.
 COLOURS = {'NORMAL': 'GREEN', 'WARNING': 'RED'}
+
+
+#: The message types whose ``data`` is a float; every other numeric std_msgs type holds an integer.
+_FLOAT_TYPES = (Float32, Float64)
 
 
 def _alive():
@@ -59,12 +63,15 @@ class SensorFeeder(object):
     def __init__(self, rates, tcp_nodelay=False, clock=None):
         self._clock = clock or rospy.get_time
         self._lock = threading.Lock()
+        self._tcp_nodelay = tcp_nodelay
         self._pubs = {}
+        self._types = {}
         self._values = {}
         self._quiet_until = {}
         self._last_sent = {}
         for topic in rates:
             self._pubs[topic] = rospy.Publisher(topic, Float32, queue_size=10, tcp_nodelay=tcp_nodelay)
+            self._types[topic] = Float32
             self._values[topic] = None
             self._quiet_until[topic] = 0.0
         self._stopped = threading.Event()
@@ -110,6 +117,21 @@ class SensorFeeder(object):
             self._quiet_until[topic] = time.monotonic() + quiet
             return self._publish(topic, value)
 
+    def retype(self, topic, msg_class):
+        """Publish ``topic`` as ``msg_class`` from now on (a numeric std_msgs type: integer types get the
+        value rounded), with the value it had; return the time of its first message.
+
+        The grader's probe does this when rospy refused a node's subscription for another type: the
+        publisher is replaced (unregistered, then registered anew), so the master tells the node's
+        subscriber about a publisher of its own type and rospy connects it.
+        """
+        with self._lock:
+            self._pubs[topic].unregister()
+            self._pubs[topic] = rospy.Publisher(topic, msg_class, queue_size=10, tcp_nodelay=self._tcp_nodelay)
+            self._types[topic] = msg_class
+            value = self._values[topic]
+            return self._publish(topic, value) if value is not None else None
+
     def close(self):
         """Stop every feeding thread and unregister the publishers."""
         self._stopped.set()
@@ -132,7 +154,8 @@ class SensorFeeder(object):
     def _publish(self, topic, value):
         """Publish one message (the caller holds the lock); return its ROS time."""
         self._last_sent[topic] = self._clock()
-        self._pubs[topic].publish(Float32(value))
+        kind = self._types[topic]
+        self._pubs[topic].publish(kind(value if kind in _FLOAT_TYPES else int(round(value))))
         return self._last_sent[topic]
 
 

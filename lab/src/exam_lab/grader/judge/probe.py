@@ -58,6 +58,8 @@ SETTLE_S = 0.8
 IGNORE_S = 0.3
 #: Seconds to wait for the second input's subscription once the node is up.
 SUBSCRIBE_S = 6.0
+#: Seconds a publisher in the node's type waits for its connection before it is registered anew.
+RETYPE_S = 1.0
 #: Seconds to wait for the output publisher once the node subscribed.
 OUTPUT_S = 3.0
 #: The flight: rest below, short excursion above (< delay), gap below, long excursion lasts delay + AFTER_S.
@@ -273,9 +275,13 @@ class Probe(object):
         return True
 
     def input_types(self, inputs, timeout=3.0):
-        """{input topic: {"type" the node subscribed with, "connected", "refused"}}: a subscription
-        rospy refused (another type than the drone's) shows as no connection and a refusal in our log.
-        Waits up to ``timeout`` s for each subscribed input to connect or be refused.
+        """{input topic: {"type" the node subscribed with, "connected", "refused", "adapted"}}: a
+        subscription rospy refused (another type than the drone's) shows as no connection and a refusal
+        in our log. Waits up to ``timeout`` s for each subscribed input to connect or be refused.
+
+        A refused input the node asked for as another numeric std_msgs type is then published in that
+        type (``adapted``: the type, once the node connected to it), as a teacher would change one word to
+        see the rest work: the wrong type costs question 10 alone, not the values and the warning too.
 
         :param inputs: {resolved input topic: the feeder's name of it}."""
         feeder = self.drone.feeder
@@ -285,16 +291,30 @@ class Probe(object):
                        for t, name in inputs.items())
         wait_until(settled, timeout, period=0.1)
         refused = self.refusals.refused()
+        adapted = {t: refused[t]['wanted'] for t in inputs
+                   if t in refused and refused[t]['wanted'] in VALUE_TYPES and refused[t]['wanted'] != 'std_msgs/Float32'}
+        # The node's subscriber may still hold the refused connection when the master tells it of the new
+        # publisher (rospy then skips a publisher it thinks it is connected to): a publisher not
+        # connected within RETYPE_S is registered anew, until SUBSCRIBE_S.
+        deadline = time.time() + SUBSCRIBE_S
+        waiting = sorted(adapted)
+        while waiting and time.time() < deadline:
+            for topic in waiting:
+                feeder.retype(inputs[topic], VALUE_TYPES[adapted[topic]])
+            wait_until(lambda: all(feeder.connections(inputs[t]) > 0 for t in waiting),
+                       min(RETYPE_S, max(0.0, deadline - time.time())), period=0.05)
+            waiting = [t for t in waiting if feeder.connections(inputs[t]) == 0]
         out = {}
         for topic, name in sorted(inputs.items()):
+            connected = feeder.connections(name) > 0
             if topic in refused:
-                out[topic] = {'type': refused[topic]['wanted'], 'connected': feeder.connections(name) > 0,
+                out[topic] = {'type': refused[topic]['wanted'], 'connected': connected,
                               'refused': 'rospy refused the connection: the node asked for %s, the drone '
-                                         'publishes %s' % (refused[topic]['wanted'], refused[topic]['published'])}
+                                         'publishes %s' % (refused[topic]['wanted'], refused[topic]['published']),
+                              'adapted': adapted[topic] if topic in adapted and connected else None}
             elif self.graph.subscribers(topic):
-                connected = feeder.connections(name) > 0
                 out[topic] = {'type': 'std_msgs/Float32' if connected else None, 'connected': connected,
-                              'refused': None}
+                              'refused': None, 'adapted': None}
         return out
 
     def find_output(self):

@@ -127,8 +127,13 @@ def score_q10(sheet, session):
     evidence = 'subscribes to %s' % (', '.join('%s%s' % (t, ' (%s)' % types[t]['type'] if (types.get(t) or {}).get('type')
                                                          else '') for t in got) or 'neither input')
     for topic in sorted(refused):
-        evidence += '; subscribes to %s as %s, but %s, so the node never receives it (0/1)' % (
-            topic, types[topic]['type'], types[topic]['refused'])
+        if types[topic].get('adapted'):
+            evidence += ('; subscribes to %s as %s, but %s, so with the drone it would never receive it (0/1); '
+                         'the grader\'s drone then published it as %s, so the rest is judged on what the node '
+                         'does with it' % (topic, types[topic]['type'], types[topic]['refused'], types[topic]['adapted']))
+        else:
+            evidence += '; subscribes to %s as %s, but %s, so the node never receives it (0/1)' % (
+                topic, types[topic]['type'], types[topic]['refused'])
     if missing:
         evidence += '; never to %s' % ', '.join(missing)
     return item('Q10', len(got), evidence)
@@ -137,6 +142,16 @@ def score_q10(sheet, session):
 def refused_inputs(probe):
     """The input topics whose subscription rospy refused (another message type than the drone's)."""
     return sorted(t for t, info in ((probe or {}).get('input_types') or {}).items() if info and info.get('refused'))
+
+
+def adapted_inputs(probe):
+    """The grader's fixes for refused subscriptions, one line each: the inputs its drone published in
+    the type the node asked for (:meth:`exam_lab.grader.judge.probe.Probe.input_types`)."""
+    return ['the drone published %s as %s, the type the node subscribed with (rospy refused the drone\'s %s): '
+            'Q10 lost that input once, the rest judged on that run' % (
+                topic, info['adapted'], (info.get('refused') or '').rsplit(' ', 1)[-1])
+            for topic, info in sorted(((probe or {}).get('input_types') or {}).items())
+            if info and info.get('refused') and info.get('adapted')]
 
 
 def _agrees(expected, published):
@@ -551,6 +566,7 @@ def status(static, session, fixes=()):
     if verdict.get('refused'):
         fixes = list(fixes) + ['roslaunch refuses %s as handed in ("%s"): the grader ran it without the drone\'s '
                                'node; Q12 judged on the file as handed in' % (verdict['file'], verdict['refused'])]
+    fixes = list(fixes) + adapted_inputs(main_probe(session))
     if fixes:
         return GRADED_WITH_FIXES, _one_line('; '.join(fixes))
     return GRADED, ''

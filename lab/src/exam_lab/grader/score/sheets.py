@@ -5,6 +5,7 @@ grader drives with come from :mod:`exam_lab.harness.oracle`, the drone itself is
 :class:`exam_lab.harness.fake_drone.Drone`.
 """
 import collections
+import re
 
 Sheet = collections.namedtuple('Sheet', 'name seed drone_pkg drone_type inputs output service threshold')
 
@@ -51,17 +52,31 @@ HAND_ITEMS = collections.OrderedDict([
 
 #: The requests the sheets name for the warning service (the drone refuses any other string).
 REQUESTS = ('WARNING', 'NORMAL')
+#: Other words students send for each status, upper case: the LED's colours and labels, on/off and
+#: true/false, English and French (the course's language). A request is read by its whole text, else by
+#: its first word ("WARNING: too high"), so "NOT NORMAL" means neither.
+MEANINGS = {
+    'WARNING': ('WARNING', 'WARN', 'WARNED', 'ALERT', 'ALARM', 'DANGER', 'RED', 'ON', 'TRUE', 'HIGH', 'ABOVE',
+                'ALT WARN', 'DEPTH WARN', 'ALTITUDE WARNING', 'DEPTH WARNING', 'TOO HIGH', 'TOO DEEP',
+                'ALERTE', 'ATTENTION', 'ROUGE', 'AVERTISSEMENT'),
+    'NORMAL': ('NORMAL', 'OK', 'OKAY', 'GREEN', 'OFF', 'FALSE', 'LOW', 'BELOW', 'SAFE', 'CLEAR', 'NOMINAL',
+               'NORMALE', 'VERT', 'VERTE'),
+}
+_MEANING_OF = {word: meaning for meaning, words in MEANINGS.items() for word in words}
 
 
 def request_meaning(request):
     """The status a warning-service request was meant as: ``'WARNING'`` or ``'NORMAL'`` for the sheets'
-    words in any case, spacing or quoting ("warning", " Normal", "'WARNING'"), else None.
+    words in any case, spacing, quoting or punctuation ("warning", " Normal", "'WARNING'", "WARNING!") and
+    for the other words of :data:`MEANINGS` ("RED", "alert", "ok"), else None.
 
     The drone refuses all but the exact words; the rubric still judges *when* the node called from
-    what it meant, so a wrong spelling costs once (question 13), not every timing item too.
+    what it meant, so a wrong word costs once (question 13), not every timing item too.
     """
-    word = str(request).strip().strip('"\'').strip().upper()
-    return word if word in REQUESTS else None
+    words = re.findall(r'[A-Z0-9]+', str(request).upper())
+    if not words:
+        return None
+    return _MEANING_OF.get(' '.join(words)) or _MEANING_OF.get(words[0])
 
 
 def drone_packages():
