@@ -17,6 +17,7 @@ import subprocess
 import sys
 import time
 
+from exam_lab.grader.publish.provenance import grader_version
 from exam_lab.harness.supervisor import Supervisor
 
 import driver
@@ -64,6 +65,7 @@ def machine():
         'nproc': os.cpu_count(), 'cpu_model': model, 'mem_gb': mem_kb / 1024.0 / 1024.0,
         'kernel': 'Linux ' + platform.release(), 'python': platform.python_version(),
         'rospy': importlib.metadata.version('rospy'),
+        'commit': grader_version(),  # the repository's commit, "+changes" when its files differ
         'loadavg_start': procs.loadavg(),
     }
 

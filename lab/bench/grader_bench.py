@@ -29,6 +29,7 @@ import tempfile
 import time
 
 from exam_lab.grader import runner
+from exam_lab.grader.publish.provenance import grader_version
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SUBMISSIONS = os.path.join(HERE, '..', 'test', 'grader', 'submissions')
@@ -107,6 +108,7 @@ def main(argv=None):
     kinds = packages()
     runner.ensure_underlay(runner.default_underlay())
     results = {'alone': {}, 'classes': [], 'date': datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M'),
+               'commit': grader_version(),
                'load_start': list(os.getloadavg()), 'command': 'python3 lab/bench/grader_bench.py '
                '--students %d --jobs %s' % (args.students, args.jobs)}
 
@@ -202,10 +204,11 @@ def render(results):
             '' if klass['students'] != 60 else (' (goal met)' if klass['wall'] <= 900 else ' (goal missed)')))
     return '\n'.join([
         '## The grader', '',
-        '_Measured by `%s --record` on %s (UTC)%s, after `make build` and `source tools/env.sh`; the '
-        'last stage of a full `make bench`, or alone._%s' % (
+        '_Measured by `%s --record` on %s (UTC)%s at commit %s, after `make build` and `source tools/env.sh`; '
+        'the last stage of a full `make bench`, or alone._%s' % (
             results.get('command', 'python3 lab/bench/grader_bench.py'), when,
-            ' in %.0f s' % results['total_s'] if results.get('total_s') else '', load), '',
+            ' in %.0f s' % results['total_s'] if results.get('total_s') else '',
+            results.get('commit', 'unknown (not recorded)'), load), '',
         'What `make grade` costs ([docs/grading.md](grading.md)), and whether grading students side by side '
         '(`JOBS`, each student on a master of its own) keeps its timing checks fair. The packages are our '
         'exam node and the student packages of `lab/test/grader/submissions/`; a class cycles through '
