@@ -50,6 +50,20 @@ def test_the_stale_reading_leg_is_not_reached():
         assert 'stayed above' not in items[item_id]['evidence'], 'no false evidence'
     status, reason = rubric.status(STATIC, record)
     assert status == rubric.HAND_GRADE and 'long excursion above' in reason
+    assert 'refused' not in reason
+
+
+def test_an_unreached_leg_names_the_refused_input_the_drone_could_not_speak():
+    """/pressure subscribed as a message the drone cannot publish (sensor_msgs/FluidPressure): the node
+    never gets it, its value never moves, the legs are not reached: the hand grade says why."""
+    record = with_legs(measured(calls=[]), reached={'long_up': None}, values={'long_up': 1040.0})
+    record['runs'][0]['probe']['input_types'] = {
+        '/pressure': {'type': 'sensor_msgs/FluidPressure', 'connected': False, 'adapted': None,
+                      'refused': 'rospy refused the connection: the node asked for sensor_msgs/FluidPressure, '
+                                 'the drone publishes std_msgs/Float32'}}
+    status, reason = rubric.status(STATIC, record)
+    assert status == rubric.HAND_GRADE
+    assert 'rospy refused its subscription to /pressure as sensor_msgs/FluidPressure' in reason, reason
 
 
 def test_a_leg_reached_late_counts_from_the_node_and_says_so():

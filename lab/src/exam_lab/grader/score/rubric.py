@@ -551,9 +551,13 @@ def status(static, session, fixes=()):
     for run in runs:
         missed = unreached_legs(run.get('probe'))
         if missed:
+            types = (run.get('probe') or {}).get('input_types') or {}
+            cause = ''.join('; rospy refused its subscription to %s as %s, so it never received that input'
+                            % (t, types[t]['type']) for t in refused_inputs(run.get('probe')) if not types[t].get('adapted'))
             return HAND_GRADE, _one_line(
                 'in the %s run the node\'s own value never reached the side of the threshold of its %s: '
-                'nothing judged there, read its code' % (run['tag'], ', '.join(LEG_WORDS.get(m, m) for m in missed)))
+                'nothing judged there, read its code%s' % (run['tag'], ', '.join(LEG_WORDS.get(m, m) for m in missed),
+                                                         cause))
     refused = refused_calls(main_probe(session))
     if refused:
         return HAND_GRADE, _one_line(
