@@ -37,7 +37,13 @@ OUR_EXAM = os.path.realpath(os.path.join(HERE, '..', '..', 'exam'))
 
 
 def packages():
-    found = {name: os.path.join(SUBMISSIONS, name, 'exam') for name in sorted(os.listdir(SUBMISSIONS))}
+    """{kind: its package folder}: each folder of submissions/ holds one package (``exam``, or the name the
+    student gave it), and ours."""
+    found = {}
+    for name in sorted(os.listdir(SUBMISSIONS)):
+        inside = sorted(d for d in os.listdir(os.path.join(SUBMISSIONS, name))
+                        if os.path.isdir(os.path.join(SUBMISSIONS, name, d)))
+        found[name] = os.path.join(SUBMISSIONS, name, inside[0])
     found['ours'] = OUR_EXAM
     return found
 
@@ -49,7 +55,7 @@ def make_class(folder, count, kinds):
     for i in range(count):
         kind = names[i % len(names)]
         student = 's%02d_%s' % (i + 1, kind)
-        shutil.copytree(kinds[kind], os.path.join(folder, student, 'exam'),
+        shutil.copytree(kinds[kind], os.path.join(folder, student, os.path.basename(kinds[kind])),
                         ignore=shutil.ignore_patterns('__pycache__', '.grader-*'))
         students[student] = kind
     return students
