@@ -53,3 +53,41 @@ def test_close_gives_up_after_its_timeout_and_says_how_many_are_still_inside():
     assert gate.close(timeout=0.05) == 1
     gate.leave()
     assert gate.close(timeout=0.0) == 0
+
+
+#: A close() timeout that no test waits out: a close that returns must have seen the gate empty.
+LONG_CLOSE_S = 120.0
+
+
+def _close_in_thread(gate, timeout):
+    """close(timeout) on a thread of its own: (event set when it returns, list of its result)."""
+    done, result = threading.Event(), []
+
+    def closer():
+        result.append(gate.close(timeout))
+        done.set()
+    threading.Thread(target=closer, daemon=True).start()
+    return done, result
+
+
+def test_close_returns_as_soon_as_the_last_callback_leaves_not_at_its_timeout():
+    # close() waits "up to" its timeout: the last leave() ends the wait at once. Two callbacks inside:
+    # the first to leave does not end it, the last does.
+    gate = Gate()
+    assert gate.enter() and gate.enter()
+    done, result = _close_in_thread(gate, LONG_CLOSE_S)
+    assert not done.wait(0.2)
+    gate.leave()
+    assert not done.wait(0.2)  # one is still inside
+    gate.leave()
+    assert done.wait(LONG_CLOSE_S / 4), 'close() waited for its timeout, not for the last callback'
+    assert result == [0]
+
+
+def test_closing_an_empty_gate_does_not_wait():
+    gate = Gate()
+    assert gate.enter()
+    gate.leave()
+    done, result = _close_in_thread(gate, LONG_CLOSE_S)
+    assert done.wait(LONG_CLOSE_S / 4), 'close() of an empty gate waited for its timeout'
+    assert result == [0]

@@ -4,6 +4,7 @@ The stand-in is Python's own XML-RPC server in a process of its own, threaded an
 rosmaster's (``rosgraph.xmlrpc``) does, so that its death is a real one: the kernel closes its
 connections, which is the event the master link waits for.
 """
+import http.client
 import signal
 import socket
 import subprocess
@@ -12,7 +13,7 @@ import time
 
 import pytest
 
-from node_kit.master_line import KEEPALIVE_IDLE_S, MasterLine
+from node_kit.master_line import KEEPALIVE_IDLE_S, KEEPALIVE_INTERVAL_S, KEEPALIVE_PROBES, MasterLine
 
 STAND_IN = r'''
 import socketserver, sys
@@ -20,6 +21,7 @@ from xmlrpc.server import SimpleXMLRPCRequestHandler, SimpleXMLRPCServer
 opened = [0]
 class Handler(SimpleXMLRPCRequestHandler):
     protocol_version = sys.argv[1]
+    rpc_paths = tuple(sys.argv[2:]) or ('/',)
     def setup(self):
         opened[0] += 1
         SimpleXMLRPCRequestHandler.setup(self)
@@ -33,6 +35,10 @@ server.register_function(lambda caller: [1, 'pid', 4242], 'getPid')
 server.register_function(lambda caller, name: [1, 'node', 'http://n:1/'] if name == '/known'
                          else [-1, 'unknown node', ''], 'lookupNode')
 server.register_function(lambda: opened[0], 'connections')
+def close_after_answers():  # from this answer on, the server ends every connection after its answer
+    Handler.protocol_version = 'HTTP/1.0'
+    return True
+server.register_function(close_after_answers, 'close_after_answers')
 print(server.server_address[1], flush=True)
 server.serve_forever()
 '''
@@ -40,12 +46,13 @@ server.serve_forever()
 EVENT_TIMEOUT = 30.0
 
 
-def stand_in(protocol):
-    proc = subprocess.Popen([sys.executable, '-c', STAND_IN, protocol], stdout=subprocess.PIPE,
+def stand_in(protocol, path='/'):
+    """A stand-in master speaking ``protocol``, serving XML-RPC at ``path`` only: (process, its URI)."""
+    proc = subprocess.Popen([sys.executable, '-c', STAND_IN, protocol, path], stdout=subprocess.PIPE,
                             universal_newlines=True)
     port = proc.stdout.readline().strip()
     assert port, 'the stand-in master did not start'
-    return proc, 'http://127.0.0.1:%s/' % port
+    return proc, 'http://127.0.0.1:%s%s' % (port, path)
 
 
 @pytest.fixture
@@ -140,3 +147,63 @@ def test_an_absent_master_raises_and_holds_nothing():
     with pytest.raises(OSError):
         line.multicall([('getPid', ['/a'])])
     assert not line.held()
+
+
+def test_the_call_goes_to_the_path_of_the_masters_uri(wake):
+    proc, uri = stand_in('HTTP/1.1', '/ros/master')  # answers at that path only (404 elsewhere)
+    try:
+        line = MasterLine(uri, 5.0)
+        assert line.multicall([('getPid', ['/a'])]) == [[1, 'pid', 4242]]
+        line.close()
+        with pytest.raises(http.client.HTTPException):  # the stand-in does answer 404 at another path
+            MasterLine(uri.replace('/ros/master', '/elsewhere'), 5.0).multicall([('getPid', ['/a'])])
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+def test_a_uri_without_a_port_means_the_http_port_80(monkeypatch):
+    opened = []
+
+    class Refused(object):
+        """An HTTPConnection that records where it connects and is refused there."""
+        def __init__(self, host, port, timeout):
+            opened.append((host, port, timeout))
+            self.sock = None
+
+        def request(self, *args):
+            raise ConnectionRefusedError('refused')
+
+        def close(self):
+            pass
+    monkeypatch.setattr(http.client, 'HTTPConnection', Refused)
+    with pytest.raises(ConnectionRefusedError):
+        MasterLine('http://ground/', 3.0).multicall([('getPid', ['/a'])])
+    with pytest.raises(ConnectionRefusedError):
+        MasterLine('http://ground:11311/', 3.0).multicall([('getPid', ['/a'])])
+    assert opened == [('ground', 80, 3.0), ('ground', 11311, 3.0)]
+
+
+def test_a_master_that_stops_holding_the_connection_still_answers_and_is_not_held(master):
+    # The connection was held (and its keepalive set), then the master closes it after an answer: the
+    # answer still comes, nothing is held any more, and the next call opens a new connection.
+    line = MasterLine(master[1], 5.0)
+    assert line.multicall([('getPid', ['/a'])]) == [[1, 'pid', 4242]]
+    assert line.held()
+    assert line.multicall([('close_after_answers', [])]) == [True]
+    assert not line.held()
+    assert line.multicall([('connections', [])]) == [2]
+    assert not line.held()
+    line.close()
+
+
+def test_every_keepalive_option_is_set_on_the_held_connection(master):
+    line = MasterLine(master[1], 5.0)
+    line.multicall([('getPid', ['/a'])])
+    sock = line._connection.sock
+    assert sock.getsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE) == 1
+    for option, value in (('TCP_KEEPIDLE', KEEPALIVE_IDLE_S), ('TCP_KEEPINTVL', KEEPALIVE_INTERVAL_S),
+                          ('TCP_KEEPCNT', KEEPALIVE_PROBES)):
+        if hasattr(socket, option):
+            assert sock.getsockopt(socket.IPPROTO_TCP, getattr(socket, option)) == value, option
+    line.close()

@@ -112,6 +112,7 @@ def test_status_up_down_and_re_registered():
     level, summary, values = w.status(12.5)
     assert (level, summary) == ('warn', 'master down for 2.5 s')
     assert dict(values)['down since [s]'] == '10.000' and dict(values)['state'] == 'down'
+    assert dict(values)['down for [s]'] == '2.5'
     assert dict(values)['last answer at [s]'] == '6.000'
     w.reregister_failed(13.0, 'refused')
     assert w.status(13.0)[1] == 'master down for 3.0 s, re-registration failing'
