@@ -48,6 +48,31 @@ class ParamScenarios(fake_drone.DroneScenario):
         self.assertEqual([s for _, s in calls], ['WARNING', 'NORMAL'])
         self.assertLess(calls[1][0] - t2, 0.5)
 
+    def test_stale_input_never_changes_the_led(self):
+        """While the temperature is stale, no value is computed from old data, so the pressure alone
+        changes nothing: above the threshold for longer than the delay, no WARNING; back below after a
+        WARNING, no NORMAL until a fresh temperature comes (then at once)."""
+        made = len(self.drone.service.calls())
+        last = self.drone.feeder.stop('temperature')
+        time.sleep(max(0.0, last + TIMEOUT + 1.0 - rospy.get_time()))  # older than ~timeout: stale
+        self.drone.fly_to(HIGH)
+        time.sleep(DELAY + 2.0)
+        self.assertEqual(self.drone.service.calls()[made:], [],
+                         'a WARNING from a pressure above the threshold while the temperature was stale')
+        self.drone.feeder.set('temperature', fake_drone.AIR_TEMPERATURE)
+        calls = self.drone.service.wait_for_calls(made + 1, DELAY + 3.0)
+        self.assertEqual([s for _, s in calls[made:]], ['WARNING'], 'no WARNING once the temperature was fresh')
+        last = self.drone.feeder.stop('temperature')
+        time.sleep(max(0.0, last + TIMEOUT + 1.0 - rospy.get_time()))
+        self.drone.fly_to(LOW)
+        time.sleep(2.0)
+        self.assertEqual([s for _, s in self.drone.service.calls()[made:]], ['WARNING'],
+                         'a NORMAL from a pressure back below while the temperature was stale')
+        resumed = self.drone.feeder.set('temperature', fake_drone.AIR_TEMPERATURE)
+        calls = self.drone.service.wait_for_calls(made + 2, 2.0)
+        self.assertEqual([s for _, s in calls[made:]], ['WARNING', 'NORMAL'])
+        self.assertLess(calls[-1][0] - resumed, 0.5, 'NORMAL not at once on the fresh temperature')
+
     def test_stale_input_stops_publishing_until_fresh_data(self):
         for topic, fresh in (('temperature', fake_drone.AIR_TEMPERATURE),
                              ('pressure', self.drone.input_for(LOW))):
