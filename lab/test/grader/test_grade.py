@@ -1,7 +1,8 @@
 """The grader end to end: our exam node gets full marks on both sheets; each flawed student package
 loses exactly the points the rubric takes for its flaw, and each upload form students really produce
-(a Windows zip, a whole workspace as exam.tar.gz, a package named otherwise) costs nothing. One class
-run (two students side by side) and one submission run; about eight minutes on two cores.
+(a Windows zip, a whole workspace as exam.tar.gz, a package named otherwise) costs nothing. Two class
+runs (the packages below, then the third kind of class), each at the default JOBS, and one submission
+run.
 """
 import csv
 import json
@@ -128,7 +129,8 @@ def graded(tmp_path_factory):
             shutil.copytree(source, str(folder / 'exam'), symlinks=True,
                             ignore=shutil.ignore_patterns('__pycache__', '.grader-*'))
     out = root / 'out'
-    records = runner.grade_class(str(klass), str(out), jobs=3)
+    # The default JOBS (two per core): what a teacher's class run uses, held to the same points here.
+    records = runner.grade_class(str(klass), str(out), jobs=runner.default_jobs())
     return out, {r['student']: r for r in records}
 
 
@@ -227,7 +229,7 @@ def dated_zip(source, path, when):
 
 @pytest.fixture(scope='module')
 def fair(tmp_path_factory):
-    """A class of six graded with JOBS=3 (two rounds, as four at JOBS=2), and its desk (the page) written."""
+    """A class of six graded with the default JOBS, and its desk (the page) written."""
     from exam_lab.grader.publish import desk
     root = tmp_path_factory.mktemp('fair')
     klass = root / 'class'
@@ -243,7 +245,7 @@ def fair(tmp_path_factory):
             shutil.copytree(os.path.join(SUBMISSIONS, name, 'exam'), str(folder / 'exam'),
                             ignore=shutil.ignore_patterns('__pycache__', '.grader-*'))
     out = root / 'out'
-    records = runner.grade_class(str(klass), str(out), jobs=3)
+    records = runner.grade_class(str(klass), str(out), jobs=runner.default_jobs())
     desk.finish(str(out), records, title='ROS-Exam altitude')
     return out, {r['student']: r for r in records}
 

@@ -277,11 +277,16 @@ class Supervisor(object):
         """
         env = dict(self.env if env is None else env)
         env[MARKER] = self.log_dir
-        if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        ignoring = signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+        if ignoring:
             argv = DEFAULT_SIGINT + list(argv)
         with open(self.log(name), 'ab') as out:
             proc = subprocess.Popen(list(argv), env=env, cwd=cwd, stdout=out, stderr=subprocess.STDOUT,
                                     stdin=subprocess.DEVNULL, start_new_session=True)
+        if ignoring:
+            # Until `env` has reset it, the child ignores SIGINT as we do: a stop right after the start
+            # would be lost. Wait for the reset (or the child's end), a few milliseconds.
+            wait_until(lambda: proc.poll() is not None or not _ignores_sigint(proc.pid), 5.0, period=0.005)
         self.procs.append(proc)
         if self.pid_file:
             with open(self.pid_file, 'a') as f:
@@ -353,6 +358,18 @@ class Supervisor(object):
         for proc in reversed(list(self.procs)):
             self.stop(proc, grace)
         end_pids(marked(self.log_dir), grace)
+
+
+def _ignores_sigint(pid):
+    """Whether process ``pid`` ignores SIGINT (its SigIgn mask in /proc); False once it is gone."""
+    try:
+        with open('/proc/%d/status' % pid) as f:
+            for line in f:
+                if line.startswith('SigIgn:'):
+                    return bool(int(line.split()[1], 16) & (1 << (signal.SIGINT - 1)))
+    except (OSError, ValueError):
+        pass
+    return False
 
 
 def main(argv):
