@@ -120,6 +120,7 @@ def test_a_refused_moving_input_published_in_the_nodes_type_costs_q10_once():
     session['runs'][0]['probe']['input_types'] = {
         '/temperature': {'type': 'std_msgs/Float32', 'connected': True, 'refused': None, 'adapted': None},
         '/pressure': {'type': 'std_msgs/Float64', 'connected': True, 'adapted': 'std_msgs/Float64',
+                      'published': 'std_msgs/Float32',
                       'refused': 'rospy refused the connection: the node asked for std_msgs/Float64, the '
                                  'drone publishes std_msgs/Float32'}}
     assert lost(session) == {'Q10': 1.0}

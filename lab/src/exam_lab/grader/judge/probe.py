@@ -311,6 +311,7 @@ class Probe(object):
                 out[topic] = {'type': refused[topic]['wanted'], 'connected': connected,
                               'refused': 'rospy refused the connection: the node asked for %s, the drone '
                                          'publishes %s' % (refused[topic]['wanted'], refused[topic]['published']),
+                              'published': refused[topic]['published'],
                               'adapted': adapted[topic] if topic in adapted and connected else None}
             elif self.graph.subscribers(topic):
                 out[topic] = {'type': 'std_msgs/Float32' if connected else None, 'connected': connected,

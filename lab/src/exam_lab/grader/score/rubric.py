@@ -149,7 +149,7 @@ def adapted_inputs(probe):
     the type the node asked for (:meth:`exam_lab.grader.judge.probe.Probe.input_types`)."""
     return ['the drone published %s as %s, the type the node subscribed with (rospy refused the drone\'s %s): '
             'Q10 lost that input once, the rest judged on that run' % (
-                topic, info['adapted'], (info.get('refused') or '').rsplit(' ', 1)[-1])
+                topic, info['adapted'], info.get('published', 'std_msgs/Float32'))
             for topic, info in sorted(((probe or {}).get('input_types') or {}).items())
             if info and info.get('refused') and info.get('adapted')]
 
