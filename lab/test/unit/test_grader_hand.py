@@ -323,3 +323,28 @@ def test_the_one_cell_rule(value, written):
     from exam_lab.grader.publish import cells
     assert cells.cell(value) == written
     assert cells.read_cell(written) == ('' if value is None else value)
+
+
+def test_a_late_classmate_of_the_same_name_never_takes_the_first_ones_folder(tmp_path):
+    """The folders of OUT (kept measurements, grade.json, logs) stay with their participant: run 1
+    graded Jane Doe (1002) into OUT/Jane Doe; run 2, with Jane Doe. (1001) sorted before her, keeps
+    1002 in OUT/Jane Doe and gives 1001 a folder of her own. A folder of OUT that is a participant's
+    not in this run is not given to anyone either."""
+    import json
+    from exam_lab.grader import runner
+    out = tmp_path / 'out'
+    (out / 'Jane Doe').mkdir(parents=True)
+    (out / 'Jane Doe' / runner.MEASUREMENTS).write_text(json.dumps({'extra': {'participant': 1002}}))
+    (out / 'Paul').mkdir()
+    (out / 'Paul' / 'grade.json').write_text(json.dumps({'folder': 'Paul_7_assignsubmission_file_'}))
+    (out / 'Paul' / 'logs').mkdir()
+    assert runner.kept_folders(str(out)) == {1002: 'Jane Doe', 7: 'Paul'}
+    class_ = [('Jane Doe', '/c/Jane Doe._1001_assignsubmission_file_'),
+              ('Jane Doe', '/c/Jane Doe_1002_assignsubmission_file_'), ('Paul', '/c/Paul_8_assignsubmission_file_')]
+    assert runner._unique(class_, runner.kept_folders(str(out))) == [
+        ('Jane Doe_2', class_[0][1]), ('Jane Doe', class_[1][1]), ('Paul_2', class_[2][1])]
+    assert runner._unique(class_) == [('Jane Doe', class_[0][1]), ('Jane Doe_2', class_[1][1]), ('Paul', class_[2][1])]
+    folders = tmp_path / 'class'
+    for _, path in class_:
+        (folders / path.split('/')[-1]).mkdir(parents=True)
+    assert [name for name, _ in runner.class_students(str(folders), [], out=str(out))] == ['Jane Doe_2', 'Jane Doe', 'Paul_2']
