@@ -43,7 +43,7 @@ _IDENTIFIER = re.compile(r'^\D*?(\d+)$')
 #: (mod/assign/feedback/comments/lang/en/assignfeedback_comments.php); fr, de, es, it, nl: Moodle's
 #: language packs from AMOS as kept in projectestac/moodle-langpacks at 6340d351 (2026-06-18, packs of
 #: Moodle 4.5: <lang>/assign.php, <lang>/moodle.php, <lang>/assignfeedback_comments.php; the same
-#: strings in its packs of 3.8, 3.11, 4.1 and 4.4, except where a second value is listed).
+#: strings in its packs of 3.8, 3.11, 4.1 and 4.4). Only English has two spellings of one string.
 HEADERS = {
     'identifier': ('Identifier', 'Identifiant', 'ID', 'Identificador', 'Identificativo', 'Identificatie'),
     'name': ('Full name', 'Nom complet', 'Vollständiger Name', 'Nombre completo', 'Nome', 'Volledige naam'),
@@ -57,12 +57,6 @@ HEADERS = {
     'feedback': ('Feedback comments', 'Feedback par commentaires', 'Feedback als Kommentar',
                  'Comentarios de retroalimentación', 'Commenti', 'Feedback tekstvak'),
 }
-#: The same, by the names this module had (kept for what imports them).
-IDENTIFIER_HEADERS = HEADERS['identifier']
-GRADE_HEADERS = HEADERS['grade']
-MAX_GRADE_HEADERS = HEADERS['maximum']
-FEEDBACK_HEADERS = HEADERS['feedback']
-NAME_HEADERS = HEADERS['name']
 #: Statuses whose points go into the grade column (the others wait for the teacher).
 GRADED = ('graded', 'graded with fixes')
 _BOM = '\ufeff'
