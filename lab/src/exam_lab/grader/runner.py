@@ -632,6 +632,8 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
     except Exception as err:  # anything: this student's row says so, the class goes on
         record = could_not_grade(name, sheet, '%r' % err,
                                  ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
+        moodle_name = os.path.basename(os.path.abspath(folder).rstrip('/'))
+        record.update(participant=moodle.participant_number(moodle_name), folder=moodle_name)  # who, even so
         try:
             report.write_grade(os.path.join(out_dir, name), record)
         except OSError:
