@@ -6,9 +6,11 @@ teacher's hand points (OUT/hand.csv), on the worksheet's own scale (docs/grading
 
 Writes OUT/<worksheet>-whole.csv, each grade out of the worksheet's maximum grade (30 points scaled),
 each feedback comment listing every item, the machine's and the teacher's. A student whose hand
-points are not all given, or whose status waits for the teacher, is left as it was and listed. Exits
-0 when the file was written, 1 when it could not be (hand.csv or the worksheet unreadable: every
-problem is printed). No ROS, no sandbox, no root: it reads records only.
+points are not all given, or whose status waits for the teacher, is left as it was and listed. A
+student's hand points are the row of hand.csv with its participant number (the name only where the
+class has no numbers): a row that could be another student's stops it, naming both. Exits 0 when the
+file was written, 1 when it could not be (hand.csv, its rows or the worksheet unusable: every problem
+is printed). No ROS, no sandbox, no root: it reads records only.
 """
 import argparse
 import glob
@@ -48,7 +50,14 @@ def main(argv=None):
         return 1
     if not os.path.isfile(path):
         print('worksheet: no %s: every student\'s hand points are missing (make grade writes it)' % path)
-    whole = [hand.combine(record, hands.get(record['student'])) for record in records]
+    try:
+        rows, notes = hand.match(hands, records)
+    except hand.HandError as err:
+        print('worksheet: NOT filled: %s' % safe_text.clean(str(err)), file=sys.stderr)
+        return 1
+    for line in notes:
+        print(safe_text.one_line(line))
+    whole = [hand.combine(record, row) for record, row in zip(records, rows)]
     target = os.path.join(args.out, '%s-whole.csv' % os.path.splitext(os.path.basename(args.worksheet))[0])
     try:
         summary = moodle.fill_file(args.worksheet, target, whole, scale=True)

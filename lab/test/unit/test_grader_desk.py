@@ -173,7 +173,8 @@ def test_finish_writes_the_desk_for_a_class(tmp_path):
     assert os.path.isfile(os.path.join(out, 'ws-filled.csv'))
     # hand.csv beside grades.csv, one empty row per student for the teacher's 13 points.
     assert any(l.startswith('hand points: %s' % os.path.join(out, 'hand.csv')) for l in lines)
-    assert sorted(hand.read(os.path.join(out, 'hand.csv'))) == ['Jane Doe', 'Paul']
+    assert sorted((h.student, h.participant) for h in hand.read(os.path.join(out, 'hand.csv')).values()) == \
+        [('Jane Doe', 101), ('Paul', 102)]
 
 
 def test_pdf_pages(tmp_path):

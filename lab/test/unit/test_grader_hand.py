@@ -173,3 +173,178 @@ def test_a_badly_filled_hand_csv_stops_the_worksheet_with_every_problem(tmp_path
     assert "column Q5: 'two'" in err and "column comments: '9'" in err
     assert not (out / 'ws-whole.csv').exists()
 
+
+
+def moodle_record(folder, total):
+    """A class student's record as a run makes it: the name cleaned from Moodle's folder name (the
+    intake's own rule), the participant number read from it."""
+    from exam_lab.grader.boxed import unpack
+    from exam_lab.grader.publish import moodle
+    return dict(record(unpack.student_name(folder), total, moodle.participant_number(folder)), folder=folder)
+
+
+def named_as_a_run_names_them(records):
+    """Each record's name made unique as a class run does (runner._unique, in the folders' order)."""
+    from exam_lab.grader import runner
+    records = sorted(records, key=lambda r: r['folder'])
+    names = runner._unique([(r['student'], r['folder']) for r in records])
+    return [dict(r, student=name) for r, (name, _) in zip(records, names)]
+
+
+WORKSHEET_TWO_JANES = '\ufeff' + '\r\n'.join([
+    'Identifier,"Full name",Status,Grade,"Maximum Grade","Grade can be changed","Last modified (grade)",'
+    '"Feedback comments"',
+    '"Participant 1001","Jane Doe.","Submitted for grading",,30.00,Yes,-,',
+    '"Participant 1002","Jane Doe","Submitted for grading",,30.00,Yes,-,',
+]) + '\r\n'
+
+
+def write_run(out, records):
+    import json
+    for r in records:
+        (out / r['student']).mkdir(parents=True, exist_ok=True)
+        (out / r['student'] / 'grade.json').write_text(json.dumps(r))
+    hand.write(str(out / hand.FILE), records)
+
+
+def test_a_name_differing_by_a_trailing_dot_never_takes_a_classmates_hand_points(tmp_path, capsys):
+    """Issue 36's case. Jane Doe (participant 1002) is graded, the teacher gives her 13 hand points
+    and a remark; Jane Doe. (participant 1001, cleaned to the same name) submits late, make grade
+    runs again and sorts her first (she takes the name "Jane Doe", the first Jane becomes "Jane
+    Doe_2"). make worksheet: the points and the remark stay participant 1002's; 1001 has none yet."""
+    import shutil
+    out = tmp_path / 'out'
+    first = named_as_a_run_names_them([moodle_record('Jane Doe_1002_assignsubmission_file_', 15.0)])
+    assert [r['student'] for r in first] == ['Jane Doe']
+    write_run(out, first)
+    cells = {('Jane Doe', item): str(top) for item, (top, _) in HAND_ITEMS.items()}
+    cells[('Jane Doe', 'remark')] = 'a clear report'
+    fill(str(out / hand.FILE), cells)
+    late = named_as_a_run_names_them([moodle_record('Jane Doe_1002_assignsubmission_file_', 15.0),
+                                       moodle_record('Jane Doe._1001_assignsubmission_file_', 11.0)])
+    assert [(r['student'], r['participant']) for r in late] == [('Jane Doe', 1001), ('Jane Doe_2', 1002)]
+    shutil.rmtree(str(out / 'Jane Doe'))
+    write_run(out, late)
+    hands = hand.read(str(out / hand.FILE))
+    assert hands[1002].remark == 'a clear report' and hands[1002].points['comments'] == 4.0
+    assert hands[1002].student == 'Jane Doe_2' and all(v is None for v in hands[1001].points.values())
+    (tmp_path / 'ws.csv').write_text(WORKSHEET_TWO_JANES, encoding='utf-8', newline='')
+    assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 0
+    filled = (out / 'ws-whole.csv').read_text(encoding='utf-8-sig')
+    rows = {r['Identifier']: r for r in csv.DictReader(filled.splitlines())}
+    assert rows['Participant 1002']['Grade'] == '28'  # 15 + 13 of 30
+    assert 'a clear report' in rows['Participant 1002']['Feedback comments']
+    assert rows['Participant 1001']['Grade'] == '' and rows['Participant 1001']['Feedback comments'] == ''
+    assert 'Jane Doe: Q4, Q5' in capsys.readouterr().out  # 1001's hand points: none given yet
+
+
+def test_a_kept_row_whose_participant_no_longer_matches_stops_the_worksheet(tmp_path, capsys):
+    """The row of Jane Doe (participant 1002) was filled; now the only Jane Doe graded is 1001 (1002's
+    folder went): the row is not hers, and make worksheet stops naming both."""
+    out = tmp_path / 'out'
+    write_run(out, [moodle_record('Jane Doe_1002_assignsubmission_file_', 15.0)])
+    fill(str(out / hand.FILE), {('Jane Doe', item): str(top) for item, (top, _) in HAND_ITEMS.items()})
+    import shutil
+    shutil.rmtree(str(out / 'Jane Doe'))
+    write_run(out, [moodle_record('Jane Doe._1001_assignsubmission_file_', 11.0)])
+    (tmp_path / 'ws.csv').write_text(WORKSHEET_TWO_JANES, encoding='utf-8', newline='')
+    assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
+    err = capsys.readouterr().err
+    assert 'hand.csv line 3 (Jane Doe, participant 1002)' in err
+    assert 'Jane Doe (participant 1001, folder Jane Doe._1001_assignsubmission_file_)' in err
+    assert not (out / 'ws-whole.csv').exists()
+
+
+def test_a_row_without_a_number_is_not_given_to_a_student_who_has_one(tmp_path, capsys):
+    """A row written when the class had no participant numbers (a folder of plain names) meets a
+    Moodle class with the same name: not guessed."""
+    out = tmp_path / 'out'
+    hand.write(str(out.mkdir() or out / hand.FILE), [record('Jane Doe', 15.0)])
+    fill(str(out / hand.FILE), {('Jane Doe', 'Q4'): '1'})
+    jane = moodle_record('Jane Doe_1002_assignsubmission_file_', 15.0)
+    write_run(out, [jane])
+    with pytest.raises(hand.HandError, match='no participant number'):
+        hand.match(hand.read(str(out / hand.FILE)), [jane])
+
+
+def test_one_participant_in_two_folders_is_refused_by_name(tmp_path):
+    path = str(tmp_path / hand.FILE)
+    twice = [dict(record('Jane Doe', 15.0, 1002)), dict(record('Jane Doe_2', 12.0, 1002))]
+    with pytest.raises(hand.HandError, match='Jane Doe and Jane Doe_2 are both participant 1002'):
+        hand.write(path, twice)
+    assert not (tmp_path / hand.FILE).exists()
+
+
+def test_two_students_sharing_a_name_keep_their_own_rows(tmp_path):
+    """Two Moodle users really named Jane Doe: two rows, each with its number; filling one leaves the
+    other empty, and a rescore with their names swapped keeps each row with its participant."""
+    path = str(tmp_path / hand.FILE)
+    a, b = record('Jane Doe', 15.0, 1), record('Jane Doe_2', 12.0, 2)
+    assert hand.write(path, [a, b]) == 2
+    fill(path, {('Jane Doe_2', 'Q4'): '1'})
+    assert hand.write(path, [dict(a, student='Jane Doe_2'), dict(b, student='Jane Doe')]) == 0
+    hands = hand.read(path)
+    assert hands[2].points['Q4'] == 1.0 and hands[2].student == 'Jane Doe' and hands[1].points['Q4'] is None
+    rows, notes = hand.match(hands, [dict(a, student='Jane Doe_2'), dict(b, student='Jane Doe')])
+    assert [r.participant for r in rows] == [1, 2] and notes == []
+
+
+@pytest.mark.parametrize('name', ['=cmd|"/c calc"!A1', '+1', '-Jane', '@SUM(A1)', '\tJane', '\rJane', "'t Hooft",
+                                  "''", 'Jane -= Doe'])
+def test_a_name_no_spreadsheet_runs_and_read_back_exactly(tmp_path, name):
+    """OWASP's rule in hand.csv and grades.csv: a cell beginning with = + - @ tab or CR begins with a
+    quote; the grader reads back exactly what it was given (a name beginning with a quote too), and
+    writing again does not add a second quote. The teacher's remark is kept the same way."""
+    from exam_lab.grader.publish import cells, report
+    from exam_lab.grader.score import safe_text
+    path = str(tmp_path / hand.FILE)
+    student = record(name, 15.0, 7)
+    hand.write(path, [student])
+    fill(path, {(cells.cell(name), 'remark'): '=1+1'})  # typed in a spreadsheet, saved as text
+    for _ in range(2):
+        hand.write(path, [student])
+        with open(path, newline='') as f:
+            raw = dict(zip(hand.COLUMNS, [r for r in csv.reader(f)][2]))
+        assert raw['student'] == (name if name == 'Jane -= Doe' else "'" + name)
+        assert raw['remark'] == "'=1+1"
+        assert hand.read(path)[7].student == name.strip() and hand.read(path)[7].remark == '=1+1'
+    report.write_csv(str(tmp_path / 'grades.csv'), [dict(student, status='-graded')])
+    with open(str(tmp_path / 'grades.csv'), newline='') as f:
+        rows = list(csv.DictReader(f))
+    assert rows[0]['student'][:1] not in cells.FORMULA_STARTS
+    assert cells.read_cell(rows[0]['student']) == safe_text.one_line(name)
+    assert rows[0]['participant'] == '7' and rows[0]['status'] == "'-graded"
+
+
+@pytest.mark.parametrize('value, written', [('=1+1', "'=1+1"), ('+33 6', "'+33 6"), ('-x', "'-x"), ('@a', "'@a"),
+                                            ('\tx', "'\tx"), ('\rx', "'\rx"), ("'x", "''x"), ('-', '-'), ('', ''),
+                                            ('x=1', 'x=1'), ('12.5', '12.5'), (None, '')])
+def test_the_one_cell_rule(value, written):
+    from exam_lab.grader.publish import cells
+    assert cells.cell(value) == written
+    assert cells.read_cell(written) == ('' if value is None else value)
+
+
+def test_a_late_classmate_of_the_same_name_never_takes_the_first_ones_folder(tmp_path):
+    """The folders of OUT (kept measurements, grade.json, logs) stay with their participant: run 1
+    graded Jane Doe (1002) into OUT/Jane Doe; run 2, with Jane Doe. (1001) sorted before her, keeps
+    1002 in OUT/Jane Doe and gives 1001 a folder of her own. A folder of OUT that is a participant's
+    not in this run is not given to anyone either."""
+    import json
+    from exam_lab.grader import runner
+    out = tmp_path / 'out'
+    (out / 'Jane Doe').mkdir(parents=True)
+    (out / 'Jane Doe' / runner.MEASUREMENTS).write_text(json.dumps({'extra': {'participant': 1002}}))
+    (out / 'Paul').mkdir()
+    (out / 'Paul' / 'grade.json').write_text(json.dumps({'folder': 'Paul_7_assignsubmission_file_'}))
+    (out / 'Paul' / 'logs').mkdir()
+    assert runner.kept_folders(str(out)) == {1002: 'Jane Doe', 7: 'Paul'}
+    class_ = [('Jane Doe', '/c/Jane Doe._1001_assignsubmission_file_'),
+              ('Jane Doe', '/c/Jane Doe_1002_assignsubmission_file_'), ('Paul', '/c/Paul_8_assignsubmission_file_')]
+    assert runner._unique(class_, runner.kept_folders(str(out))) == [
+        ('Jane Doe_2', class_[0][1]), ('Jane Doe', class_[1][1]), ('Paul_2', class_[2][1])]
+    assert runner._unique(class_) == [('Jane Doe', class_[0][1]), ('Jane Doe_2', class_[1][1]), ('Paul', class_[2][1])]
+    folders = tmp_path / 'class'
+    for _, path in class_:
+        (folders / path.split('/')[-1]).mkdir(parents=True)
+    assert [name for name, _ in runner.class_students(str(folders), [], out=str(out))] == ['Jane Doe_2', 'Jane Doe', 'Paul_2']

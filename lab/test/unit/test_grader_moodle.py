@@ -6,24 +6,31 @@ import io
 
 import pytest
 
-from exam_lab.grader.publish import moodle
+from exam_lab.grader.publish import cells, moodle
 from exam_lab.grader.score.sheets import ITEMS
 
-HEADER = ['Identifier', 'Full name', 'Email address', 'Status', 'Grade', 'Maximum grade',
-          'Grade can be changed', 'Last modified (submission)', 'Online text', 'Last modified (grade)',
-          'Feedback comments']
+#: The header line of a real worksheet, exactly as Moodle wrote it in English (quoting included):
+#: copied from a public grading script that quotes a downloaded worksheet's first line in a comment
+#: (found with the search tools; its repository is not named there). Its columns are those of
+#: mod/assign/gradingtable.php in download mode (moodle/moodle at 003699db) for an assignment
+#: with groups, file submissions (no column: no editor field) and feedback comments, each headed by
+#: the English string of mod/assign/lang/en/assign.php ('Maximum Grade': the later of its two
+#: 'maxgrade' lines, which PHP keeps), lang/en/moodle.php and assignfeedback_comments.
+HEADER_LINE = ('Identifier,"Full name","Email address",Status,Group,Grade,"Maximum Grade","Grade can be changed",'
+               '"Last modified (submission)","Last modified (grade)","Feedback comments"')
+HEADER = next(csv.reader([HEADER_LINE]))
 #: Rows as Moodle's writer quotes them (spaces, commas, line breaks, quotes), CRLF line ends.
 WORKSHEET = '\ufeff' + '\r\n'.join([
-    ','.join(HEADER),
-    '"Participant 101","Jane Doe",jane@example.org,"Submitted for grading",,17.00,Yes,'
-    '"Monday, 3 March 2025, 10:12 AM","a ""quoted""\nline",-,',
-    '"Participant 102","Paul Martin",paul@example.org,"Submitted for grading",,17.00,Yes,'
-    '"Monday, 3 March 2025, 10:13 AM",,-,',
-    '"Participant 103","Ada Lovelace",ada@example.org,"Submitted for grading",12.00,17.00,Yes,'
-    '"Monday, 3 March 2025, 10:14 AM",,"Monday, 3 March 2025, 11:00 AM","<p>seen by hand</p>"',
-    '"Participant 104","Alan Turing",alan@example.org,"No submission",,17.00,Yes,-,,-,',
-    '"Participant 105","Grace Hopper",grace@example.org,"Submitted for grading",,17.00,Yes,'
-    '"Monday, 3 March 2025, 10:15 AM",,-,',
+    HEADER_LINE,
+    '"Participant 101","Jane Doe",jane@example.org,"Submitted for grading","Team ""A"", the\nmorning",,17.00,Yes,'
+    '"Monday, 3 March 2025, 10:12 AM",-,',
+    '"Participant 102","Paul Martin",paul@example.org,"Submitted for grading","Default group",,17.00,Yes,'
+    '"Monday, 3 March 2025, 10:13 AM",-,',
+    '"Participant 103","Ada Lovelace",ada@example.org,"Submitted for grading","Default group",12.00,17.00,Yes,'
+    '"Monday, 3 March 2025, 10:14 AM","Monday, 3 March 2025, 11:00 AM","<p>seen by hand</p>"',
+    '"Participant 104","Alan Turing",alan@example.org,"No submission","Default group",,17.00,Yes,-,-,',
+    '"Participant 105","Grace Hopper",grace@example.org,"Submitted for grading","Default group",,17.00,Yes,'
+    '"Monday, 3 March 2025, 10:15 AM",-,',
 ]) + '\r\n'
 
 
@@ -106,15 +113,16 @@ def test_every_byte_outside_the_filled_cells_is_kept():
     assert before[0] == after[0]
     for line in (3, 4, 5):  # Ada (graded by hand), Alan (no submission), Grace (needs a hand grade)
         assert before[line] == after[line]
-    assert after[1].startswith('"Participant 101","Jane Doe",jane@example.org,"Submitted for grading",17,17.00,')
+    assert after[1].startswith('"Participant 101","Jane Doe",jane@example.org,"Submitted for grading","Team ""A"", '
+                               'the\nmorning",17,17.00,')
     assert filled.endswith('\r\n')
 
 
 def test_decimal_comma_follows_the_worksheet():
     text = WORKSHEET.replace('17.00', '"17,00"').replace('12.00', '"12,00"')
     filled, _ = moodle.fill(text, RECORDS)
-    _, rows = moodle_read(filled)
-    assert rows[1][4] == '15,5'
+    header, rows = moodle_read(filled)
+    assert rows[1][header.index('Grade')] == '15,5'
 
 
 def test_a_malformed_worksheet_is_refused():
@@ -149,3 +157,103 @@ def test_fill_file_and_summary(tmp_path):
     lines = moodle.summary_lines(summary, str(target))
     assert '2 grade(s) written' in lines[0]
     assert any('NOT MATCHED: Eve Elsewhere' in line for line in lines)
+
+
+#: The same worksheet as Moodle writes it in French, German and Spanish, each header the string of that
+#: language's pack (Moodle 4.5 packs from AMOS, as kept in projectestac/moodle-langpacks at 6340d351:
+#: <lang>/assign.php recordid, maxgrade, gradecanbechanged, lastmodifiedsubmission, lastmodifiedgrade;
+#: <lang>/moodle.php fullname, email, status, gradenoun; <lang>/assignfeedback_comments.php pluginname),
+#: copied here by hand from those files, apart from the module's table, so a slip in either shows.
+#: English twice: as PHP reads mod/assign/lang/en/assign.php ('Maximum Grade') and as AMOS's pack
+#: has it ('Maximum grade').
+LANGUAGES = {
+    'en': HEADER_LINE.replace(',Group', ''),
+    'en AMOS': HEADER_LINE.replace(',Group', '').replace('Maximum Grade', 'Maximum grade'),
+    'fr': 'Identifiant,"Nom complet","Adresse de courriel",Statut,Note,"Note maximale","La note peut être modifiée",'
+          '"Dernière modification (travail remis)","Dernière modification (note)","Feedback par commentaires"',
+    'de': 'ID,"Vollständiger Name",E-Mail-Adresse,Status,Bewertung,Bestwertung,"Bewertung kann geändert werden",'
+          '"Zuletzt geändert (Abgabe)","Zuletzt geändert (Bewertung)","Feedback als Kommentar"',
+    'es': 'Identificador,"Nombre completo","Dirección de correo",Estado,Calificación,"Calificación máxima",'
+          '"La calificación puede ser cambiada","Última modificación (entrega)","Última modificación (calificación)",'
+          '"Comentarios de retroalimentación"',
+    'en lower case': HEADER_LINE.replace(',Group', '').lower(),
+}
+WORD = {'en': 'Participant', 'en AMOS': 'Participant', 'fr': 'Participant', 'de': 'Teilnehmer/in',
+        'es': 'Participante', 'en lower case': 'Participant'}
+
+
+@pytest.mark.parametrize('language', sorted(LANGUAGES))
+@pytest.mark.parametrize('scale', [False, True])
+def test_moodles_own_headers_in_each_language_and_any_case(language, scale):
+    """The maximum grade column is found whatever its language or case: with the worksheet out of 20,
+    15.5 of 17 is written as it is (the summary says NOT SCALED) or scaled to 18.24."""
+    text = '\ufeff' + '\r\n'.join([
+        LANGUAGES[language],
+        '"%s 102","Paul Martin",paul@example.org,"-",,20.00,Yes,-,-,' % WORD[language],
+    ]) + '\r\n'
+    filled, summary = moodle.fill(text, [record('Paul Martin', 102, 15.5)], scale=scale)
+    assert summary['graded'] == [('Paul Martin', 102, '18.24' if scale else '15.5')]
+    assert summary['maxima'] == [20.0]
+    header, rows = moodle_read(filled)
+    assert rows[0][4] == ('18.24' if scale else '15.5') and rows[0][9].startswith('<p>')
+
+
+def test_a_worksheet_whose_maximum_grade_is_not_recognised_stops():
+    """Never a total out of 17 (or 30) into a column out of 20 without a word: a maximum grade column
+    not recognised stops the filling, naming what was looked for; a scale says so."""
+    for other in ('Max. grade', 'Maximum points'):
+        text = WORKSHEET.replace('"Maximum Grade"', '"%s"' % other, 1)
+        for scale in (False, True):
+            with pytest.raises(moodle.WorksheetError, match="no maximum grade column .*'Maximum Grade'"):
+                moodle.fill(text, RECORDS, scale=scale)
+    with pytest.raises(moodle.WorksheetError, match='graded on a scale'):
+        moodle.fill(WORKSHEET.replace('"Maximum Grade"', 'Scale', 1), RECORDS)
+    with pytest.raises(moodle.WorksheetError, match='no last modified'):
+        moodle.fill(WORKSHEET.replace('"Last modified (grade)"', 'Modified', 1), RECORDS)
+
+
+def test_a_row_whose_maximum_is_no_number_is_left_with_why():
+    text = WORKSHEET.replace('"Default group",,17.00', '"Default group",,', 1)  # Paul's row
+    _, summary = moodle.fill(text, RECORDS, scale=True)
+    assert ('Paul Martin', "its maximum grade '' is not a number above 0") in summary['kept']
+    assert [g[0] for g in summary['graded']] == ['Jane Doe']
+
+
+def test_cells_a_student_chose_cannot_run_in_a_spreadsheet():
+    """OWASP's rule on the filled copy: a name, an email, a group beginning with = + - @ tab or CR
+    begins with a quote; Moodle's own "-" and the columns its importer reads are as they were."""
+    hostile = {'Full name': '=HYPERLINK("http://x","y")', 'Email address': '@SUM(1+1)', 'Group': '-2+3'}
+    text = WORKSHEET.replace('"Jane Doe",jane@example.org', '"=HYPERLINK(""http://x"",""y"")",@SUM(1+1)', 1)
+    text = text.replace('"Team ""A"", the\nmorning"', '-2+3', 1)
+    text = text.replace('"Paul Martin"', '"\tPaul"', 1).replace('"Ada Lovelace"', '"\'t Hooft"', 1)
+    filled, summary = moodle.fill(text, RECORDS)
+    header, rows = moodle_read(filled)
+    jane = rows[0]
+    for column, value in hostile.items():
+        assert jane[header.index(column)] == "'" + value
+        assert cells.read_cell(jane[header.index(column)]) == value
+    assert rows[1][1] == "'\tPaul" and rows[2][1] == "''t Hooft"
+    assert jane[header.index('Grade')] == '17' and jane[header.index('Last modified (grade)')] == '-'
+    assert rows[3][header.index('Last modified (submission)')] == '-'
+    assert [g[1] for g in summary['graded']] == [101, 102]
+
+
+def test_a_participant_two_records_claim_is_written_for_neither():
+    """Two folders of OUT with one participant (a stale folder, a renamed student): the row is not
+    guessed."""
+    records = RECORDS + [record('Jane Doe_2', 101, 3.0)]
+    filled, summary = moodle.fill(WORKSHEET, records)
+    _, rows = moodle_read(filled)
+    assert rows[0][5] == ''
+    assert sorted(s for s, why in summary['unmatched'] if 'participant 101 is also' in why) == ['Jane Doe', 'Jane Doe_2']
+
+
+def test_identity_gives_the_participant_and_moodles_folder():
+    jane = dict(record('Jane Doe', 1234567, 17.0), folder='Jane Doe_1234567_assignsubmission_file_')
+    assert moodle.identity(jane) == (1234567, 'Jane Doe_1234567_assignsubmission_file_', ('participant', 1234567))
+    flat = dict(jane, folder='Jane Doe_1234567_assignsubmission_file_exam.zip')
+    assert moodle.identity(flat).folder == 'Jane Doe_1234567_assignsubmission_file_'
+    plain = dict(record('jdupont', None, 17.0), folder='jdupont')
+    assert moodle.identity(plain) == (None, None, ('name', 'jdupont'))
+    from_folder = dict(record('Jane Doe', None, 17.0), folder='Jane Doe._88_assignsubmission_file_')
+    assert moodle.identity(from_folder) == (88, 'Jane Doe._88_assignsubmission_file_', ('participant', 88))

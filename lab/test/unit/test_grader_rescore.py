@@ -29,3 +29,14 @@ def test_rescore_applies_todays_rubric_to_the_kept_measurements(tmp_path, monkey
     assert (tmp_path / 'grades.csv').is_file()
     grade_md = (tmp_path / 'late' / 'grade.md').read_text()
     assert 'Rescored by the grader' in grade_md and 'Before: 17 / 17 (graded)' in grade_md
+
+
+def test_a_student_the_grader_could_not_grade_keeps_its_participant(tmp_path, monkeypatch):
+    """Its hand.csv row and worksheet row are keyed by the participant number like everyone's."""
+    def fails(*args, **kwargs):
+        raise RuntimeError('a grader bug')
+    monkeypatch.setattr(runner, 'grade_submission', fails)
+    record = runner.grade_student('Jane Doe', str(tmp_path / 'Jane Doe._1001_assignsubmission_file_'), str(tmp_path))
+    assert record['status'] == 'not graded' and 'a grader bug' in ' '.join(record['for_the_teacher'])
+    assert (record['participant'], record['folder']) == (1001, 'Jane Doe._1001_assignsubmission_file_')
+    assert json.loads((tmp_path / 'Jane Doe' / 'grade.json').read_text())['participant'] == 1001

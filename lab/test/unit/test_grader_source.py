@@ -58,7 +58,8 @@ def test_reports(tmp_path):
     report.write_grade(str(tmp_path), record)
     report.write_csv(str(tmp_path / 'grades.csv'), [record])
     rows = (tmp_path / 'grades.csv').read_text().splitlines()
-    assert rows[0].startswith('student,sheet,status,runs,Q10,Q11') and rows[1].startswith('Ann,altitude,graded,2,1,0')
+    assert rows[0].startswith('student,participant,sheet,status,runs,Q10,Q11') and \
+        rows[1].startswith('Ann,,altitude,graded,2,1,0')
     assert 'Ann' in report.table([record]) and report.evidence_lines(record)[0].startswith('Q10 1/2')
 
 

@@ -534,9 +534,11 @@ def _staged_work(prefix, sources, parent=None):
     return work, staged
 
 
-def class_students(class_path, work_dirs, scratch=None):
+def class_students(class_path, work_dirs, scratch=None, out=None):
     """``[(student, folder or archive)]`` of a class, each name unique (``Jane Doe``, ``Jane Doe_2``):
-    the students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`). A
+    the students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`); with
+    ``out``, the folder of an earlier run of the class, each student keeps the name (the folder in OUT)
+    that run gave its participant number (:func:`kept_folders`). A
     folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.boxed.unpack.list_students`
     opens no file of a folder); an archive is unpacked by :mod:`exam_lab.grader.boxed.intake` in a box of
     its own (INTAKE_BOUNDS), in a work folder made in ``scratch`` (default: the system's temp folder) and
@@ -546,7 +548,7 @@ def class_students(class_path, work_dirs, scratch=None):
     """
     class_path = os.path.abspath(class_path)
     if not os.path.isfile(class_path):
-        return _unique(unpack.list_students(class_path, None))
+        return _unique(unpack.list_students(class_path, None), kept_folders(out))
     if scratch:
         os.makedirs(scratch, mode=0o711, exist_ok=True)
     work, (staged,) = _staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch)
@@ -565,18 +567,58 @@ def class_students(class_path, work_dirs, scratch=None):
         if os.path.realpath(path) != os.path.normpath(path) or not os.path.lexists(path):
             raise unpack.UnpackError('the intake named %s, which is a link or missing' % student['path'])
         students.append((student['name'], path))
-    return _unique(students)
+    return _unique(students, kept_folders(out))
 
 
-def _unique(students):
-    named, seen = [], set()
-    for name, folder in students:
-        unique, n = name, 2
-        while unique in seen:
-            unique, n = '%s_%d' % (name, n), n + 1
-        seen.add(unique)
-        named.append((unique, folder))
-    return named
+def kept_folders(out):
+    """``{participant number: folder name}`` of the students an earlier run graded into ``out`` (from
+    each folder's measurements.json, else its grade.json; written by the grader, never by a box)."""
+    kept = {}
+    if not out or not os.path.isdir(out):
+        return kept
+    for name in sorted(os.listdir(out)):
+        for kept_file in (MEASUREMENTS, 'grade.json'):
+            path = os.path.join(out, name, kept_file)
+            if not os.path.isfile(path):
+                continue
+            try:
+                with open(path) as f:
+                    facts = json.load(f)
+            except (OSError, ValueError):
+                continue
+            facts = facts.get('extra', {}) if kept_file == MEASUREMENTS else facts
+            number = facts.get('participant')
+            if number is None:
+                number = moodle.participant_number(str(facts.get('folder') or ''))
+            if isinstance(number, int):
+                kept.setdefault(number, name)
+            break
+    return kept
+
+
+def _unique(students, kept=None):
+    """Each student's name made unique (``Jane Doe``, ``Jane Doe_2``): it is the student's folder in
+    OUT. A participant that ``kept`` (:func:`kept_folders`) gives a folder keeps it, and no other
+    student takes a folder of OUT that is a participant's: a classmate whose name cleans to the same
+    (``Jane Doe.``) submitting late never takes the first one's folder, its kept measurements or its
+    row (the rows of hand.csv and the worksheet are keyed by the number anyway)."""
+    kept = kept or {}
+    held = set(kept.values())
+    named, seen = [None] * len(students), set()
+    for index, (name, folder) in enumerate(students):
+        previous = kept.get(moodle.participant_number(os.path.basename(folder.rstrip('/'))))
+        if previous is not None and previous not in seen and \
+                (previous == name or re.match(r'^%s_\d+$' % re.escape(name), previous)):
+            named[index] = previous
+            seen.add(previous)
+    for index, (name, _) in enumerate(students):
+        if named[index] is None:
+            unique, n = name, 2
+            while unique in seen or unique in held:
+                unique, n = '%s_%d' % (name, n), n + 1
+            named[index] = unique
+            seen.add(unique)
+    return [(named[index], folder) for index, (_, folder) in enumerate(students)]
 
 
 def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
@@ -590,6 +632,8 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
     except Exception as err:  # anything: this student's row says so, the class goes on
         record = could_not_grade(name, sheet, '%r' % err,
                                  ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
+        moodle_name = os.path.basename(os.path.abspath(folder).rstrip('/'))
+        record.update(participant=moodle.participant_number(moodle_name), folder=moodle_name)  # who, even so
         try:
             report.write_grade(os.path.join(out_dir, name), record)
         except OSError:
@@ -672,7 +716,7 @@ def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progre
     jobs = jobs or default_jobs()
     work_dirs = []
     try:
-        students = class_students(class_path, work_dirs)
+        students = class_students(class_path, work_dirs, out=out_dir)
         underlay = ensure_underlay(default_underlay())
         isolate = can_isolate() if isolate is None else isolate
         records = [None] * len(students)

@@ -331,7 +331,7 @@ def grade_class(class_path, out_dir, sheet=None, progress=None, unsandboxed=Fals
     for folder in ('results', 'logs'):
         os.makedirs(os.path.join(base, folder))
     say = progress.say if progress else (lambda line: None)
-    students = runner.class_students(class_path, os.path.join(base, 'class'))
+    students = runner.class_students(class_path, os.path.join(base, 'class'), out=out_dir)
     records = []
     if students:
         runner.ensure_underlay(runner.default_underlay())  # here, once, rather than by the first tasks at once

@@ -8,14 +8,24 @@ row ``(max)`` with each column's maximum. The teacher fills it in any spreadshee
 read as well as a point) and saves it as CSV; :func:`combine` then adds the two.
 
 Nothing the teacher wrote is ever lost: writing ``hand.csv`` again (a second run, a rescore) keeps
-every row and cell already there, updates only the machine's column and adds rows for new students.
-An empty cell is a point not given yet, never a 0: :func:`combine` lists it as missing.
+every row and cell already there, updates only the machine's columns (and the name shown) and adds
+rows for new students. An empty cell is a point not given yet, never a 0: :func:`combine` lists it as
+missing.
+
+A row is the student's by Moodle's participant number where the class has one (the ``participant``
+column, from the "download all submissions" name: :func:`exam_lab.grader.publish.moodle.identity`),
+by the name only where there is none; the name is shown, never matched, so two students whose names
+clean to the same (``Jane Doe`` and ``Jane Doe.``), or who really share a name, never share or swap a
+row, even when a late submission renames one of them. :func:`match` gives each graded student its row
+and stops at a row that could be another student's (both named). Every cell is written as one no
+spreadsheet runs and read back as it was (:mod:`~exam_lab.grader.publish.cells`).
 """
 import collections
 import csv
 import io
 import os
 
+from exam_lab.grader.publish import cells, moodle
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 
 FILE = 'hand.csv'
@@ -25,11 +35,24 @@ COLUMNS = ['student', 'participant', 'sheet', 'machine'] + list(HAND_ITEMS) + ['
 MACHINE_MAX = sum(points for points, _ in ITEMS.values())
 HAND_MAX = sum(points for points, _ in HAND_ITEMS.values())
 
-Hand = collections.namedtuple('Hand', 'student points remark')
+#: One row of hand.csv: ``participant`` (int or None) and ``line`` say which row it is.
+Hand = collections.namedtuple('Hand', 'student points remark participant line')
+Hand.__new__.__defaults__ = (None, None)
 
 
 class HandError(Exception):
     """hand.csv cannot be read as the teacher meant it: every problem, with its line and column."""
+
+
+def key(record):
+    """What a grade record's row in hand.csv is keyed by: its participant number (an int) where it
+    has one, else its name (a str)."""
+    who = moodle.identity(record)
+    return who.participant if who.participant is not None else record['student']
+
+
+def _who(key_):
+    return 'participant %d' % key_ if isinstance(key_, int) else key_
 
 
 def _points(x):
@@ -47,51 +70,96 @@ def _rows(path):
     """The rows of an existing hand.csv as dicts (a spreadsheet may add a BOM or use ';')."""
     with open(path, newline='', encoding='utf-8-sig') as f:
         text = f.read()
-    try:
-        dialect = csv.Sniffer().sniff(text.split('\n', 1)[0], delimiters=',;\t')
+    try:  # only the delimiter: a header without quotes makes the sniffer turn doubled quotes off
+        delimiter = csv.Sniffer().sniff(text.split('\n', 1)[0], delimiters=',;\t').delimiter
     except csv.Error:
-        dialect = csv.excel
-    reader = csv.DictReader(io.StringIO(text), dialect=dialect)
+        delimiter = ','
+    reader = csv.DictReader(io.StringIO(text), delimiter=delimiter)
     missing = [c for c in ['student'] + list(HAND_ITEMS) if c not in (reader.fieldnames or [])]
     if missing:
         raise HandError('%s: no column %s (the header must keep the names make grade wrote: %s)'
                         % (path, ', '.join(missing), ', '.join(COLUMNS)))
-    return [(number, row) for number, row in enumerate(reader, start=2)]
+    return [(number, {name: cells.read_cell(value) if isinstance(value, str) else value
+                      for name, value in row.items()})
+            for number, row in enumerate(reader, start=2)]
+
+
+def _row_key(line, row):
+    """The key of a row of hand.csv (see :func:`key`); HandError for a participant that is no number."""
+    number = (row.get('participant') or '').strip()
+    if not number:
+        return (row.get('student') or '').strip()
+    if not number.isdigit():
+        raise HandError('line %d (%s), column participant: %r is not a participant number (Moodle\'s, from the '
+                        'submission\'s folder): leave it as make grade wrote it' % (line, row.get('student'), number))
+    return int(number)
+
+
+def _kept_rows(path):
+    """``{key: (line, row)}`` of an existing hand.csv, in its order; HandError for a student twice."""
+    kept, problems = collections.OrderedDict(), []
+    for line, row in _rows(path):
+        name = (row.get('student') or '').strip()
+        if not name or name == MAX_ROW:
+            continue
+        try:
+            found = _row_key(line, row)
+        except HandError as err:
+            problems.append(str(err))
+            continue
+        if found in kept:
+            problems.append('line %d: %s is already on another line (line %d)' % (
+                line, name if isinstance(found, str) else '%s (%s)' % (name, _who(found)), kept[found][0]))
+            continue
+        kept[found] = (line, row)
+    if problems:
+        raise HandError('%s:\n  %s' % (path, '\n  '.join(problems)))
+    return kept
+
+
+def _unique_keys(records):
+    """HandError when two records are one student (two folders of OUT with one participant number)."""
+    seen, problems = {}, []
+    for record in records:
+        found = key(record)
+        if found in seen:
+            problems.append('%s and %s are both %s (two folders of one student in OUT: remove the stale one and '
+                            'run make rescore)' % (seen[found], record['student'], _who(found)))
+        seen.setdefault(found, record['student'])
+    if problems:
+        raise HandError('; '.join(problems))
 
 
 def write(path, records):
-    """Write ``hand.csv`` for ``records`` (grade records), keeping what the teacher already filled.
+    """Write ``hand.csv`` for ``records`` (grade records), keeping what the teacher already filled:
+    each record's row is found by its :func:`key`, never by its name.
 
     :returns: how many students were added.
+    :raises HandError: the existing file holds a student twice or a participant that is no number, or
+        two records are one participant (nothing is written then).
     """
-    kept, order = {}, []
-    if os.path.isfile(path):
-        for _, row in _rows(path):
-            name = (row.get('student') or '').strip()
-            if name and name != MAX_ROW and name not in kept:
-                kept[name] = row
-                order.append(name)
+    _unique_keys(records)
+    kept = _kept_rows(path) if os.path.isfile(path) else collections.OrderedDict()
+    rows = collections.OrderedDict((found, row) for found, (_, row) in kept.items())
     added = 0
     for record in records:
-        name = record['student']
-        row = kept.get(name)
+        found = key(record)
+        row = rows.get(found)
         if row is None:
-            row = {c: '' for c in COLUMNS}
-            row['student'] = name
-            kept[name] = row
-            order.append(name)
+            row = rows[found] = {c: '' for c in COLUMNS}
             added += 1
-        row['participant'] = '' if record.get('participant') is None else str(record['participant'])
+        row['student'] = record['student']
+        row['participant'] = '' if not isinstance(found, int) else str(found)
         row['sheet'] = record.get('sheet', '')
         row['machine'] = _points(record['total'])
-    columns = COLUMNS + sorted({c for row in kept.values() for c in row if c and c not in COLUMNS})
+    columns = COLUMNS + sorted({c for row in rows.values() for c in row if c and c not in COLUMNS})
     temporary = path + '.new'
     with open(temporary, 'w', newline='', encoding='utf-8') as f:
         writer = csv.DictWriter(f, columns, extrasaction='ignore')
         writer.writeheader()
         writer.writerow(_max_row())
-        for name in order:
-            writer.writerow({c: kept[name].get(c) or '' for c in columns})
+        for row in rows.values():
+            writer.writerow({c: cells.cell(row.get(c) or '') for c in columns})
     os.replace(temporary, path)
     return added
 
@@ -104,19 +172,19 @@ def _number(text):
 
 
 def read(path):
-    """``{student: Hand}`` from a filled hand.csv; a point not filled in is None.
+    """``{key: Hand}`` from a filled hand.csv (the key: :func:`key`, the participant number where the
+    row has one, else the name); a point not filled in is None.
 
     :raises HandError: with every cell that is not a number between 0 and its item's maximum, and
         every student named twice (nothing is guessed).
     """
     hands, problems = {}, []
-    for line, row in _rows(path):
+    try:
+        kept = _kept_rows(path)
+    except HandError as err:
+        kept, problems = {}, [str(err).split(':\n  ', 1)[-1]]
+    for found, (line, row) in kept.items():
         name = (row.get('student') or '').strip()
-        if not name or name == MAX_ROW:
-            continue
-        if name in hands:
-            problems.append('line %d: %s is already on another line' % (line, name))
-            continue
         points = collections.OrderedDict()
         for item, (top, _) in HAND_ITEMS.items():
             cell = (row.get(item) or '').strip()
@@ -125,10 +193,53 @@ def read(path):
                 problems.append('line %d (%s), column %s: %r is not a number from 0 to %s'
                                 % (line, name, item, cell, _points(top)))
             points[item] = value
-        hands[name] = Hand(name, points, (row.get('remark') or '').strip())
+        hands[found] = Hand(name, points, (row.get('remark') or '').strip(),
+                            found if isinstance(found, int) else None, line)
     if problems:
         raise HandError('%s:\n  %s' % (path, '\n  '.join(problems)))
     return hands
+
+
+def match(hands, records):
+    """Each record's row of hand.csv, by its :func:`key` only.
+
+    :param hands: :func:`read`'s answer.
+    :returns: ``(rows, notes)``: ``rows`` the :class:`Hand` of each record, in order (None when it has
+        no row yet), ``notes`` lines for the teacher (a row whose shown name is not the student's
+        name today; a row no graded student has).
+    :raises HandError: a row whose participant no longer matches: a row with a participant number no
+        graded student has, shown with the name of a graded student who is another participant, or
+        a row with no number shown with the name of a student who has one. Its points could be that
+        student's or not: both are named, nothing is guessed. Also two records of one participant.
+    """
+    _unique_keys(records)
+    by_key = {key(record): record for record in records}
+    by_name = {}
+    for record in records:
+        by_name.setdefault(record['student'], []).append(record)
+    problems, notes = [], []
+    for found, row in sorted(hands.items(), key=lambda item: item[1].line or 0):
+        record = by_key.get(found)
+        if record is not None:
+            if record['student'] != row.student:
+                notes.append('hand.csv line %s: %s is shown as %s there and graded as %s today: its points are '
+                             '%s\'s' % (row.line, _who(found), row.student, record['student'], _who(found)))
+            continue
+        others = [r for r in by_name.get(row.student, []) if key(r) != found]
+        if others:
+            other = others[0]
+            problems.append('hand.csv line %s (%s, %s) and the graded student %s (%s, folder %s) share the name '
+                            'but not the participant: the row is not that student\'s. Put the participant '
+                            'number of the student the points are for on line %s (or empty the row), then run '
+                            'this again' % (row.line, row.student, _who(found) if isinstance(found, int) else
+                                            'no participant number', other['student'], _who(key(other)),
+                                            other.get('folder') or '-', row.line))
+        elif any(v is not None for v in row.points.values()) or row.remark:
+            notes.append('hand.csv line %s: %s (%s) is no graded student of this run: its points are not used'
+                         % (row.line, row.student, _who(found)))
+    if problems:
+        raise HandError('\n  '.join(problems))
+    return [hands.get(key(record)) for record in records], notes
 
 
 def combine(record, hand):

@@ -18,9 +18,11 @@ So the filled copy changes only the grade and the feedback cells of the rows it 
 everything else (the mark, the quoting of every other cell, the line ends), and leaves a grade or a
 feedback already in the worksheet as it was (a teacher's grade wins over the machine's).
 """
+import collections
 import html
 import re
 
+from exam_lab.grader.publish import cells
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 
@@ -28,13 +30,33 @@ from exam_lab.grader.score.sheets import ITEMS
 _FOLDER_NUMBER = re.compile(r'_(\d+)_assign(?:submission|feedback)_')
 #: A cell of the identifier column: Moodle's word for participant (any language), then the number.
 _IDENTIFIER = re.compile(r'^\D*?(\d+)$')
-#: Column headers by language (Moodle's strings; en first).
-IDENTIFIER_HEADERS = ('Identifier', 'Identifiant', 'ID', 'Identificador', 'Identificativo')
-GRADE_HEADERS = ('Grade', 'Note', 'Bewertung', 'Calificación', 'Nota', 'Voto', 'Cijfer')
-MAX_GRADE_HEADERS = ('Maximum grade', 'Note maximale', 'Bestwertung', 'Calificación máxima')
-FEEDBACK_HEADERS = ('Feedback comments', 'Commentaires de feedback', 'Commentaires',
-                    'Feedback als Kommentar', 'Comentarios de retroalimentación')
-NAME_HEADERS = ('Full name', 'Nom complet', 'Vollständiger Name', 'Nombre completo')
+#: Moodle's own headers of the worksheet, as ``get_string`` gives them in each language (matched
+#: case-insensitively: Moodle's English ``maxgrade`` is defined twice in
+#: ``mod/assign/lang/en/assign.php``, ``'Maximum grade'`` then ``'Maximum Grade'``, and PHP keeps the
+#: later one, while AMOS's English pack has the first). Which string heads which column:
+#: ``mod/assign/gradingtable.php`` (download mode): ``recordid`` (assign), ``fullname`` (core),
+#: ``grade``/``gradenoun`` (core), ``maxgrade`` or ``scale`` (assign), ``lastmodifiedgrade`` (assign),
+#: each feedback plugin's editor field: ``pluginname`` of ``assignfeedback_comments``. The importer
+#: (``mod/assign/feedback/offline/importgradeslib.php``) finds the identifier, grade, last-modified
+#: and feedback columns by the same strings, exactly.
+#: Sources: en: moodle/moodle at 0085741f (mod/assign/lang/en/assign.php) and 7fceae55
+#: (mod/assign/feedback/comments/lang/en/assignfeedback_comments.php); fr, de, es, it, nl: Moodle's
+#: language packs from AMOS as kept in projectestac/moodle-langpacks at 6340d351 (2026-06-18, packs of
+#: Moodle 4.5: <lang>/assign.php, <lang>/moodle.php, <lang>/assignfeedback_comments.php; the same
+#: strings in its packs of 3.8, 3.11, 4.1 and 4.4). Only English has two spellings of one string.
+HEADERS = {
+    'identifier': ('Identifier', 'Identifiant', 'ID', 'Identificador', 'Identificativo', 'Identificatie'),
+    'name': ('Full name', 'Nom complet', 'Vollständiger Name', 'Nombre completo', 'Nome', 'Volledige naam'),
+    'grade': ('Grade', 'Note', 'Bewertung', 'Calificación', 'Valutazione', 'Cijfer'),
+    'maximum': ('Maximum Grade', 'Maximum grade', 'Note maximale', 'Bestwertung', 'Calificación máxima',
+                'Valutazione massima', 'Maximaal cijfer'),
+    'scale': ('Scale', 'Barème', 'Skala', 'Escala', 'Scala', 'Schaal'),
+    'modified': ('Last modified (grade)', 'Dernière modification (note)', 'Zuletzt geändert (Bewertung)',
+                 'Última modificación (calificación)', 'Ultima modifica (valutazione)',
+                 'Laatst gewijzigd (beoordeling)'),
+    'feedback': ('Feedback comments', 'Feedback par commentaires', 'Feedback als Kommentar',
+                 'Comentarios de retroalimentación', 'Commenti', 'Feedback tekstvak'),
+}
 #: Statuses whose points go into the grade column (the others wait for the teacher).
 GRADED = ('graded', 'graded with fixes')
 _BOM = '\ufeff'
@@ -65,6 +87,32 @@ def participant_number(name):
     """The participant's unique id in a Moodle "download all submissions" name, or None."""
     match = _FOLDER_NUMBER.search(name + '_' if not name.endswith('_') else name)
     return int(match.group(1)) if match else None
+
+
+#: Who a grade record is (:func:`identity`).
+Identity = collections.namedtuple('Identity', 'participant folder key')
+_MOODLE_FOLDER = re.compile(r'^(.*?_\d+_assign(?:submission|feedback)_[a-z]+_)')
+
+
+def identity(record):
+    """Who a grade record is, for everything kept across runs and everything sent back to Moodle.
+
+    :returns: :class:`Identity`: ``participant``, Moodle's participant number (the record's, read from
+        the "download all submissions" name) or None; ``folder``, the name Moodle gave the student's
+        folder in that zip (``Jane Doe_1234567_assignsubmission_file_``; for a flat download, the same
+        prefix of the file's name) or None when the name is not Moodle's; ``key``, what identifies the
+        student across runs: ``('participant', 1234567)`` where there is a number, else ``('name',
+        student)``. The student's name is for display only where there is a number: two students with
+        the same or nearly the same name (``Jane Doe`` and ``Jane Doe.``, both cleaned to ``Jane Doe``)
+        have two keys.
+    """
+    number = record.get('participant')
+    name = record.get('folder') or ''
+    if number is None:
+        number = participant_number(name)
+    match = _MOODLE_FOLDER.match(name) if number is not None else None
+    folder = match.group(1) if match and participant_number(match.group(1)) == number else None
+    return Identity(number, folder, ('participant', number) if number is not None else ('name', record['student']))
 
 
 def parse(text):
@@ -132,20 +180,42 @@ def quoted(value):
     return value
 
 
-def _column(header, names, what):
-    for name in names:
-        if name in header:
-            return header.index(name)
-    raise WorksheetError('no %s column (looked for %s) in the header: %s. Moodle names the columns in the '
-                         'language of its interface: switch it to English and download the worksheet again'
-                         % (what, ', '.join(repr(n) for n in names), ', '.join(header)))
+def _find(header, what):
+    """The index of the column ``what`` (a key of :data:`HEADERS`) in ``header``, or None: Moodle's
+    string in any language, whatever its case and the spaces around it."""
+    names = {name.casefold() for name in HEADERS[what]}
+    found = [i for i, cell in enumerate(header) if cell.strip().casefold() in names]
+    return found[0] if found else None
+
+
+def _column(header, what, label):
+    index = _find(header, what)
+    if index is None:
+        raise WorksheetError('no %s column (looked for %s, in any case) in the header: %s. Moodle names the '
+                             'columns in the language of its interface: switch it to English and download the '
+                             'worksheet again' % (label, ', '.join(repr(n) for n in HEADERS[what]),
+                                                  ', '.join(header)))
+    return index
+
+
+def _maximum_column(header):
+    """The "Maximum grade" column: without it the grade's scale is unknown, so nothing is written
+    (never a total out of 17 or 30 into a column out of 20 without a word)."""
+    index = _find(header, 'maximum')
+    if index is not None:
+        return index
+    if _find(header, 'scale') is not None:
+        raise WorksheetError('the assignment is graded on a scale (the worksheet has a %r column, no maximum '
+                             'grade): the grader writes points; give the assignment a point grade (Type: Point) '
+                             'and download the worksheet again' % header[_find(header, 'scale')])
+    _column(header, 'maximum', 'maximum grade')
 
 
 def _identifier_column(header, rows):
     """The identifier column by its header, else the one column whose every cell is a word and a
     number (``Participant 12``, ``Teilnehmer/in 12``) in any language."""
     try:
-        return _column(header, IDENTIFIER_HEADERS, 'identifier')
+        return _column(header, 'identifier', 'identifier')
     except WorksheetError:
         found = [i for i in range(len(header)) if rows and all(
             len(fields) == len(header) and re.match(r'^\D+\s?\d+$', fields[i][1].strip()) for fields, _ in rows)]
@@ -156,7 +226,7 @@ def _identifier_column(header, rows):
 
 def _feedback_column(header):
     try:
-        return _column(header, FEEDBACK_HEADERS, 'feedback comments')
+        return _column(header, 'feedback', 'feedback comments')
     except WorksheetError:
         found = [i for i, h in enumerate(header) if 'comment' in h.lower()]
         if len(found) == 1:
@@ -219,10 +289,16 @@ def fill(text, records, scale=False):
     comment say so when the worksheet's "Maximum grade" is another (20, Moodle's default 100); with
     ``scale`` they are scaled to that maximum instead (the teacher's choice, never silent either).
 
+    A row is the participant's: a record is matched by its participant number only (never by name),
+    and a number two records claim (two folders of one participant in OUT) fills neither row. Every
+    other cell a student chose (the full name, the email, a group, an online text) is made one no
+    spreadsheet runs (:mod:`~exam_lab.grader.publish.cells`); Moodle's importer reads none of them.
+
     :returns: ``(filled text, summary)``; summary: ``graded`` [(student, participant, points)],
         ``kept`` [(student, why)] (rows matched but left as they were), ``unmatched`` [(student, why)],
         ``no_submission`` [row names of the worksheet no record matched].
-    :raises WorksheetError: the file lacks a column the import needs, or a row is malformed.
+    :raises WorksheetError: the file lacks a column the import needs (the maximum grade among them:
+        without it the grade's scale is unknown), or a row is malformed.
     """
     bom = text.startswith(_BOM)
     body = text[1:] if bom else text
@@ -232,26 +308,41 @@ def fill(text, records, scale=False):
         raise WorksheetError('the worksheet is empty')
     header = [value.strip() for _, value in rows[0][0]]
     ident = _identifier_column(header, rows[1:])
-    grade = _column(header, GRADE_HEADERS, 'grade')
+    grade = _column(header, 'grade', 'grade')
+    maximum = _maximum_column(header)
+    modified = _column(header, 'modified', 'last modified (grade)')  # Moodle's importer refuses a file without it
     comments = _feedback_column(header)
-    names = next((header.index(n) for n in NAME_HEADERS if n in header), None)
-    maximum = next((header.index(n) for n in MAX_GRADE_HEADERS if n in header), None)
+    names = _find(header, 'name')
+    read_by_moodle = (ident, grade, maximum, modified, comments)
     by_number = {}
     for fields, _ in rows[1:]:
         if len(fields) != len(header):
             raise WorksheetError('a row has %d fields, the header %d (Moodle refuses such a file): %s'
                                  % (len(fields), len(header), ','.join(raw for raw, _ in fields)[:200]))
+        for column, field in enumerate(fields):
+            if column not in read_by_moodle and cells.needs_quote(field[1]):
+                field[:] = [quoted(cells.cell(field[1])), cells.cell(field[1])]
         match = _IDENTIFIER.match(fields[ident][1].strip())
         if match:
             by_number[int(match.group(1))] = fields
     summary = {'graded': [], 'kept': [], 'unmatched': [], 'no_submission': [], 'maxima': [], 'scaled': scale,
                'machine_max': []}
     matched = set()
+    claims = {}
+    for record in records:
+        if record.get('participant') is not None:
+            claims.setdefault(record['participant'], []).append(record['student'])
     for record in records:
         number = record.get('participant')
         student = record['student']
         if number is None:
             summary['unmatched'].append((student, 'no participant number in the submission\'s name'))
+            continue
+        if len(claims[number]) > 1:
+            matched.add(number)
+            summary['unmatched'].append((student, 'participant %d is also %s\'s: two folders of OUT claim one '
+                                         'participant, neither is written' % (
+                                             number, ' and '.join(s for s in claims[number] if s != student))))
             continue
         fields = by_number.get(number)
         if fields is None:
@@ -268,21 +359,21 @@ def fill(text, records, scale=False):
         if fields[grade][1].strip() or fields[comments][1].strip():
             summary['kept'].append((student, 'the worksheet already has a grade or a feedback for it'))
             continue
-        top = fields[maximum][1].strip() if maximum is not None else ''
+        top = fields[maximum][1].strip()
         comma = ',' in top and '.' not in top
         top_value = _number(top) if top else None
-        if top_value is not None and top_value not in summary['maxima']:
-            summary['maxima'].append(top_value)
-        if scale and top_value is None:
-            summary['kept'].append((student, 'no maximum grade in the worksheet to scale to'))
+        if top_value is None or top_value <= 0:
+            summary['kept'].append((student, 'its maximum grade %r is not a number above 0' % top))
             continue
+        if top_value not in summary['maxima']:
+            summary['maxima'].append(top_value)
         total = record['total'] * top_value / record['max'] if scale else record['total']
-        if top_value is not None and total > top_value + 1e-9:
+        if total > top_value + 1e-9:
             summary['kept'].append((student, '%s points exceed the maximum grade %s' % (record['total'], top)))
             continue
         points = _points(round(total, 2), comma)
         fields[grade][:] = [quoted(points), points]
-        note = feedback(record, top_value, points if scale else None)
+        note = cells.cell(feedback(record, top_value, points if scale else None))
         fields[comments][:] = [quoted(note), note]
         summary['graded'].append((student, number, points))
         if record['max'] not in summary['machine_max']:

@@ -9,6 +9,7 @@ import csv
 import json
 import os
 
+from exam_lab.grader.publish import cells
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS, SHEETS
 
@@ -95,16 +96,18 @@ def write_grade(out_dir, record):
 
 
 def write_csv(path, records):
-    """grades.csv: one row per student, each item's points, the total."""
+    """grades.csv: one row per student (its Moodle participant number beside the name, the key that
+    stays when names clash), each item's points, the total; every cell one no spreadsheet runs
+    (:mod:`~exam_lab.grader.publish.cells`)."""
     with open(path, 'w', newline='') as f:
         writer = csv.writer(f)
-        writer.writerow(['student', 'sheet', 'status'] + list(ITEMS) + ['total', 'max'])
+        writer.writerow(['student', 'participant', 'sheet', 'status'] + list(ITEMS) + ['total', 'max'])
         for record in records:
             points = {e['id']: e['points'] for e in record['items']}
-            writer.writerow([safe_text.one_line(record['student']), record['sheet'],
-                             safe_text.one_line(record.get('status', 'graded'))] +
-                            [_points(points.get(i, 0)) for i in ITEMS] +
-                            [_points(record['total']), _points(record['max'])])
+            writer.writerow(cells.row([safe_text.one_line(record['student']), record.get('participant'),
+                                       record['sheet'], safe_text.one_line(record.get('status', 'graded'))] +
+                                      [_points(points.get(i, 0)) for i in ITEMS] +
+                                      [_points(record['total']), _points(record['max'])]))
 
 
 def table(records):
