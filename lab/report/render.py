@@ -263,8 +263,9 @@ def facts(work, repo, outputs):
     v['model.err_1500'] = fmt(analysis.isothermal_error(1500.0))
     v['model.err_3000'] = fmt(analysis.isothermal_error(3000.0))
     v['model.true_at_threshold'] = fmt(analysis.true_altitude_read_as(flight['threshold']))
-    v['model.mean_t_1300'] = '%.2f' % analysis.mean_temperature_error(1300.0)
-    v['model.mean_t_3000'] = '%.1f' % analysis.mean_temperature_error(3000.0)
+    # Two significant digits each: 0.097 and 1.3, not 0.10 beside 1.3 (one precision for both).
+    v['model.mean_t_1300'] = '%.2g' % analysis.mean_temperature_error(1300.0)
+    v['model.mean_t_3000'] = '%.2g' % analysis.mean_temperature_error(3000.0)
     v['model.t_1300'] = '%.2f' % atmosphere.temperature_c(1300.0)
     v['model.p_1300'] = '%.0f' % atmosphere.pressure_pa(1300.0)
     # Rounding only: the bound, a power of ten, rather than digits that change with the sampling.

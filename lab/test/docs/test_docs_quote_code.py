@@ -216,3 +216,42 @@ def test_the_launch_arguments_quoted_in_architecture_are_the_files():
     sentence = re.search(r'`exam/launch/exam\.launch` has (.*?);', text, re.S).group(1)
     quoted = dict(re.findall(r'`(\w+)` \(`?([\w.]+)`?\)', sentence))
     assert quoted == declared
+
+
+# --- console excerpts ------------------------------------------------------------------------------
+
+def console_block_problems(text):
+    """What is wrong with the console block of lab/report/console_excerpt.py in a document: [] when it
+    is whole (lines A to B, B - A + 1 lines, unedited: nothing cut with "..."), dated and at a commit."""
+    begin = text.find('<!-- console: written by lab/report/console_excerpt.py')
+    end = text.find('<!-- end of console -->')
+    if begin < 0 or end < begin:
+        return ['no console block between its markers']
+    block = text[begin:end]
+    head = re.search(r'Lines (\d+) to (\d+) of the launch\'s console, unedited, in the run of '
+                     r'(\d{4}-\d\d-\d\d \d\d:\d\d UTC) at commit ([0-9a-f]{7,40})', block)
+    if head is None:
+        return ['the block does not say which lines, which run and which commit']
+    lines = block.split('```')[1].strip('\n').splitlines() if block.count('```') >= 2 else []
+    problems = []
+    if len(lines) != int(head.group(2)) - int(head.group(1)) + 1:
+        problems.append('lines %s to %s are %d lines, the block shows %d'
+                        % (head.group(1), head.group(2), int(head.group(2)) - int(head.group(1)) + 1, len(lines)))
+    problems += ['a line is cut: %s' % line for line in lines if line.rstrip().endswith('...')]
+    problems += ['not a log line: %s' % line for line in lines if not re.match(r'\[(INFO|WARN|ERROR)\] \[\d+\.\d+\]: ', line)]
+    return problems
+
+
+def test_the_master_restart_console_is_a_whole_run_of_its_test():
+    assert console_block_problems(read(os.path.join(REPO, 'docs', 'operations.md'))) == []
+
+
+def test_the_console_check_catches_a_cut_or_typed_excerpt():
+    head = ("<!-- console: written by lab/report/console_excerpt.py x -->\nLines 3 to 4 of the launch's console, "
+            "unedited, in the run of 2026-11-26 18:22 UTC at commit 08d9b3cb88dd:\n\n```\n")
+    whole = head + '[INFO] [1.5]: a\n[WARN] [2.5]: b\n```\n<!-- end of console -->'
+    assert console_block_problems(whole) == []
+    assert console_block_problems(whole.replace('[WARN] [2.5]: b', '[WARN] [2.5]: b; ...')) == [
+        'a line is cut: [WARN] [2.5]: b; ...']
+    assert len(console_block_problems(whole.replace('[INFO] [1.5]: a\n', ''))) == 1
+    assert console_block_problems('no block') == ['no console block between its markers']
