@@ -255,3 +255,69 @@ def test_the_console_check_catches_a_cut_or_typed_excerpt():
         'a line is cut: [WARN] [2.5]: b; ...']
     assert len(console_block_problems(whole.replace('[INFO] [1.5]: a\n', ''))) == 1
     assert console_block_problems('no block') == ['no console block between its markers']
+
+
+# --- the PDF a student copies from -----------------------------------------------------------------
+
+#: DejaVu Sans Mono's advance width, in em (1233 of 2048 units): every character of a code line.
+MONO_EM = 1233 / 2048.0
+#: A CSS px in pt.
+PX = 0.75
+
+
+def code_columns(css):
+    """How many characters of a code line fit across an answer box of the PDF, from report.css: the
+    A4 page less its margins, the block quote's border and padding, the box's padding and border."""
+    def number(pattern):
+        return float(re.search(pattern, css, re.S).group(1))
+    margins = re.search(r'@page \{ size: A4; margin: [\d.]+mm ([\d.]+)mm [\d.]+mm ([\d.]+)mm', css).groups()
+    width_pt = (210.0 - float(margins[0]) - float(margins[1])) / 25.4 * 72.0
+    quote = number(r'blockquote \{ border-left: (\d+)px') + 2 * number(r'blockquote \{[^}]*padding: \d+px (\d+)px')
+    box = 2 * number(r'\npre \{[^}]*padding: \d+px (\d+)px') + 2 * number(r'\npre \{[^}]*border: (\d+)px')
+    font = number(r'pre code \{ font-size: ([\d.]+)pt')
+    return int((width_pt - (quote + box) * PX) / (font * MONO_EM))
+
+
+def code_lines(markdown):
+    """Every line of the code fences (python, xml, cmake) of a Markdown text, quote marks removed."""
+    lines, language = [], None
+    for line in markdown.splitlines():
+        bare = re.sub(r'^(> ?)+', '', line)
+        fence = re.match(r'```(\w*)', bare)
+        if fence:
+            language = None if language is not None else fence.group(1)
+            continue
+        if language in ('python', 'xml', 'cmake'):
+            lines.append(bare)
+    return lines
+
+
+def test_no_code_line_of_the_report_is_wider_than_its_box():
+    css = read(os.path.join(REPO, 'lab', 'report', 'report.css'))
+    assert re.search(r'pre\.python[^{]*\{ white-space: pre;', css), 'report.css wraps code'
+    columns = code_columns(css)
+    assert 100 <= columns <= 200, columns
+    report = read(os.path.join(REPO, 'docs', 'report.md'))
+    wide = [line for line in code_lines(report) if len(line) > columns]
+    assert wide == [], '%d code lines wider than the %d columns of a box' % (len(wide), columns)
+
+
+def test_no_code_is_set_side_by_side():
+    # A code box in a half-width column wraps: render.py stacks the two sheets' code.
+    report = read(os.path.join(REPO, 'docs', 'report.md'))
+    for cell in re.findall(r'<td>(.*?)</td>', report, re.S):
+        assert not re.search(r'```(python|xml|cmake)', cell), cell[:200]
+
+
+def test_the_code_width_check_catches_a_long_line():
+    assert code_lines('> ```python\n> x = 1\n> ```\n```console\n$ y\n```') == ['x = 1']
+    assert code_columns(read(os.path.join(REPO, 'lab', 'report', 'report.css'))) < len('#' * 200)
+
+
+def test_the_report_prints_the_whole_simple_answer():
+    report = read(os.path.join(REPO, 'docs', 'report.md'))
+    appendix = report[report.index('## E. The simple answer, whole'):]
+    for path in ('package.xml', 'CMakeLists.txt', 'scripts/exam_node.py', 'scripts/exam_submarine_node.py',
+                 'launch/exam.launch', 'launch/exam_submarine.launch'):
+        body = read(os.path.join(REPO, 'docs', 'simple_answer', 'exam', path)).rstrip()
+        assert body in appendix, path
