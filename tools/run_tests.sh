@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs the catkin test targets (every package's pytest unit tests and rostests) and prints the summary
-# line `N passed, N failed`; exits non-zero when anything failed or no test ran.
+# line `N passed, N failed, N skipped`; exits non-zero when anything failed or no test ran.
 # Usage: tools/run_tests.sh [catkin target, default run_tests]
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"

@@ -12,7 +12,8 @@ import xml.etree.ElementTree as ET
 
 
 def count_file(path):
-    """Return (passed, failed, skipped, failed_names) for one JUnit file."""
+    """Return (passed, failed, skipped, names): ``names`` holds "FAILED <test>" for each failure and
+    "SKIPPED <test>: <reason>" for each skip, so a test skipped for a missing tool is seen, not only counted."""
     root = ET.parse(path).getroot()
     suites = [root] if root.tag == 'testsuite' else root.iter('testsuite')
     passed = failed = skipped = 0
@@ -23,9 +24,11 @@ def count_file(path):
             label = '%s: %s.%s' % (path.parent.name, case.get('classname'), case.get('name'))
             if case.find('failure') is not None or case.find('error') is not None:
                 failed += 1
-                names.append(label)
+                names.append('FAILED ' + label)
             elif case.find('skipped') is not None:
                 skipped += 1
+                reason = case.find('skipped').get('message') or (case.find('skipped').text or '').strip()
+                names.append('SKIPPED %s: %s' % (label, ' '.join(reason.split())[:200]))
             elif not wrapper:
                 passed += 1
     return passed, failed, skipped, names
@@ -40,13 +43,13 @@ def main(argv):
         try:
             p, f, s, names = count_file(path)
         except ET.ParseError as err:
-            p, f, s, names = 0, 1, 0, ['%s: unreadable result file (%s)' % (path, err)]
+            p, f, s, names = 0, 1, 0, ['FAILED %s: unreadable result file (%s)' % (path, err)]
         totals[0] += p
         totals[1] += f
         totals[2] += s
         failed_names += names
-    for name in failed_names:
-        print('FAILED', name)
+    for name in sorted(failed_names, key=lambda n: not n.startswith('SKIPPED')):
+        print(name)
     if not files:
         print('no test result files under %s' % results)
     print('%d passed, %d failed, %d skipped' % tuple(totals))

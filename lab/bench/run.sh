@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `make bench`: measures the exam node against lab/bench/baseline_exam_node.py and writes
-# docs/benchmarks.md and docs/figures/bench_fleet.png (about 10 minutes, 15 with BENCH_PROFILE=1).
+# docs/benchmarks.md and docs/figures/bench_fleet.png (17 minutes measured with BENCH_PROFILE=1 on two cores
+# on 2026-11-25, before the grader's stage; that stage grades a class of 60 twice, about 40 minutes more).
 #   BENCH_QUICK=1    a few seconds per stage; results go to $EXAM_WS/bench-quick/, docs/ is untouched
 #   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet grader), also to $EXAM_WS/bench-quick/
 #   BENCH_FLEET_SIZES=5,20,50  the fleet sizes of ours (default 1,5,10,20,50,100: 200 nodes and the

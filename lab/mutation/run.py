@@ -15,7 +15,6 @@ Usage: run.py CONFIG KNOWN_MUTANTS OUTDIR [group name ...]
 """
 import ast
 import datetime
-import fnmatch
 import os
 import re
 import shlex
@@ -28,20 +27,7 @@ import toml
 from cosmic_ray.work_db import WorkDB, use_db
 from cosmic_ray.work_item import TestOutcome, WorkerOutcome, WorkResult
 
-
-def group_modules(group):
-    """The .py files of a group: its paths (files or directories), less its excludes, sorted."""
-    found = []
-    for path in group['paths']:
-        if path.endswith('.py'):
-            found.append(path)
-            continue
-        for root, _, files in os.walk(path):
-            found.extend(os.path.join(root, name) for name in files if name.endswith('.py'))
-    excludes = group.get('exclude', [])
-    return sorted(p for p in found
-                  if not any(fnmatch.fnmatch(p, pattern) for pattern in excludes)
-                  and os.path.getsize(p) > 0)
+from scope import group_modules, unmatched
 
 
 def session_config(modules, command, timeout):
@@ -109,24 +95,21 @@ def skip_reason(mutation, rules, lines, formatting):
 def apply_filters(session, modules, rules):
     """Mark the ruled-out mutants of a session as skipped.
 
-    Return ({reason: count}, the patterns of ``definitions`` and ``skip-definitions`` that matched).
+    Return {reason: count}.
     """
     sources = {m: open(m).read().splitlines() for m in modules}
     formatting = {m: string_formatting_spans(m) for m in modules}
     skipped = {}
-    patterns = set(rules['definitions']) | set(rules['skip-definitions'])
-    matched = set()
     with use_db(session, WorkDB.Mode.open) as db:
         for item in list(db.pending_work_items):
             mutation = item.mutations[0]
-            matched |= {p for p in patterns if re.search(p, mutation.definition_name or '')}
             path = str(mutation.module_path)
             reason = skip_reason(mutation, rules, sources[path], formatting[path])
             if reason is not None:
                 skipped[reason] = skipped.get(reason, 0) + 1
                 db.set_result(item.job_id, WorkResult(output='filtered: ' + reason,
                                                       worker_outcome=WorkerOutcome.SKIPPED))
-    return skipped, matched
+    return skipped
 
 
 def cosmic_ray(*args, log=None):
@@ -153,7 +136,7 @@ KINDS = ('equivalent', 'not worth a test')
 
 
 def run_session(name, slug, modules, command, timeout, rules, outdir):
-    """Run one cosmic-ray session; return ({skip reason: count}, patterns of functions matched,
+    """Run one cosmic-ray session; return ({skip reason: count},
     [(mutation, result)] of the mutants run)."""
     config_path = os.path.join(outdir, slug + '.toml')
     session = os.path.join(outdir, slug + '.sqlite')
@@ -164,7 +147,7 @@ def run_session(name, slug, modules, command, timeout, rules, outdir):
         os.remove(session)
     with open(log_path, 'w') as log:
         cosmic_ray('init', config_path, session, log=log)
-        skipped, matched = apply_filters(session, modules, rules)
+        skipped = apply_filters(session, modules, rules)
         print('mutation: %s: %d mutants skipped by the configuration %s; baseline...'
               % (name, sum(skipped.values()), skipped), flush=True)
         # The unmutated code must pass, or every mutant would count as killed.
@@ -176,7 +159,7 @@ def run_session(name, slug, modules, command, timeout, rules, outdir):
         for item, result in db.completed_work_items:
             if result.worker_outcome != WorkerOutcome.SKIPPED:
                 results.append((item.mutations[0], result))
-    return skipped, matched, results
+    return skipped, results
 
 
 def run_group(group, defaults, outdir):
@@ -190,7 +173,7 @@ def run_group(group, defaults, outdir):
     }
     slug = re.sub(r'[^a-z0-9]+', '-', group['name'].lower()).strip('-')
     start = time.monotonic()
-    skipped, results, modules, matched = {}, [], [], set()
+    skipped, results, modules = {}, [], []
     for modules_of_session, command in sessions(group):
         modules.extend(modules_of_session)
         name = group['name']
@@ -198,17 +181,11 @@ def run_group(group, defaults, outdir):
         if len(modules_of_session) == 1 and '{module-tests}' in group['test']:
             stem = os.path.splitext(os.path.basename(modules_of_session[0]))[0]
             name, session_slug = '%s: %s' % (name, stem), '%s-%s' % (slug, stem)
-        session_skipped, session_matched, session_results = run_session(
+        session_skipped, session_results = run_session(
             name, session_slug, modules_of_session, command, group['timeout'], rules, outdir)
-        matched |= session_matched
         for reason, count in session_skipped.items():
             skipped[reason] = skipped.get(reason, 0) + count
         results.extend(session_results)
-    unmatched = (set(rules['definitions']) | set(rules['skip-definitions'])) - matched
-    if unmatched:
-        # A function renamed or moved: its mutants would silently drop out of the run, or into it.
-        print('mutation: warning: %s: no function matches %s' % (group['name'], sorted(unmatched)),
-              flush=True)
     return {'name': group['name'], 'test': group['test'], 'modules': modules, 'skipped': skipped,
             'results': results, 'seconds': time.monotonic() - start}
 
@@ -304,6 +281,12 @@ def main(argv):
     config_path, known_path, outdir = argv[:3]
     wanted = argv[3:]
     config = toml.load(config_path)
+    problems = unmatched(config)
+    if problems:
+        # A renamed or moved function: its mutants would silently leave the run (or join it).
+        sys.exit('mutation: %s matches no function of its group; fix the scope in %s:\n%s'
+                 % ('a pattern' if len(problems) == 1 else '%d patterns' % len(problems), config_path,
+                    '\n'.join('  %s: %s %r' % problem for problem in problems)))
     groups = [g for g in config['group'] if not wanted or g['name'] in wanted]
     if wanted and len(groups) != len(wanted):
         sys.exit('mutation: unknown group in %s; the groups are: %s'

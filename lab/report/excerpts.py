@@ -14,11 +14,16 @@ import re
 ALTITUDE = 'docs/simple_answer/exam/scripts/exam_node.py'
 DEPTH = 'docs/simple_answer/exam/scripts/exam_submarine_node.py'
 ALTITUDE_LAUNCH = 'docs/simple_answer/exam/launch/exam.launch'
+PACKAGE_XML = 'docs/simple_answer/exam/package.xml'
+CMAKELISTS = 'docs/simple_answer/exam/CMakeLists.txt'
 
 
 def _sheet(path, sensor, output, ticks):
     """The ranges of one sheet's node for questions 11, 13, 14a and 14b (both nodes have one layout)."""
     return {
+        'q10': (path, [(r'^from std_msgs', r'^from std_msgs'),
+                       (r'^def \w+_callback\(msg\)', r'^    %s = msg\.data' % sensor),
+                       (r'# Question 10: one subscriber', r"rospy\.Subscriber\('/%s'" % sensor)]),
         'q11': (path, [(r'^# The latest value received', r'^    %s = msg\.data' % sensor),
                        (r'^def compute_', r'^    return '),
                        (r'# Question 11: the publisher', r'%s_pub = rospy\.Publisher' % output),
@@ -43,6 +48,12 @@ def _all():
             ('depth', (DEPTH, 'pressure_remote', 'depth', 'ticks_deeper'))):
         for question, spec in _sheet(path, sensor, output, ticks).items():
             excerpts['%s.%s' % (question, sheet)] = spec
+    # Question 9: what catkin_create_pkg wrote and the simple answer kept: the dependencies.
+    excerpts['q9.package'] = (PACKAGE_XML, [(r'<name>exam</name>', r'<name>exam</name>'),
+                                            (r'<buildtool_depend>', r'</package>')])
+    excerpts['q9.cmake'] = (CMAKELISTS, [(r'^project\(exam\)', r'^project\(exam\)'),
+                                         (r'^## The drones', r'^catkin_package\(\)'),
+                                         (r'^## Python nodes', r'^\)$')])
     excerpts['q14a.altitude.launch'] = (ALTITUDE_LAUNCH, [(r'<!-- Question 14a', r'<arg name="threshold"'),
                                                           (r'<node pkg="exam"', r'</node>')])
     return excerpts
@@ -73,7 +84,7 @@ def excerpt(repo, name):
     path, ranges = EXCERPTS[name]
     with open(os.path.join(repo, path)) as f:
         lines = f.read().splitlines()
-    xml = path.endswith('.launch')
+    xml = path.endswith(('.launch', '.xml'))
     merged = []
     for first, last in line_ranges(lines, ranges, '%s (%s)' % (path, name)):
         if merged and first <= merged[-1][1] + 1:

@@ -17,8 +17,10 @@ The template is Markdown with placeholders, each replaced by something this run 
 Placeholders of one kind (run, source, block) separated by blank lines only share one block. A
 placeholder alone on a line of a block quote (``> {{file PATH}}``) becomes a block inside the quote:
 the answer boxes of questions 9 to 14 hold the simple answer's code that way. A line ``LEFT || RIGHT``,
-each side one or more placeholders, puts sheet 000's blocks beside sheet 001's (a two-column table of
-raw HTML, which pandoc and GitHub both keep): the questions part stays within its 10 pages.
+each side one or more placeholders, puts sheet 000's command outputs beside sheet 001's (a two-column
+table of raw HTML, which pandoc and GitHub both keep): the questions part stays within its 10 pages.
+Code (``file``, ``source``, ``excerpt``) is never put side by side: sheet 001's comes below sheet 000's,
+at full width, so no line of it wraps in the PDF (report.css; the docs test measures the lines).
 
 An unknown placeholder or key is an error: the report never shows a hole.
 """
@@ -49,6 +51,17 @@ PLACEHOLDER = re.compile(r'\{\{(run|line|value|block|file|source|excerpt) ([^ }]
 QUOTED = re.compile(r'^> (\{\{(?:run|block|file|source|excerpt) [^ }]+\}\})$', re.M)
 #: Two sets of placeholders side by side: ``{{run a}} {{run b}} || {{run c}}``, maybe in a block quote.
 PAIR = re.compile(r'^(> )?((?:\{\{[a-z]+ [^ }]+\}\} ?)+)\|\| ((?:\{\{[a-z]+ [^ }]+\}\} ?)+)$', re.M)
+#: The placeholders that stand for code (a file, a function, an excerpt of the simple answer).
+CODE = re.compile(r'\{\{(?:file|source|excerpt) ')
+#: The fence language of a file, by its name: what pandoc highlights, and what report.css never wraps.
+LANGUAGES = {'.launch': 'xml', '.xml': 'xml', '.py': 'python', '.srv': 'text', 'CMakeLists.txt': 'cmake'}
+
+
+def language_of(path):
+    name = os.path.basename(path)
+    return LANGUAGES.get(name, LANGUAGES.get(os.path.splitext(name)[1], ''))
+
+
 ANSI = re.compile(r'\x1b\][^\x07\x1b]*(\x07|\x1b\\)?|\x1b\[[0-9;]*[A-Za-z]|\][0-9];[^\n]*?(?=\n|$)')
 
 
@@ -263,8 +276,9 @@ def facts(work, repo, outputs):
     v['model.err_1500'] = fmt(analysis.isothermal_error(1500.0))
     v['model.err_3000'] = fmt(analysis.isothermal_error(3000.0))
     v['model.true_at_threshold'] = fmt(analysis.true_altitude_read_as(flight['threshold']))
-    v['model.mean_t_1300'] = '%.2f' % analysis.mean_temperature_error(1300.0)
-    v['model.mean_t_3000'] = '%.1f' % analysis.mean_temperature_error(3000.0)
+    # Two significant digits each: 0.097 and 1.3, not 0.10 beside 1.3 (one precision for both).
+    v['model.mean_t_1300'] = '%.2g' % analysis.mean_temperature_error(1300.0)
+    v['model.mean_t_3000'] = '%.2g' % analysis.mean_temperature_error(3000.0)
     v['model.t_1300'] = '%.2f' % atmosphere.temperature_c(1300.0)
     v['model.p_1300'] = '%.0f' % atmosphere.pressure_pa(1300.0)
     # Rounding only: the bound, a power of ten, rather than digits that change with the sampling.
@@ -360,11 +374,10 @@ def render(template, outputs, values, blocks, repo):
             return fence(blocks[key], 'text')
         if kind == 'excerpt':
             path = excerpts.EXCERPTS[key][0]
-            return fence(excerpts.excerpt(repo, key), 'xml' if path.endswith('.launch') else 'python')
+            return fence(excerpts.excerpt(repo, key), language_of(path))
         if kind == 'file':
             with open(os.path.join(repo, key)) as f:
-                language = {'.launch': 'xml', '.xml': 'xml', '.py': 'python', '.srv': 'text'}
-                return fence(f.read().rstrip(), language.get(os.path.splitext(key)[1], ''))
+                return fence(f.read().rstrip(), language_of(key))
         return fence(source_of(key), 'python')
     def quoted(text):
         return '\n'.join(('> ' + line).rstrip() for line in text.splitlines())
@@ -379,7 +392,12 @@ def render(template, outputs, values, blocks, repo):
     def replace_pair(match):
         left, right = (re.findall(r'\{\{[^}]+\}\}', match.group(i)) for i in (2, 3))
         cells = [PLACEHOLDER.sub(replace, side(placeholders)) for placeholders in (left, right)]
-        text = ('<table class="pair"><tr><td>\n\n%s\n\n</td><td>\n\n%s\n\n</td></tr></table>' % tuple(cells))
+        if any(CODE.match(p) for p in left + right):
+            # Code a student copies: one sheet's below the other's, at the page's full width, never
+            # wrapped (a wrapped comment loses its #, a wrapped statement no longer runs).
+            text = '%s\n\n%s' % tuple(cells)
+        else:
+            text = ('<table class="pair"><tr><td>\n\n%s\n\n</td><td>\n\n%s\n\n</td></tr></table>' % tuple(cells))
         return quoted(text) if match.group(1) else text
     template = PAIR.sub(replace_pair, template)
     return PLACEHOLDER.sub(replace, GROUP.sub(replace_group, QUOTED.sub(replace_quoted, template)))

@@ -1,7 +1,8 @@
 """The simple answer of docs/report.md (docs/simple_answer/exam, what a student can write in three
 hours) gets full marks on both sheets from the grader, stays out of every catkin build of this
 repository (it is a second package named ``exam``), and `make run-simple` builds and runs it on its own
-for both sheets. About 45 s per sheet graded, and a build of four packages.
+for both sheets. About 45 s per sheet graded, and a build of five packages (node_kit, drone_sim, mydrone,
+submarinedrone and the simple answer's exam).
 """
 import os
 import re

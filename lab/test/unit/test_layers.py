@@ -119,13 +119,24 @@ def test_the_oracle_is_independent_of_the_answer():
     assert sorted(m for m in imports(path) if m.split('.')[0] in ANSWER) == []
 
 
-#: The grader's folders by trust level (exam_lab.grader's docstring): what runs as a box's uid on the
-#: student's bytes (boxed), the judge (not root), root's side (host), pure scoring, and what the teacher
-#: reads (publish).
+#: The grader's folders by trust level (exam_lab.grader's docstring). Each folder may import only the
+#: folders named here (and itself, and nothing of the grader beyond them), relative imports included:
+#: what runs as a box's uid on the student's bytes (boxed) leans on pure records only; the judge (a
+#: judge uid, never root) the same; root's side (host) never imports what reads student bytes or runs
+#: the student's nodes; score and publish are pure; the runner is the pipeline; engine/ is the host
+#: as the teacher, submitting classes elsewhere, each student by the runner.
 GRADER = 'exam_lab.grader'
-#: Folders that must never import what reads student bytes or runs the student's nodes.
-NEVER_IMPORT = {'host': ('boxed', 'judge'), 'score': ('boxed', 'judge', 'host', 'publish'),
-                'publish': ('boxed', 'judge', 'host')}
+MAY_IMPORT = {
+    'boxed': ('score',),
+    'judge': ('score',),
+    'host': ('score',),
+    'score': (),
+    'publish': ('score',),
+    'runner': ('boxed', 'judge', 'host', 'score', 'publish'),
+    'engine': ('runner', 'host', 'score', 'publish'),
+}
+#: The package itself (``exam_lab.grader``: ``workspace()``) is plain configuration, open to every folder.
+PACKAGE_ITSELF = (GRADER,)
 
 
 def grader_modules(folder):
@@ -133,22 +144,75 @@ def grader_modules(folder):
     return sorted(name for name in source_modules() if name == prefix or name.startswith(prefix + '.'))
 
 
-@pytest.mark.parametrize('folder', sorted(NEVER_IMPORT))
-def test_the_grader_layers_keep_to_their_trust_level(folder):
-    modules = grader_modules(folder)
+def resolved_imports(name, path):
+    """Every module name a file imports, relative imports resolved against the module ``name``."""
+    names = imports(path)
+    package = name.split('.') if path.endswith('__init__.py') else name.split('.')[:-1]
+    for node in nodes(path):
+        if isinstance(node, ast.ImportFrom) and node.level > 0:
+            base = package[:len(package) - (node.level - 1)]
+            module = '.'.join(base + ([node.module] if node.module else []))
+            names.add(module)
+            names.update('%s.%s' % (module, alias.name) for alias in node.names)
+    return names
+
+
+def trust_violations(folder, modules):
+    """["<module> imports <module>"] of every import of ``modules`` (name -> path) that leaves what the
+    folder may import."""
+    allowed = tuple('%s.%s' % (GRADER, f) for f in (folder,) + MAY_IMPORT[folder])
+    offending = []
+    for name, path in sorted(modules.items()):
+        for module in sorted(resolved_imports(name, path)):
+            if not module.startswith(GRADER + '.') or module in PACKAGE_ITSELF:
+                continue
+            if module == '%s.workspace' % GRADER:
+                continue  # ``from exam_lab.grader import workspace``: the package's own function
+            if not any(module == a or module.startswith(a + '.') for a in allowed):
+                offending.append('%s imports %s' % (name, module))
+    return offending
+
+
+@pytest.mark.parametrize('folder', sorted(MAY_IMPORT))
+def test_the_grader_folders_keep_to_their_trust_level(folder):
+    modules = {name: source_modules()[name] for name in grader_modules(folder)}
     assert modules, 'no modules under %s.%s' % (GRADER, folder)
-    forbidden = tuple('%s.%s' % (GRADER, f) for f in NEVER_IMPORT[folder])
-    offending = ['%s imports %s' % (name, m) for name in modules for m in sorted(imports(source_modules()[name]))
-                 if m.startswith(forbidden)]
+    assert trust_violations(folder, modules) == []
+
+
+def test_the_trust_check_sees_a_forbidden_import_absolute_or_relative(tmp_path):
+    # A planted module of boxed/ that imports root's side, both ways: the check must fail on each.
+    planted = tmp_path / 'planted.py'
+    planted.write_text('from exam_lab.grader.host import sandbox\nfrom ..publish import moodle\n'
+                       'from . import unpack\nfrom exam_lab.grader.score import records\n')
+    name = '%s.boxed.planted' % GRADER
+    assert trust_violations('boxed', {name: str(planted)}) == [
+        '%s imports %s.host' % (name, GRADER), '%s imports %s.host.sandbox' % (name, GRADER),
+        '%s imports %s.publish' % (name, GRADER), '%s imports %s.publish.moodle' % (name, GRADER)]
+
+
+@pytest.mark.parametrize('folder', ['score', 'publish'])
+def test_the_pure_grader_folders_import_no_ros(folder):
+    graph = project_graph()
+    offending = []
+    for module in grader_modules(folder):
+        seen, todo = set(), [module]
+        while todo:
+            current = todo.pop()
+            if current in seen:
+                continue
+            seen.add(current)
+            offending += ['%s (from %s) imports %s' % (current, module, m)
+                          for m in sorted(imports(source_modules()[current])) if m.split('.')[0] in ROS]
+            todo.extend(graph[current])
     assert offending == []
 
 
 def test_every_grader_module_lives_in_a_trust_folder():
-    """Only the package itself and the runner (the pipeline) sit at the grader's top level; engine/
-    (where else a class is graded: the host, as the teacher) calls the runner."""
+    """Only the package itself and the runner (the pipeline) sit at the grader's top level; every other
+    module is in a folder of MAY_IMPORT."""
     top = [name for name in source_modules() if name.startswith(GRADER + '.') and name.count('.') == 2]
-    assert sorted(top) == ['%s.%s' % (GRADER, f)
-                           for f in sorted(set(NEVER_IMPORT) | {'boxed', 'judge', 'runner', 'engine'})]
+    assert sorted(top) == ['%s.%s' % (GRADER, f) for f in sorted(MAY_IMPORT)]
 
 
 def test_the_node_kit_imports_no_simulator_nor_the_exam_node():
