@@ -321,3 +321,74 @@ def test_the_report_prints_the_whole_simple_answer():
                  'launch/exam.launch', 'launch/exam_submarine.launch'):
         body = read(os.path.join(REPO, 'docs', 'simple_answer', 'exam', path)).rstrip()
         assert body in appendix, path
+
+
+# --- the benchmarks' hand-written analysis ---------------------------------------------------------
+
+BENCH = os.path.join(REPO, 'lab', 'bench')
+
+
+def bench_results():
+    import json
+    with open(os.path.join(BENCH, 'results.json')) as f:
+        return json.load(f)
+
+
+def per_node_cpu_quoted(text):
+    """(low, high, cpu of 20, each of 20, cpu of 100, each of 100) of "CPU at L to H % of a core per exam
+    node (A % for 20: a % each; B % for 100: b % each)"."""
+    found = re.search(r'CPU at ([\d.]+) to ([\d.]+) % of a core per exam node \(([\d.]+) % for 20: ([\d.]+) % '
+                      r'each; ([\d.]+) % for 100: ([\d.]+) % each\)', text)
+    return found.groups() if found else None
+
+
+def per_node_cpu_expected(results):
+    fleet = results['ours']['fleet']
+    twenty, hundred = fleet['20']['cpu_percent']['exam'], fleet['100']['cpu_percent']['exam']
+    each = sorted([twenty / 20, hundred / 100])
+    return ('%.2f' % each[0], '%.2f' % each[1], '%.1f' % twenty, '%.2f' % (twenty / 20), '%.1f' % hundred,
+            '%.2f' % (hundred / 100))
+
+
+def test_the_analysis_per_node_cpu_is_the_fleet_tables_divided():
+    quoted = per_node_cpu_quoted(prose(read(os.path.join(BENCH, 'analysis.md'))))
+    assert quoted is not None, 'lab/bench/analysis.md no longer says "CPU at L to H % of a core per exam node (...)"'
+    assert quoted == per_node_cpu_expected(bench_results())
+
+
+def test_the_per_node_cpu_check_catches_a_rounded_range():
+    stale = 'CPU at 0.5 to 0.6 % of a core per exam node (11.7 % for 20: 0.6 % each; 48.1 % for 100: 0.5 % each)'
+    assert per_node_cpu_quoted(stale) != per_node_cpu_expected(bench_results())
+
+
+def history_figures_quoted(text):
+    """[(file, [figures])] of every "a / b / c / d (`fleet-master-*.json`)" of a text."""
+    return [(name, figures.split(' / ')) for figures, name in
+            re.findall(r'((?:[\d.]+ / )+[\d.]+)\*{0,2} \(`(fleet-master-[\w-]+\.json)`\)', text)]
+
+
+def history_master_cpu(name):
+    import json
+    with open(os.path.join(BENCH, 'history', name)) as f:
+        fleet = json.load(f)['ours']['fleet']
+    return ['%.1f' % fleet[n]['master_cpu_percent'] for n in sorted(fleet, key=int)]
+
+
+def test_the_masters_cpu_figures_are_their_history_files():
+    quoted = history_figures_quoted(prose(read(os.path.join(BENCH, 'analysis.md'))))
+    assert len(quoted) >= 4, quoted
+    for name, figures in quoted:
+        assert figures == history_master_cpu(name), name
+
+
+def test_the_history_check_catches_a_figure_of_another_file():
+    swapped = '0.4 / 1.0 / 1.5 / 3.2 (`fleet-master-0551.json`)'
+    (name, figures), = history_figures_quoted(swapped)
+    assert figures != history_master_cpu(name)
+
+
+def test_the_analysis_explains_the_delay_the_latency_stage_used():
+    delay = bench_results()['config']['delay']
+    text = prose(read(os.path.join(BENCH, 'analysis.md')))
+    quoted = re.findall(r"with the stage's `~delay` of ([\d.]+) s it counts `delay_ticks` = (\d+) ticks", text)
+    assert quoted == [('%g' % delay, '%d' % round(delay * 10))], quoted
