@@ -96,6 +96,7 @@ def block(times, date, commit):
 
 def main():
     date = datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M UTC')
+    commit = console_excerpt.commit()  # the code that runs, before anything is written
     times = []
     # rospy allows one init_node per process: each launch is measured in a process of its own.
     if len(sys.argv) == 3 and sys.argv[1] == '--one':
@@ -114,7 +115,7 @@ def main():
     with open(DOC, encoding='utf-8') as f:
         text = f.read()
     with open(DOC, 'w', encoding='utf-8') as f:
-        f.write(console_excerpt.splice(text, block(times, date, console_excerpt.commit()), BEGIN, END))
+        f.write(console_excerpt.splice(text, block(times, date, commit), BEGIN, END))
     print('run_timing: written into README.md')
 
 
