@@ -392,3 +392,129 @@ def test_the_analysis_explains_the_delay_the_latency_stage_used():
     text = prose(read(os.path.join(BENCH, 'analysis.md')))
     quoted = re.findall(r"with the stage's `~delay` of ([\d.]+) s it counts `delay_ticks` = (\d+) ticks", text)
     assert quoted == [('%g' % delay, '%d' % round(delay * 10))], quoted
+
+
+# --- the grader's speed, quoted from the benchmark's grader section --------------------------------
+
+def grader_bench_quoted(section):
+    """What lab/bench/grader.md measured: {'date', 'commit', 'alone': (n, wall, low, high, cpu),
+    'classes': {jobs: (students, wall)}, 'packages': {name: seconds}}."""
+    head = re.search(r'on (\d{4}-\d\d-\d\d \d\d:\d\d) \(UTC\).*? at commit ([0-9a-f]+)', section)
+    alone = re.search(r'\| each of (\d+) packages alone \(JOBS=1\) \| (\d+) s \| (\d+)-(\d+) s \| (\d+) s \|', section)
+    return {'date': head.group(1), 'commit': head.group(2), 'alone': alone.groups(),
+            'classes': {jobs: (n, wall) for n, jobs, wall in
+                        re.findall(r'^\| class of (\d+), JOBS=(\d+) \| (\d+) s \|', section, re.M)},
+            'packages': dict(re.findall(r'^\| (\w+) \| [\d.]+ \| (\d+) s \|$', section, re.M))}
+
+
+def speed_problems(speed, measured):
+    """What the Speed paragraph of docs/grading.md says that the grader section did not measure."""
+    problems = []
+    for name, seconds in re.findall(r'`(\w+)`: (\d+) s', speed):
+        if measured['packages'].get(name) != seconds:
+            problems.append('%s: %s s quoted, %s s measured' % (name, seconds, measured['packages'].get(name)))
+    run = re.search(r'on (\d{4}-\d\d-\d\d \d\d:\d\d) UTC \(commit ([0-9a-f]+)\)', speed)
+    if run is None or run.groups() != (measured['date'], measured['commit']):
+        problems.append('the run quoted is not the grader section\'s (%s at %s)' % (measured['date'], measured['commit']))
+    alone = re.search(r'the (\d+) packages of that day .*? took (\d+) to (\d+) s each \((\d+) s in all; (\d+) s of CPU', speed)
+    n, wall, low, high, cpu = measured['alone']
+    if alone is None or alone.groups() != (n, low, high, wall, cpu):
+        problems.append('the packages graded alone: %s' % (alone.groups() if alone else 'not quoted'))
+    classes = re.findall(r'(\d+) s (?:\([\d.]+ minutes\) )?with `JOBS=(\d+)`', speed)
+    if not classes or any(measured['classes'].get(jobs, (None, None))[1] != wall for wall, jobs in classes):
+        problems.append('the classes: %s quoted, %s measured' % (classes, measured['classes']))
+    for wall, minutes, jobs in re.findall(r'(\d+) s \(([\d.]+) minutes\) with `JOBS=(\d+)`', speed):
+        if '%.1f' % (int(wall) / 60.0) != minutes:
+            problems.append('%s s is not %s minutes' % (wall, minutes))
+    return problems
+
+
+def speed_paragraph():
+    text = prose(read(GRADING))
+    return text[text.index('## Speed'):text.index('The sandbox costs nothing')]
+
+
+def test_the_speed_paragraph_quotes_the_benchmarks_grader_section():
+    measured = grader_bench_quoted(read(os.path.join(BENCH, 'grader.md')))
+    assert len(measured['packages']) == int(measured['alone'][0])
+    speed = speed_paragraph()
+    assert len(re.findall(r'`(\w+)`: (\d+) s', speed)) >= 5
+    assert speed_problems(speed, measured) == []
+
+
+def test_the_speed_check_catches_a_typed_time():
+    measured = grader_bench_quoted(read(os.path.join(BENCH, 'grader.md')))
+    speed = speed_paragraph()
+    assert speed_problems(speed.replace('`late_warning`: 132 s', '`late_warning`: 134 s'), measured) == [
+        'late_warning: 134 s quoted, 132 s measured']
+    assert len(speed_problems(speed.replace('826 s (13.8', '826 s (13.9'), measured)) == 1
+    assert len(speed_problems(speed.replace('585 s with', '590 s with'), measured)) == 1
+
+
+# --- the test packages' table ----------------------------------------------------------------------
+
+SUBMISSIONS = os.path.join(REPO, 'lab', 'test', 'grader', 'submissions')
+
+
+def package_table_rows(text):
+    """The packages named by the first cell of the rows of the test-package tables of docs/grading.md's
+    Tests section ("| `no_kelvin` | ..." or "| `wrong_topic` (depth) | ..."); rows made by the test from
+    another package ("made from") are not folders and are left out."""
+    tests = text[text.index('\n## Tests'):]
+    tests = tests[:tests.index('\n## ', 1)]
+    names = []
+    for line in tests.splitlines():
+        cell = re.match(r'^\| `(\w+)`([^|]*)\|', line)
+        if cell and 'made from' not in cell.group(2):
+            names.append(cell.group(1))
+    return names
+
+
+def test_every_test_package_has_a_row_and_every_row_a_package():
+    folders = sorted(d for d in os.listdir(SUBMISSIONS) if os.path.isdir(os.path.join(SUBMISSIONS, d)))
+    rows = package_table_rows(read(GRADING))
+    assert len(rows) == len(set(rows)), 'a package has two rows'
+    assert sorted(rows) == folders, ('no row for %s; a row without a folder: %s'
+                                     % (sorted(set(folders) - set(rows)), sorted(set(rows) - set(folders))))
+
+
+def test_the_package_table_check_catches_a_missing_row():
+    text = ('\n## Tests\n\n| package | flaw |\n|---|---|\n| `no_kelvin` | degC |\n| `wrong_topic` (depth) | x |\n'
+            '| `windows_zip` (made from `good_student`) | CRLF |\n\n## Determinism\n| `not_here` | x |\n')
+    assert package_table_rows(text) == ['no_kelvin', 'wrong_topic']
+
+
+def grade_test_expectations():
+    """{package: its total} of lab/test/grader/test_grade.py's EXPECTED and FAIR_EXPECTED (the tested
+    truth): full marks less what each package loses."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location('grade_expectations', os.path.join(
+        REPO, 'lab', 'test', 'grader', 'test_grade.py'))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    totals = {}
+    for expected in (module.EXPECTED, module.FAIR_EXPECTED):
+        for name, points in expected.items():
+            totals[name] = sum(dict(module.FULL, **points).values())
+    return totals
+
+
+def package_table_points(text):
+    """{package: points} of the test-package tables' rows."""
+    tests = text[text.index('\n## Tests'):]
+    tests = tests[:tests.index('\n## ', 1)]
+    return {name: float(points) for name, points in
+            re.findall(r'^\| `(\w+)`[^|]*\|[^|]*\| ([\d.]+) \|', tests, re.M)}
+
+
+def test_the_package_tables_points_are_the_grader_tests_expectations():
+    totals = grade_test_expectations()
+    quoted = package_table_points(read(GRADING))
+    assert set(quoted) <= set(totals), set(quoted) - set(totals)
+    assert {name: totals[name] for name in quoted} == quoted
+
+
+def test_the_points_check_catches_a_typed_total():
+    totals = grade_test_expectations()
+    assert package_table_points('\n## Tests\n| `no_kelvin` | degC | 15 | Q11 |\n\n## Next\n') == {'no_kelvin': 15.0}
+    assert totals['no_kelvin'] == 15.5
