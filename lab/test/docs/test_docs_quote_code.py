@@ -518,3 +518,138 @@ def test_the_points_check_catches_a_typed_total():
     totals = grade_test_expectations()
     assert package_table_points('\n## Tests\n| `no_kelvin` | degC | 15 | Q11 |\n\n## Next\n') == {'no_kelvin': 15.0}
     assert totals['no_kelvin'] == 15.5
+
+
+# --- outputs the docs quote, made again by the code that prints them --------------------------------
+
+def quoted_output(pattern, text=None):
+    """The one output of docs/grading.md that ``pattern`` finds (its first group), line breaks folded."""
+    found = re.findall(pattern, prose(read(GRADING)) if text is None else text)
+    assert len(found) == 1, 'docs/grading.md no longer quotes %r once: %s' % (pattern, found)
+    return found[0]
+
+
+def not_scaled_problems(text=None):
+    from exam_lab.grader.publish import moodle
+    quote = quoted_output(r'`(NOT SCALED: [^`]+)`', text)
+    maximum, machine = re.match(r"NOT SCALED: the worksheet's maximum grade is ([\d.]+), .* out of ([\d.]+)$", quote).groups()
+    lines = moodle.summary_lines({'graded': [], 'machine_max': [float(machine)], 'maxima': [float(maximum)],
+                                  'scaled': False, 'kept': [], 'unmatched': [], 'no_submission': []}, 'w.csv')
+    return [] if any(quote in line for line in lines) else ['not printed: %s' % quote]
+
+
+def test_the_not_scaled_line_is_the_worksheets():
+    assert not_scaled_problems() == []
+
+
+def test_the_not_scaled_check_catches_a_reworded_line():
+    text = prose(read(GRADING)).replace('the grades written are', 'the grades are')
+    assert len(not_scaled_problems(text)) == 1
+
+
+def synthetic_grade(total_before=None):
+    from exam_lab.grader.publish import report
+    from exam_lab.grader.score.sheets import ITEMS
+    record = report.grade_record('late', 'altitude', [{'id': i, 'points': p, 'max': p, 'evidence': 'ok'}
+                                                      for i, (p, _) in ITEMS.items()], [])
+    if total_before is not None:
+        record['provenance'] = {'how': 'rescore', 'grader': 'abc', 'rubric': 'def', 'machine': 'vm', 'date': 'd'}
+        record['previous'] = {'total': total_before, 'status': 'graded'}
+    return record
+
+
+def test_the_feedback_comment_quoted_is_moodles():
+    import html
+    from exam_lab.grader.publish import moodle
+    quote = quoted_output(r'\("(The grade is out of [^"]+)"\)')
+    maximum = float(re.search(r'the maximum grade ([\d.]+)', quote).group(1))
+    assert quote in html.unescape(moodle.feedback(synthetic_grade(), maximum=maximum))
+
+
+def rescored_problems(text=None):
+    from exam_lab.grader.publish import report
+    quote = quoted_output(r'\("Rescored \.\.\. (Before: [^"]+)"\)', text)
+    before = float(re.match(r'Before: ([\d.]+)', quote).group(1))
+    line = [l for l in report.markdown(synthetic_grade(before)).splitlines() if l.startswith('Rescored')]
+    return [] if line and quote in line[0] else ['grade.md does not say %r: %s' % (quote, line)]
+
+
+def test_the_rescored_line_is_grade_mds():
+    assert rescored_problems() == []
+
+
+def test_the_rescored_check_catches_a_typed_line():
+    assert len(rescored_problems(prose(read(GRADING)).replace('Before: 15.5 / 17', 'Before: 15.5 of 17'))) == 1
+
+
+def format_literal(path, literal):
+    """``literal`` (a format string) as the code has it, or a failure naming where it was looked for."""
+    assert literal in read(os.path.join(REPO, path)), '%s no longer formats its line with %s' % (path, literal)
+    return literal
+
+
+def rescore_change_problems(text=None):
+    """The rescore's line quoted (``late: 17 -> 15.5 (Q14b 3 -> 1.5)``) against runner.rescore_class's
+    two formats, and its arithmetic: the total moves by what the items moved."""
+    quote = quoted_output(r'`(\w+: [\d.]+ -> [\d.]+ \([^`]*\))`', text)
+    line = format_literal('lab/src/exam_lab/grader/runner.py', "'%s: %s -> %s (%s)'").strip("'")
+    item = format_literal('lab/src/exam_lab/grader/runner.py', "'%s %s -> %s'").strip("'")
+    student, old, new, moved = re.match(r'(\w+): ([\d.]+) -> ([\d.]+) \((.*)\)$', quote).groups()
+    items = [re.match(r'(\w+) ([\d.]+) -> ([\d.]+)$', m).groups() for m in moved.split('; ')]
+    problems = []
+    if line % (student, old, new, '; '.join(item % i for i in items)) != quote:
+        problems.append('not the runner\'s form: %s' % quote)
+    if abs((float(new) - float(old)) - sum(float(b) - float(a) for _, a, b in items)) > 1e-9:
+        problems.append('the total moves by %s, its items by another amount' % quote)
+    return problems
+
+
+def test_the_rescore_change_line_is_the_runners():
+    assert rescore_change_problems() == []
+
+
+def test_the_rescore_change_check_catches_wrong_arithmetic():
+    text = prose(read(GRADING)).replace('Q14b 3 -> 1.5', 'Q14b 3 -> 2')
+    assert rescore_change_problems(text) == ['the total moves by late: 17 -> 15.5 (Q14b 3 -> 2), its items by another amount']
+
+
+def test_the_worksheets_missing_hand_points_line_is_the_scripts():
+    from exam_lab.grader.score.sheets import HAND_ITEMS
+    quote = quoted_output(r'\(`([A-Z][\w ]+: (?:Q\d+, )+\.\.\.)`\)')
+    literal = format_literal('lab/scripts/worksheet.py',
+                             "'  %s: %s' % (safe_text.one_line(record['student']), ', '.join(record['missing']))")
+    assert literal
+    student, items = quote.split(': ', 1)
+    named = items.split(', ')[:-1]
+    assert named and set(named) <= set(HAND_ITEMS), named
+    assert named == [i for i in HAND_ITEMS if i in named], 'not in the order worksheet.py lists them'
+
+
+def slurm_problems(text=None):
+    from exam_lab.grader import runner
+    from exam_lab.grader.engine import slurm
+    problems = []
+    state = quoted_output(r'`(slurm job [^`]+)`', text)
+    counts = re.match(r'slurm job (\d+): (\d+) pending, (\d+) running, (\d+) done of (\d+)$', state)
+    if counts is None:
+        return ['not the engine\'s state line: %s' % state]
+    job, pending, running, done, total = counts.groups()
+    tasks = dict(enumerate([('PENDING', 0)] * int(pending) + [('RUNNING', 0)] * int(running)))
+    if slurm.state_line([job], tasks, int(done), 0, int(total)) != state:
+        problems.append('not the engine\'s state line: %s' % state)
+    said = quoted_output(r'`(could not grade: Slurm said: [^`]+)`', text)
+    fields = dict(zip(('JobState', 'ExitCode'), re.match(r'could not grade: Slurm said: (\w+), exit code ([\d:]+)$',
+                                                         said).groups()))
+    reason = runner.could_not_grade('x', 'altitude', 'Slurm said: %s' % slurm.slurm_said(fields))['status_reason']
+    if reason != said:
+        problems.append('not the engine\'s reason: %s (it says %s)' % (said, reason))
+    return problems
+
+
+def test_the_slurm_lines_quoted_are_the_engines():
+    assert slurm_problems() == []
+
+
+def test_the_slurm_check_catches_a_typed_line():
+    text = prose(read(GRADING)).replace('0 done of 3', '0 of 3 done')
+    assert len(slurm_problems(text)) == 1
