@@ -10,6 +10,7 @@ moved out of reach of its check is not a guarded one). Each check is held to a w
 import glob
 import os
 import re
+import sys
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -18,6 +19,10 @@ from exam_lab.grader import runner
 from exam_lab.grader.publish import provenance
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
+sys.path.insert(0, os.path.join(REPO, 'lab', 'report'))
+
+import calibration  # noqa: E402  (lab/report is a script folder, not a package)
+
 GRADER = os.path.join(REPO, 'lab', 'src', 'exam_lab', 'grader')
 GRADING = os.path.join(REPO, 'docs', 'grading.md')
 ARCHITECTURE = os.path.join(REPO, 'docs', 'architecture.md')
@@ -487,11 +492,7 @@ def test_the_package_table_check_catches_a_missing_row():
 def grade_test_expectations():
     """{package: its total} of lab/test/grader/test_grade.py's EXPECTED and FAIR_EXPECTED (the tested
     truth): full marks less what each package loses."""
-    import importlib.util
-    spec = importlib.util.spec_from_file_location('grade_expectations', os.path.join(
-        REPO, 'lab', 'test', 'grader', 'test_grade.py'))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = calibration.load_expectations()
     totals = {}
     for expected in (module.EXPECTED, module.FAIR_EXPECTED):
         for name, points in expected.items():
@@ -653,3 +654,97 @@ def test_the_slurm_lines_quoted_are_the_engines():
 def test_the_slurm_check_catches_a_typed_line():
     text = prose(read(GRADING)).replace('0 done of 3', '0 of 3 done')
     assert len(slurm_problems(text)) == 1
+
+
+# --- the teacher's quick start and its calibration table -------------------------------------------
+
+def calibration_block(text):
+    begin, end = text.find(calibration.BEGIN), text.find(calibration.END)
+    assert 0 <= begin < end, 'docs/grading.md has no calibration block between its markers'
+    return text[begin:end + len(calibration.END)]
+
+
+def test_the_calibration_table_is_the_grader_tests_truth():
+    assert calibration_block(read(GRADING)) == calibration.block(), 'run python3 lab/report/calibration.py'
+
+
+def test_the_calibration_check_catches_a_typed_point_and_a_package_left_out():
+    block = calibration.block()
+    assert calibration_block(block.replace('15.5 / 17 (Q11 1.5)', '16 / 17 (Q11 1)')) != block
+    tested = calibration.load_expectations()
+    tested.EXPECTED = dict(tested.EXPECTED, new_mistake={'Q10': 1.0})
+    with pytest.raises(ValueError, match='new_mistake'):
+        calibration.rows(tested)
+
+
+def class_of_60_problems(quick):
+    """What the quick start's "a class of 60 took N s (M minutes) at the default JOBS=J ... run of DATE"
+    says that the benchmark's grader section did not measure."""
+    measured = grader_bench_quoted(read(os.path.join(BENCH, 'grader.md')))
+    default = str(runner.default_jobs(cores=2, memory=24 << 30))
+    wall = measured['classes'][default][1]
+    quoted = re.search(r'a class of 60 took (\d+) s \(([\d.]+) minutes\) at the default JOBS=(\d+) .*?run of '
+                       r'(\d{4}-\d\d-\d\d \d\d:\d\d) UTC', quick)
+    if quoted is None:
+        return ['the quick start no longer quotes the class of 60']
+    expected = (wall, '%.1f' % (int(wall) / 60.0), default, measured['date'])
+    return [] if quoted.groups() == expected else ['%s quoted, %s measured' % (quoted.groups(), expected)]
+
+
+def quick_start():
+    text = read(GRADING)
+    first = re.findall(r'^## .*$', text, re.M)[0]
+    assert first == "## A teacher's quick start", 'the quick start does not open docs/grading.md'
+    return prose(text[text.index(first):text.index(calibration.BEGIN)])
+
+
+def test_the_quick_start_opens_the_page_and_quotes_the_class_of_60():
+    quick = quick_start()
+    assert class_of_60_problems(quick) == []
+    for status in ('graded', 'graded with fixes', 'needs a hand grade', 'not graded'):
+        assert '| `%s` |' % status in quick
+
+
+def test_the_class_of_60_check_catches_a_rounded_time():
+    assert len(class_of_60_problems(quick_start().replace('826 s (13.8 minutes)', '826 s (14 minutes)'))) == 1
+    assert len(class_of_60_problems(quick_start().replace('2026-11-25 18:54', '2026-11-24 18:54'))) == 1
+
+
+# --- README's make run timings ---------------------------------------------------------------------
+
+def run_timing_problems(readme, banner_script):
+    """What is wrong with README's block of lab/report/run_timing.py: [] when it is there, dated, at a
+    commit of this repository, and its times keep the banner's promises (tools/run_launch.sh: "RED
+    about N s from now, GREEN again about M s later") within 5 s."""
+    import subprocess
+    import run_timing
+    begin, end = readme.find(run_timing.BEGIN), readme.find(run_timing.END)
+    if not 0 <= begin < end:
+        return ['no run timing block between its markers']
+    found = re.search(r'on (\d{4}-\d\d-\d\d \d\d:\d\d) UTC at commit ([0-9a-f]{7,40})(\+changes)?: `data: "RED"` '
+                      r'([\d.]+) s after that banner, `data: "GREEN"` ([\d.]+) s after it\..*?RED ([\d.]+) s, GREEN '
+                      r'([\d.]+) s after the banner', prose(readme[begin:end]))
+    if found is None:
+        return ['the block does not say which run, which commit and both launches\' times']
+    problems = []
+    if subprocess.run(['git', '-C', REPO, 'cat-file', '-e', found.group(2) + '^{commit}'],
+                      stderr=subprocess.DEVNULL).returncode != 0:
+        problems.append('commit %s is not in this repository' % found.group(2))
+    red_in, green_after = (float(x) for x in re.search(r'RED about (\d+) s from now, GREEN again about (\d+) s later',
+                                                       banner_script).groups())
+    for red, green in ((found.group(4), found.group(5)), (found.group(6), found.group(7))):
+        if abs(float(red) - red_in) > 5 or abs(float(green) - float(red) - green_after) > 5:
+            problems.append('the banner promises RED about %g s, GREEN %g s later; measured %s and %s'
+                            % (red_in, green_after, red, green))
+    return problems
+
+
+def test_readmes_run_timings_are_a_dated_run_keeping_the_banners_promises():
+    banner = read(os.path.join(REPO, 'tools', 'run_launch.sh'))
+    assert run_timing_problems(read(README), banner) == []
+
+
+def test_the_run_timing_check_catches_a_broken_promise():
+    readme, banner = read(README), read(os.path.join(REPO, 'tools', 'run_launch.sh'))
+    assert len(run_timing_problems(readme, banner.replace('RED about 50 s', 'RED about 40 s'))) == 2
+    assert run_timing_problems(readme.replace('at commit ', 'at commit 0000000'), banner) != []
