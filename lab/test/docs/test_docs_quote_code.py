@@ -559,12 +559,22 @@ def synthetic_grade(total_before=None):
     return record
 
 
-def test_the_feedback_comment_quoted_is_moodles():
+def feedback_problems(text=None):
     import html
     from exam_lab.grader.publish import moodle
-    quote = quoted_output(r'\("(The grade is out of [^"]+)"\)')
+    quote = quoted_output(r'\("(The grade is out of [^"]+)"\)', text)
     maximum = float(re.search(r'the maximum grade ([\d.]+)', quote).group(1))
-    assert quote in html.unescape(moodle.feedback(synthetic_grade(), maximum=maximum))
+    return [] if quote in html.unescape(moodle.feedback(synthetic_grade(), maximum=maximum)) else [
+        'not in the feedback comment: %s' % quote]
+
+
+def test_the_feedback_comment_quoted_is_moodles():
+    assert feedback_problems() == []
+
+
+def test_the_feedback_check_catches_a_reworded_comment():
+    text = prose(read(GRADING)).replace("(the machine's items), not out of", "(the machine's items), not of")
+    assert len(feedback_problems(text)) == 1
 
 
 def rescored_problems(text=None):
@@ -614,16 +624,28 @@ def test_the_rescore_change_check_catches_wrong_arithmetic():
     assert rescore_change_problems(text) == ['the total moves by late: 17 -> 15.5 (Q14b 3 -> 2), its items by another amount']
 
 
-def test_the_worksheets_missing_hand_points_line_is_the_scripts():
+def missing_hand_points_problems(text=None):
+    """The worksheet's line for a student without all hand points (``Paul Martin: Q5, Q6, ...``):
+    worksheet.py's format, hand items of score/sheets.py in their order."""
     from exam_lab.grader.score.sheets import HAND_ITEMS
-    quote = quoted_output(r'\(`([A-Z][\w ]+: (?:Q\d+, )+\.\.\.)`\)')
-    literal = format_literal('lab/scripts/worksheet.py',
-                             "'  %s: %s' % (safe_text.one_line(record['student']), ', '.join(record['missing']))")
-    assert literal
-    student, items = quote.split(': ', 1)
-    named = items.split(', ')[:-1]
-    assert named and set(named) <= set(HAND_ITEMS), named
-    assert named == [i for i in HAND_ITEMS if i in named], 'not in the order worksheet.py lists them'
+    format_literal('lab/scripts/worksheet.py',
+                   "'  %s: %s' % (safe_text.one_line(record['student']), ', '.join(record['missing']))")
+    quote = quoted_output(r'\(`([A-Z][\w ]+: (?:\w+, )+\.\.\.)`\)', text)
+    named = quote.split(': ', 1)[1].split(', ')[:-1]
+    if not named or not set(named) <= set(HAND_ITEMS):
+        return ['not hand items: %s' % named]
+    return [] if named == [i for i in HAND_ITEMS if i in named] else ['not in the order worksheet.py lists them']
+
+
+def test_the_worksheets_missing_hand_points_line_is_the_scripts():
+    assert missing_hand_points_problems() == []
+
+
+def test_the_missing_hand_points_check_catches_a_wrong_item():
+    assert missing_hand_points_problems(prose(read(GRADING)).replace('Q5, Q6, ...', 'Q11, Q6, ...')) == [
+        "not hand items: ['Q11', 'Q6']"]
+    assert missing_hand_points_problems(prose(read(GRADING)).replace('Q5, Q6, ...', 'Q6, Q5, ...')) == [
+        'not in the order worksheet.py lists them']
 
 
 def slurm_problems(text=None):
