@@ -770,3 +770,25 @@ def test_the_run_timing_check_catches_a_broken_promise():
     readme, banner = read(README), read(os.path.join(REPO, 'tools', 'run_launch.sh'))
     assert len(run_timing_problems(readme, banner.replace('RED about 50 s', 'RED about 40 s'))) == 2
     assert run_timing_problems(readme.replace('at commit ', 'at commit 0000000'), banner) != []
+
+
+def rendered_benchmarks(analysis=None):
+    """docs/benchmarks.md as `BENCH_RENDER_ONLY=1 make bench` renders it from lab/bench/results.json,
+    lab/bench/analysis.md and lab/bench/grader.md (lab/bench/report.py; nothing measured)."""
+    sys.path.insert(0, BENCH)
+    import report
+    results = bench_results()
+    results['analysis'] = read(os.path.join(BENCH, 'analysis.md')) if analysis is None else analysis
+    return report.render(results, os.path.join('figures', 'bench_fleet.png'))
+
+
+def test_benchmarks_md_is_the_render_of_its_results_never_edited_by_hand():
+    assert read(os.path.join(REPO, 'docs', 'benchmarks.md')) == rendered_benchmarks(), (
+        'docs/benchmarks.md differs from its sources: edit lab/bench/analysis.md or report.py, then '
+        'BENCH_RENDER_ONLY=1 make bench')
+
+
+def test_the_render_check_catches_an_edit():
+    analysis = read(os.path.join(BENCH, 'analysis.md'))
+    assert rendered_benchmarks(analysis.replace('0.48 to 0.59', '0.5-0.6')) != read(
+        os.path.join(REPO, 'docs', 'benchmarks.md'))
