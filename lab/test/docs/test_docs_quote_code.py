@@ -792,3 +792,18 @@ def test_the_render_check_catches_an_edit():
     analysis = read(os.path.join(BENCH, 'analysis.md'))
     assert rendered_benchmarks(analysis.replace('0.48 to 0.59', '0.5-0.6')) != read(
         os.path.join(REPO, 'docs', 'benchmarks.md'))
+
+
+def scripts_not_named(text, folder):
+    """The Python files of ``folder`` that ``text`` does not name (as `name.py`)."""
+    return sorted(os.path.basename(p) for p in glob.glob(os.path.join(folder, '*.py'))
+                  if '`%s`' % os.path.basename(p) not in text)
+
+
+def test_architecture_names_every_script_of_lab_report():
+    assert scripts_not_named(read(ARCHITECTURE), os.path.join(REPO, 'lab', 'report')) == []
+
+
+def test_the_script_list_check_catches_a_script_left_out():
+    text = read(ARCHITECTURE).replace('`run_timing.py`', 'run_timing')
+    assert scripts_not_named(text, os.path.join(REPO, 'lab', 'report')) == ['run_timing.py']
