@@ -150,7 +150,7 @@ def _points(x):
 STYLE = ('body{font-family:sans-serif;max-width:60em;margin:1.5em auto;padding:0 1em;color:#222;line-height:1.4}'
          'h1{font-size:1.5em}h2{font-size:1.2em;margin-top:1.5em}table{border-collapse:collapse;margin:1em 0}'
          'th,td{border:1px solid #bbb;padding:.3em .5em;text-align:left;vertical-align:top}'
-         'th{background:#eee}td.num{text-align:right;white-space:nowrap}tr.lost td.num{background:#f8d7d7}'
+         'th{background:#eee}.num{text-align:right;white-space:nowrap}tr.lost td.num{background:#f8d7d7}'
          'tfoot th{background:#ddd}.note{color:#555;font-size:.9em}svg.plot{max-width:100%;height:auto}'
          'p.status{font-weight:bold}')
 #: What the page may load: nothing (inline style, data: images only); no script may run.

@@ -1,5 +1,6 @@
-"""What a student's own check (``make check``, lab/scripts/check.py) prints of a grade record: what the
-teacher chose to show, in one setting (lab/check_visibility.ini, ``[check] show``):
+"""What a student's own check (``make check``, lab/scripts/check.py) prints of a grade record, and what
+a student's feedback page shows (:mod:`~exam_lab.grader.publish.feedback`): what the teacher chose to
+show, in one setting (lab/check_visibility.ini, ``[check] show``):
 
 - ``points``: each item and its points, the total and the status;
 - ``evidence``: also each item's evidence (its first line: the measured numbers) and the status's reason.
