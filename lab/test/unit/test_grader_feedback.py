@@ -74,6 +74,25 @@ def test_moodle_naming_rule_gives_the_download_names(folder, fullname, number):
     assert moodle_import(got + '/feedback.html', {number}) == (number, 'assignfeedback', 'file', '/feedback.html')
 
 
+def test_the_class_zips_names_reach_the_feedback_folders(tmp_path):
+    """A class zip as Moodle's downloader streams it (ZipStream flags a non-ASCII name as UTF-8, as Python
+    does): unpacked, each folder's name is Moodle's, and so is its feedback folder's."""
+    from exam_lab.grader.boxed import unpack
+    from test_grader_unpack import PACKAGE_XML, make_zip
+    archive = make_zip(tmp_path / 'ROS-Exam-12.zip', [('%s/exam/package.xml' % folder, PACKAGE_XML)
+                                                      for folder, _, _ in DOWNLOADS])
+    scratch = tmp_path / 'scratch'
+    scratch.mkdir()
+    found = unpack.list_students(archive, str(scratch))
+    assert sorted(os.path.basename(path) for _, path in found) == sorted(folder for folder, _, _ in DOWNLOADS)
+    for _, path in found:
+        folder = os.path.basename(path)
+        r = {'folder': folder, 'student': 'x', 'participant': None}
+        number = feedback.participant(r)
+        assert feedback.folder_name(feedback.moodle_name(r, number), number) == \
+            folder.rstrip('_').replace('_assignsubmission_file', '_assignfeedback_file') + '_'
+
+
 def test_clean_filename_is_moodles_param_file():
     assert feedback.clean_filename('a&b<c>d"e`f|g\'h:i\\j/k\x00l\x1fm\x7fn é ü') == 'abcdefghijklmn é ü'
     assert feedback.clean_filename('..') == '' and feedback.clean_filename('.') == ''
