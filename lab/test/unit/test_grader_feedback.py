@@ -418,3 +418,14 @@ def test_make_grade_rescore_and_worksheet_write_the_zip(tmp_path, capsys):
     got = pages(str(out))
     assert list(got) == ['Jane Doe_101_assignfeedback_file_/feedback.html']
     assert '<h1>Jane Doe: 30 / 30</h1>' in got['Jane Doe_101_assignfeedback_file_/feedback.html']
+
+
+def test_without_its_logs_a_grade_is_shown_as_if_the_threshold_run_took_place(tmp_path):
+    """make check reads the run's plan from its logs; a kept page cannot ask again: no logs, no value."""
+    out = str(tmp_path)
+    r = hostile_threshold_record('Ann_5_assignsubmission_file_')
+    report.write_grade(os.path.join(out, 'Ann'), r)
+    feedback.write(out, [r], show='evidence')
+    text = list(pages(out).values())[0]
+    assert not re.search(r'(?<![\w.])%s(?![\d])' % HIDDEN, text)
+    assert student_view.Q14A_WORDS[0] in html.unescape(text) and '<svg' not in text
