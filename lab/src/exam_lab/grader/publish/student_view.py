@@ -1,5 +1,6 @@
-"""What a student's own check (``make check``, lab/scripts/check.py) prints of a grade record: what the
-teacher chose to show, in one setting (lab/check_visibility.ini, ``[check] show``):
+"""What a student's own check (``make check``, lab/scripts/check.py) prints of a grade record, and what
+a student's feedback page shows (:mod:`~exam_lab.grader.publish.feedback`): what the teacher chose to
+show, in one setting (lab/check_visibility.ini, ``[check] show``):
 
 - ``points``: each item and its points, the total and the status;
 - ``evidence``: also each item's evidence (its first line: the measured numbers) and the status's reason.
@@ -70,6 +71,15 @@ def student_evidence(entry, threshold_run):
     return first
 
 
+def student_reason(record, show, threshold_run):
+    """The status's reason as the student may read it: only with ``evidence``, and never one about the
+    threshold run; '' otherwise."""
+    reason = record.get('status_reason') or ''
+    if show != 'evidence' or (threshold_run and THRESHOLD_RUN in reason):
+        return ''
+    return reason
+
+
 def lines(record, show, threshold_run):
     """The lines to print for ``record`` with the setting ``show``.
 
@@ -88,8 +98,8 @@ def lines(record, show, threshold_run):
     widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]) - 1)]
     out = ['  '.join([cell.ljust(w) for cell, w in zip(r, widths)] + [r[-1]]).rstrip() for r in rows]
     status = 'status: %s' % record.get('status', '')
-    reason = record.get('status_reason') or ''
-    if show == 'evidence' and reason and not (threshold_run and THRESHOLD_RUN in reason):
+    reason = student_reason(record, show, threshold_run)
+    if reason:
         status += ' - %s' % reason
     out += ['', status, 'not scored by the machine (the teacher grades them): %s' % NOT_SCORED]
     return out
