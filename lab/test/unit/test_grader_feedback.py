@@ -12,7 +12,7 @@ from html.parser import HTMLParser
 
 import pytest
 
-from exam_lab.grader.publish import feedback, hand, report, student_view
+from exam_lab.grader.publish import feedback, hand, moodle, report, student_view
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 from test_grader_desk import probe_result as desk_probe_result
 
@@ -88,7 +88,7 @@ def test_the_class_zips_names_reach_the_feedback_folders(tmp_path):
     for _, path in found:
         folder = os.path.basename(path)
         r = {'folder': folder, 'student': 'x', 'participant': None}
-        number = feedback.participant(r)
+        number = moodle.identity(r).participant
         assert feedback.folder_name(feedback.moodle_name(r, number), number) == \
             folder.rstrip('_').replace('_assignsubmission_file', '_assignfeedback_file') + '_'
 

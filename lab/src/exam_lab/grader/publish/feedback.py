@@ -70,16 +70,6 @@ def folder_name(fullname, participant):
     return clean_filename('%s_%s_%s_' % ((prefix,) + PLUGIN))
 
 
-def participant(record):
-    """The Moodle participant number of a grade record: ``participant`` (the runner's facts, from the
-    submission folder's name by :func:`exam_lab.grader.boxed.documents.submission_facts`), else read
-    from ``folder``; None when neither says. (A shared helper would serve hand.csv and the worksheet too.)"""
-    number = record.get('participant')
-    if isinstance(number, int) and not isinstance(number, bool):
-        return number
-    return moodle.participant_number(record.get('folder') or '')
-
-
 def moodle_name(record, number):
     """The full name as Moodle wrote it in the download folder's name (apostrophes and the like already
     removed by Moodle), else the grader's name of the student."""
@@ -89,20 +79,12 @@ def moodle_name(record, number):
     return record['student']
 
 
-def _hand_of(hands, record, number):
-    """The student's row of hand.csv, by name or by participant number (either may key it)."""
-    for key in (record['student'], number, None if number is None else str(number)):
-        if key is not None and key in hands:
-            return hands[key]
-    return None
-
-
 def released(record, hands, number):
     """``(the record to show, None)`` when the grade is released, else ``(None, why it waits)``."""
     status = record.get('status', 'graded')
     if status not in moodle.GRADED:
         return None, 'status "%s"%s' % (status, ': %s' % record['status_reason'] if record.get('status_reason') else '')
-    row = _hand_of(hands, record, number)
+    row = hands.get(hand.key(record))  # by participant number, the name only where there is none
     if row is None or all(v is None for v in row.points.values()):
         return record, None
     whole = hand.combine(record, row)
@@ -233,7 +215,7 @@ def write(out, records, single=False, show=None):
         return _nothing(target, safe_text.one_line(err))
     pages, waiting, numbers = [], [], {}
     for record in records:
-        number = participant(record)
+        number = moodle.identity(record).participant
         shown, why = released(record, hands, number)
         if why is None and number is None:
             why = 'no Moodle participant number in its folder\'s name (%s)' % (record.get('folder') or 'none')
