@@ -534,13 +534,15 @@ def _staged_work(prefix, sources, parent=None):
     return work, staged
 
 
-def class_students(class_path, work_dirs, scratch=None):
+def class_students(class_path, work_dirs, scratch=None, refused=None):
     """``[(student, folder or archive)]`` of a class, each name unique (``Jane Doe``, ``Jane Doe_2``):
     the students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`). A
     folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.boxed.unpack.list_students`
     opens no file of a folder); an archive is unpacked by :mod:`exam_lab.grader.boxed.intake` in a box of
     its own (INTAKE_BOUNDS), in a work folder made in ``scratch`` (default: the system's temp folder) and
-    appended to ``work_dirs`` (the caller removes it once the students are graded).
+    appended to ``work_dirs`` (the caller removes it once the students are graded). ``refused`` (a
+    dict) receives ``{folder: why}`` of the students whose files the intake refused by their own
+    bounds (:func:`grade_student`'s ``refused``).
 
     :raises unpack.UnpackError: the archive could not be unpacked (why, and the end of the box's log).
     """
@@ -564,11 +566,15 @@ def class_students(class_path, work_dirs, scratch=None):
         path = os.path.join(boxed.out, student['path'])
         if os.path.realpath(path) != os.path.normpath(path) or not os.path.lexists(path):
             raise unpack.UnpackError('the intake named %s, which is a link or missing' % student['path'])
+        if student.get('refused') is not None and refused is not None:
+            refused[path] = student['refused']
         students.append((student['name'], path))
     return _unique(students)
 
 
 def _unique(students):
+    """Each name once (a second ``Jane Doe`` is ``Jane Doe_2``); names are the students' folders in
+    OUT, which never end like one of the class's files (:func:`~exam_lab.grader.boxed.unpack.student_name`)."""
     named, seen = [], set()
     for name, folder in students:
         unique, n = name, 2
@@ -580,10 +586,16 @@ def _unique(students):
 
 
 def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
-                  unsandboxed=False, jobs=1):
+                  unsandboxed=False, jobs=1, refused=None):
     """Grade one student of a class into ``out_dir/name``; return the record. Anything the grader
     raises is this student's record ("could not grade"), never the class's. Both engines grade a
-    student with it: a local pool's thread and a Slurm task."""
+    student with it: a local pool's thread and a Slurm task.
+
+    :param refused: why the class's intake did not unpack this student's files (its own bounds): the
+        student is not graded, with that sentence, and its measurements are kept for a rescore.
+    """
+    if refused is not None:
+        return _refused_at_intake(name, folder, os.path.join(out_dir, name), sheet, refused)
     try:
         return grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
                                 on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
@@ -597,16 +609,33 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
         return record
 
 
+def _refused_at_intake(name, folder, out_dir, sheet, why):
+    """The record of a student whose files the class's intake refused: nothing of it ran."""
+    folder_name = os.path.basename(folder)
+    measured = {'student': name, 'sheet': sheet or 'altitude', 'static': {}, 'notes': [], 'fixes': [],
+                'comments': None, 'isolate': None, 'how_run': None,
+                'session': {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % why},
+                'extra': {'participant': moodle.participant_number(folder_name), 'folder': folder_name,
+                          'documents': [], 'seconds': 0.0}}
+    os.makedirs(out_dir, exist_ok=True)
+    with open(os.path.join(out_dir, MEASUREMENTS), 'w') as f:
+        json.dump(measured, f, indent=1, sort_keys=True)
+    record = score(measured)
+    report.write_grade(out_dir, record)
+    return record
+
+
 def class_similarity(klass, out, records_):
     """The similarity check over a class's submissions, each named as its grade record names it, run in
     a box (:mod:`exam_lab.grader.boxed.similarity` ``--class``: unpacking and comparing, SIMILARITY_BOUNDS)
     and read back as a :class:`~exam_lab.grader.score.records.SimilarityRecord`; written to
     ``out/similarity.json``. ``{"error"}`` when it could not run (the grades stand)."""
-    work_dirs = []
+    work_dirs, refused = [], {}
     try:
         by_folder = {r.get('folder'): r['student'] for r in records_}
-        submissions = [(by_folder.get(os.path.basename(folder), name), folder)
-                       for name, folder in class_students(klass, work_dirs)]
+        listed = [(by_folder.get(os.path.basename(folder), name), folder)
+                  for name, folder in class_students(klass, work_dirs, refused=refused)]
+        submissions = [(name, folder) for name, folder in listed if folder not in refused]
         python = similarity.ensure_venv()  # as root: an installation, from PyPI, of no student's bytes
         work, staged = _staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in submissions])
         work_dirs.append(work)
@@ -622,6 +651,8 @@ def class_similarity(klass, out, records_):
                 json.dump(job, f)
             result = boxed.run('exam_lab.grader.boxed.similarity', ['--class', boxed.path(f.name)],
                                records.SimilarityRecord, SIMILARITY_BOUNDS, python=python).value
+        result['notes'] = ['%s: not compared (its files were refused: %s)' % (name, refused[folder])
+                           for name, folder in listed if folder in refused] + result.get('notes', [])
     except Exception as err:  # a bug of the check, or its box failing, must not cost the class its page
         result = {'error': str(err) if isinstance(err, (InspectionFailed, unpack.UnpackError)) else repr(err)}
     finally:
@@ -670,9 +701,9 @@ def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progre
         raise sandbox.SandboxUnavailable(refusal)
     os.makedirs(out_dir, exist_ok=True)
     jobs = jobs or default_jobs()
-    work_dirs = []
+    work_dirs, refused = [], {}
     try:
-        students = class_students(class_path, work_dirs)
+        students = class_students(class_path, work_dirs, refused=refused)
         underlay = ensure_underlay(default_underlay())
         isolate = can_isolate() if isolate is None else isolate
         records = [None] * len(students)
@@ -685,7 +716,7 @@ def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progre
                 progress.started(name)
             record = grade_student(name, folder, out_dir, sheet, underlay, isolate,
                                    (lambda step: progress.step(name, step)) if progress else None, unsandboxed,
-                                   jobs=jobs)
+                                   jobs=jobs, refused=refused.get(folder))
             if progress:
                 progress.finished(record)
             return record

@@ -65,6 +65,7 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
     :param scale: scale the grades to the worksheet's maximum grade (:func:`moodle.fill`).
     :param title: the class's name (:func:`moodle.class_name`); the output folder's name when None.
     """
+    records = safe_text.cleaned(records)  # as grade_record made them; a record read back is made so again
     lines, notes, entries = [], [], {}
     for record in records:
         entry = entries[record['student']] = _student(out, record, single)
