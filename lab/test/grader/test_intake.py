@@ -152,7 +152,7 @@ def test_a_name_in_any_bytes_is_shown_escaped_everywhere(graded):
     cy = graded['records']['Cy Bytes']
     hints = ' | '.join(cy['for_the_teacher'])
     assert 'scripts/notes\\xff\\xe9.py' in hints, hints
-    assert "'exam/lien\\udcfe' -> '/tmp/cible\\udcfd'" in hints, hints
+    assert "'exam/lien\\xfe' -> '/tmp/cible\\xfd'" in hints, hints
     assert 'scripts/notes\\xff\\xe9.py' in read(os.path.join(graded['out'], 'Cy Bytes', 'grade.md'))
     assert 'notes\\xff\\xe9.py' in read(os.path.join(graded['out'], 'index.html'))
     with open(os.path.join(graded['out'], 'Cy Bytes', runner.MEASUREMENTS)) as f:  # kept exactly

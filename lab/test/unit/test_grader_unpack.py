@@ -166,3 +166,11 @@ def test_a_student_named_like_an_output_gets_a_folder_of_its_own(tmp_path):
         ('grades.csv.zip', 'z'), ('index.html.zip', 'z'), ('hand.csv_7_assignsubmission_file_/exam.zip', 'z')])
     names = [name for name, _ in unpack.list_students(archive, str(tmp_path / 'scratch'))]
     assert names == ['grades_csv', 'hand_csv', 'index_html']
+
+
+def test_a_name_in_any_bytes_is_shown_as_its_bytes():
+    """A byte that is not UTF-8 (surrogateescape) reads ``\\xNN`` in a note, as on the page; a name
+    that merely holds a backslash is not taken for one."""
+    assert unpack.shown_name(b'exam/lien\xfe'.decode('utf-8', 'surrogateescape')) == "'exam/lien\\xfe'"
+    assert unpack.shown_name('a\\udcff') == "'a\\\\udcff'"
+    assert unpack.shown_name('Größe\n') == "'Größe\\n'"

@@ -18,6 +18,7 @@ import stat
 import tarfile
 import xml.etree.ElementTree as ET
 import zipfile
+import zlib
 
 from exam_lab.grader.score.sheets import PACKAGE, drone_packages
 
@@ -62,6 +63,8 @@ _UNSUPPORTED = ((b'Rar!\x1a\x07', 'a RAR archive'), (b'7z\xbc\xaf\x27\x1c', 'a 7
 _VERSION = re.compile(r'(?:^|[^0-9])(?:[vV]|[_ -]|\()(\d{1,3})\)?$')
 #: Zip's "no date" (MS-DOS time starts in 1980): a date on or before it says nothing.
 _NO_DATE = datetime.datetime(1980, 1, 2)
+#: A byte that is not UTF-8 as repr() shows its surrogate escape (``\\udcff``).
+_ESCAPED_BYTE = re.compile(r'(?<!\\)((?:\\\\)*)\\udc([89a-f][0-9a-f])')  # not after an escaped backslash
 #: At most this many notes of one kind (links dropped, duplicates) are listed; the rest are counted.
 MAX_LISTED = 5
 
@@ -93,8 +96,9 @@ class Budget(object):
 
 
 def shown_name(name, limit=80):
-    """An archive entry's name as it may be printed: escaped (a newline cannot inject a line), cut."""
-    text = repr(name)
+    """An archive entry's name as it may be printed: escaped (a newline cannot inject a line; a byte
+    that is not UTF-8, kept by surrogateescape, reads ``\\xNN`` as everywhere else), cut."""
+    text = _ESCAPED_BYTE.sub(r'\1\\x\2', repr(name))
     return text if len(text) <= limit else text[:limit - 5] + '...' + text[-2:]
 
 
@@ -767,7 +771,8 @@ def _write_student(opened, kind, place, plan, archive_at_top):
             src = opened.open(member) if kind == 'zip' else opened.extractfile(member)
             with src:
                 _copy_capped(src, dest, size, '/'.join(parts))
-    except (zipfile.BadZipFile, tarfile.TarError, EOFError, OSError, RuntimeError) as err:
+    except (zipfile.BadZipFile, tarfile.TarError, zlib.error, EOFError, OSError, RuntimeError,
+            NotImplementedError) as err:  # encrypted, corrupt, or compressed as zipfile cannot read
         raise UnpackError('%s cannot be unpacked: %s' % (shown_name(plan.label), err))
 
 
