@@ -12,9 +12,12 @@ lab/test/unit/test_grader_moodle.py), each student a kind of upload that used to
 - ``grades.csv.zip`` and ``index.html.zip`` at the zip's top, and a Moodle folder ``hand.csv_...``
   (the case of the same kind): students named like the class's outputs;
 - ``Dee Copy`` and ``Eve Original``: the same code; Dee's package also holds 3 MB of YAML and
-  60 more Python files than the check reads of one student;
+  60 more Python files than the check reads of one student; ``Gus Deep`` a file in folders deeper than
+  an upload may be (the case of the same kind: refused alone, by the grading and by the check);
 - ``Fay Many``: 501 Python files, one over the inspection record's list cap: a sentence naming the
   cap and the value on her row, no traceback.
+
+The class zip itself is staged for its intake by a class's bounds, not one upload's.
 
 No package here starts a ROS node: what is judged is what the intake, the inspections, the
 similarity check, the desk and a rescore make of them (no flight; a few seconds of boxes).
@@ -88,6 +91,8 @@ def moodle_zip(path):
             *[('tools/t%02d.py' % i, ('value_%d = %d\n' % (i, i)).encode() * 200) for i in range(60)])),
         (MOODLE % ('Eve Original', 106) + 'exam.zip', package(('src/exam/logic.py', SHARED))),
         (MOODLE % ('Fay Many', 107) + 'exam.zip', package(*[('src/exam/m%03d.py' % i, b'x = 1\n') for i in range(501)])),
+        (MOODLE % ('Gus Deep', 108) + 'exam.zip', package()),
+        (MOODLE % ('Gus Deep', 108) + 'deep/' * (sandbox.UPLOAD_DEPTH + 1) + 'notes.txt', b'deep'),
     ] + [(MOODLE % ('Bob Crowd', 102) + 'photos/p%04d.jpg' % i, b'j') for i in range(unpack.MAX_FILES)]
     with zipfile.ZipFile(path, 'w', zipfile.ZIP_DEFLATED) as zf:
         for name, content in entries:
@@ -103,13 +108,21 @@ def graded(tmp_path_factory):
     root = tmp_path_factory.mktemp('intake')
     klass = moodle_zip(str(root / 'class.zip'))
     out = str(root / 'out')
-    records = runner.grade_class(klass, out, jobs=2)
-    similar = runner.class_similarity(klass, out, records)
+    staged, stage_upload = [], sandbox.stage_upload
+
+    def spy(source, target, *bounds):
+        staged.append((source, bounds))
+        return stage_upload(source, target, *bounds)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(sandbox, 'stage_upload', spy)
+        records = runner.grade_class(klass, out, jobs=2)
+        similar = runner.class_similarity(klass, out, records)
     lines = desk.finish(out, records, similar=similar, title='Intake class')
     before = {r['student']: r for r in records}
     rescore = runpy.run_path(os.path.join(REPO, 'lab', 'scripts', 'rescore.py'))
     status = rescore['main'](['--out', out])
-    return {'out': out, 'records': before, 'similar': similar, 'lines': lines, 'rescore': status}
+    return {'out': out, 'records': before, 'similar': similar, 'lines': lines, 'rescore': status,
+            'staged': staged, 'class': klass}
 
 
 def read(path):
@@ -118,8 +131,8 @@ def read(path):
 
 
 def test_every_student_has_a_row_and_every_output_is_written(graded):
-    names = ['Ann Screenshot', 'Bob Crowd', 'Cy Bytes', 'Dee Copy', 'Eve Original', 'Fay Many', 'grades_csv',
-             'hand_csv', 'index_html']
+    names = ['Ann Screenshot', 'Bob Crowd', 'Cy Bytes', 'Dee Copy', 'Eve Original', 'Fay Many', 'Gus Deep',
+             'grades_csv', 'hand_csv', 'index_html']
     assert sorted(graded['records']) == names
     rows = read(os.path.join(graded['out'], 'grades.csv')).splitlines()[1:]
     assert sorted(row.split(',')[0] for row in rows) == names
@@ -182,3 +195,17 @@ def test_a_cap_hit_reads_as_a_sentence(graded):
     assert fay['status'] == rubric.NOT_GRADED
     assert 'inspect.json.comments.files: 501 files (at most 500)' in fay['status_reason'], fay['status_reason']
     assert 'Traceback' not in fay['status_reason'] and 'File "' not in fay['status_reason']
+
+
+def test_a_student_over_an_upload_s_bounds_is_left_out_alone(graded):
+    gus = graded['records']['Gus Deep']
+    assert gus['status'] == rubric.NOT_GRADED, gus['status_reason']
+    assert 'folders more than %d deep' % sandbox.UPLOAD_DEPTH in gus['status_reason'], gus['status_reason']
+    assert [line for line in graded['similar']['notes'] if line.startswith('Gus Deep: not compared')]
+
+
+def test_the_class_zip_is_staged_by_a_class_s_bounds(graded):
+    """A class of 60 with its PDFs is larger than one upload may be (256 MB): its zip is staged for
+    the intake by the class's bounds."""
+    assert [bounds for source, bounds in graded['staged'] if source == graded['class']] == \
+        [(unpack.CLASS_BYTES, 1)] * 2  # the grading's intake and the similarity check's

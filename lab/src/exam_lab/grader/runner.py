@@ -518,10 +518,13 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             shutil.rmtree(work, ignore_errors=True)  # never follows a link the box left (rmtree does not)
 
 
-def _staged_work(prefix, sources, parent=None):
+def _staged_work(prefix, sources, parent=None, bounds=None, refused=None):
     """A work folder for a box (in ``parent``, by default the system's temp folder: the box's user must
     reach it), with each ``(name, path)`` of ``sources`` staged read-only as
-    ``<work>/upload/<index>/<name>``; returns ``(work, [staged paths])``."""
+    ``<work>/upload/<index>/<name>``, within ``bounds`` (``(bytes, files)``; one upload's when None);
+    returns ``(work, [staged paths])``. With ``refused`` (a dict), a source over its bounds is not
+    staged (None in its place) and ``refused`` receives ``{its path: why}``; otherwise it raises
+    :class:`~exam_lab.grader.host.sandbox.UploadRefused`."""
     work = tempfile.mkdtemp(prefix=prefix, dir=parent)
     os.chmod(work, 0o711)
     staged = []
@@ -530,7 +533,14 @@ def _staged_work(prefix, sources, parent=None):
     for index, (name, path) in enumerate(sources):
         os.mkdir(os.path.join(work, 'upload', str(index)), 0o755)
         staged.append(os.path.join(work, 'upload', str(index), name if name not in ('', '.', '..') else 'upload'))
-        sandbox.stage_upload(path, staged[-1])
+        try:
+            sandbox.stage_upload(path, staged[-1], *(bounds or ()))
+        except sandbox.UploadRefused as err:
+            if refused is None:
+                raise
+            refused[path] = str(err)
+            shutil.rmtree(os.path.dirname(staged[-1]), ignore_errors=True)
+            staged[-1] = None
     return work, staged
 
 
@@ -551,7 +561,9 @@ def class_students(class_path, work_dirs, scratch=None, refused=None):
         return _unique(unpack.list_students(class_path, None))
     if scratch:
         os.makedirs(scratch, mode=0o711, exist_ok=True)
-    work, (staged,) = _staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch)
+    # One file, bounded as a class (a class of 60 with its PDFs is more than one upload may be).
+    work, (staged,) = _staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch,
+                                   (unpack.CLASS_BYTES, 1))
     work_dirs.append(work)
     with sandbox.Box(work, bwrap=sandbox.check() is None) as box:
         boxed = Boxed(box, work)
@@ -635,10 +647,14 @@ def class_similarity(klass, out, records_):
         by_folder = {r.get('folder'): r['student'] for r in records_}
         listed = [(by_folder.get(os.path.basename(folder), name), folder)
                   for name, folder in class_students(klass, work_dirs, refused=refused)]
-        submissions = [(name, folder) for name, folder in listed if folder not in refused]
+        intake = [(name, folder) for name, folder in listed if folder not in refused]
         python = similarity.ensure_venv()  # as root: an installation, from PyPI, of no student's bytes
-        work, staged = _staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in submissions])
+        # Each student staged by its own bounds: one over them is not compared, the others are.
+        work, staged = _staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in intake],
+                                    refused=refused)
         work_dirs.append(work)
+        kept = [(student, path) for student, path in zip(intake, staged) if path is not None]
+        submissions, staged = [student for student, _ in kept], [path for _, path in kept]
         similarity.boilerplate(os.path.join(work, 'upload', 'boilerplate'))
         venv = os.path.dirname(os.path.dirname(python))
         with sandbox.Box(work, [venv], bwrap=sandbox.check() is None) as box:
