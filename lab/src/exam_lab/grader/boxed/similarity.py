@@ -163,8 +163,7 @@ def stage(submissions, target):
         if left:
             notes.append('%s: %d code file(s) compared, %d left out (at most %d files and %d bytes of a student): %s'
                          % (name, len(taken), len(left), MAX_STUDENT_FILES, MAX_STUDENT_BYTES,
-                            ', '.join(unpack.shown_name(r) for r in left[:unpack.MAX_LISTED])
-                            + (' and %d more' % (len(left) - unpack.MAX_LISTED) if len(left) > unpack.MAX_LISTED else '')))
+                            unpack.listed([unpack.shown_name(r) for r in left])))
         if os.path.isdir(folder):
             staged[name] = folder
         else:

@@ -169,16 +169,16 @@ class _Plan(object):
                 '%s (%d entries)' % (k, n) for k, n in sorted(self.products.items()))))
         if self.special:
             out.append('%s: %d special file(s) (FIFO, device) dropped: %s' % (
-                self.label, len(self.special), _listed([shown_name(n) for n in self.special])))
+                self.label, len(self.special), listed([shown_name(n) for n in self.special])))
         duplicates = sorted('/'.join(k) for k, n in self.seen.items() if n > 1)
         if duplicates:
             out.append('%s: %d entr(ies) appear more than once, the last one kept: %s' % (
-                self.label, len(duplicates), _listed([shown_name(n) for n in duplicates])))
+                self.label, len(duplicates), listed([shown_name(n) for n in duplicates])))
         clashes = sorted(' / '.join(sorted('/'.join(k) for k in keys)) for keys in self.folded.values()
                          if len(keys) > 1)
         if clashes:
             out.append('%s: names that differ only by case (one file on Windows or macOS): %s' % (
-                self.label, _listed(clashes)))
+                self.label, listed(clashes)))
         return out
 
     def link_notes(self):
@@ -190,12 +190,13 @@ class _Plan(object):
             out.append('%s: catkin\'s link %s dropped (links are never followed; the grader makes its '
                        'own workspace)' % (self.label, ', '.join(shown_name(n) for n in catkin)))
         if other:
-            out.append('%s: %d link(s) dropped, never followed: %s' % (self.label, len(other), _listed(
+            out.append('%s: %d link(s) dropped, never followed: %s' % (self.label, len(other), listed(
                 ['%s -> %s' % (shown_name(n), shown_name(t, 60)) for n, t in other])))
         return out
 
 
-def _listed(names):
+def listed(names):
+    """The first MAX_LISTED of ``names``, and how many more."""
     shown = ', '.join(names[:MAX_LISTED])
     return shown + (' and %d more' % (len(names) - MAX_LISTED) if len(names) > MAX_LISTED else '')
 
@@ -494,9 +495,9 @@ def open_submission(path, scratch, notes, fixes=None, budget=None, uploads=None)
     if not found:
         refused = [s for s in seen if '(refused: ' in s or 'cannot be opened' in s]
         if refused:  # the reason is the archive that could not be opened, not a missing package
-            raise UnpackError(_listed(refused))
+            raise UnpackError(listed(refused))
         raise UnpackError('no catkin package (package.xml) in %s%s' % (
-            os.path.basename(path), '; found: %s' % _listed(seen) if seen else ' (it is empty)'))
+            os.path.basename(path), '; found: %s' % listed(seen) if seen else ' (it is empty)'))
     chosen = found[0]
     name = package_name(os.path.join(chosen, 'package.xml'))
     if name != PACKAGE:
@@ -727,8 +728,8 @@ def unpack_class(archive, target, refused):
             single = [p for _, p in members if len(p) == 1]
             if single and any(len(p) > 1 for _, p in members):
                 raise UnpackError('%s is both a file and a folder' % shown_name(key))
-            files = len(plan.files)
-            Budget(MAX_BYTES, MAX_FILES).take(files, sum(size for _, _, size in plan.files), 'the files of %s' % shown_name(key))
+            Budget(MAX_BYTES, MAX_FILES).take(len(plan.files), sum(size for _, _, size in plan.files),
+                                              'the files of %s' % shown_name(key))
         except UnpackError as err:
             refused[place] = str(err)
             plans.append((key, place, None, members))
