@@ -518,10 +518,13 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             shutil.rmtree(work, ignore_errors=True)  # never follows a link the box left (rmtree does not)
 
 
-def _staged_work(prefix, sources, parent=None):
+def _staged_work(prefix, sources, parent=None, bounds=None, refused=None):
     """A work folder for a box (in ``parent``, by default the system's temp folder: the box's user must
     reach it), with each ``(name, path)`` of ``sources`` staged read-only as
-    ``<work>/upload/<index>/<name>``; returns ``(work, [staged paths])``."""
+    ``<work>/upload/<index>/<name>``, within ``bounds`` (``(bytes, files)``; one upload's when None);
+    returns ``(work, [staged paths])``. With ``refused`` (a dict), a source over its bounds is not
+    staged (None in its place) and ``refused`` receives ``{its path: why}``; otherwise it raises
+    :class:`~exam_lab.grader.host.sandbox.UploadRefused`."""
     work = tempfile.mkdtemp(prefix=prefix, dir=parent)
     os.chmod(work, 0o711)
     staged = []
@@ -530,11 +533,18 @@ def _staged_work(prefix, sources, parent=None):
     for index, (name, path) in enumerate(sources):
         os.mkdir(os.path.join(work, 'upload', str(index)), 0o755)
         staged.append(os.path.join(work, 'upload', str(index), name if name not in ('', '.', '..') else 'upload'))
-        sandbox.stage_upload(path, staged[-1])
+        try:
+            sandbox.stage_upload(path, staged[-1], *(bounds or ()))
+        except sandbox.UploadRefused as err:
+            if refused is None:
+                raise
+            refused[path] = str(err)
+            shutil.rmtree(os.path.dirname(staged[-1]), ignore_errors=True)
+            staged[-1] = None
     return work, staged
 
 
-def class_students(class_path, work_dirs, scratch=None, out=None):
+def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
     """``[(student, folder or archive)]`` of a class, each name unique (``Jane Doe``, ``Jane Doe_2``):
     the students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`); with
     ``out``, the folder of an earlier run of the class, each student keeps the name (the folder in OUT)
@@ -542,7 +552,9 @@ def class_students(class_path, work_dirs, scratch=None, out=None):
     folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.boxed.unpack.list_students`
     opens no file of a folder); an archive is unpacked by :mod:`exam_lab.grader.boxed.intake` in a box of
     its own (INTAKE_BOUNDS), in a work folder made in ``scratch`` (default: the system's temp folder) and
-    appended to ``work_dirs`` (the caller removes it once the students are graded).
+    appended to ``work_dirs`` (the caller removes it once the students are graded). ``refused`` (a
+    dict) receives ``{folder: why}`` of the students whose files the intake refused by their own
+    bounds (:func:`grade_student`'s ``refused``).
 
     :raises unpack.UnpackError: the archive could not be unpacked (why, and the end of the box's log).
     """
@@ -551,7 +563,9 @@ def class_students(class_path, work_dirs, scratch=None, out=None):
         return _unique(unpack.list_students(class_path, None), kept_folders(out))
     if scratch:
         os.makedirs(scratch, mode=0o711, exist_ok=True)
-    work, (staged,) = _staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch)
+    # One file, bounded as a class (a class of 60 with its PDFs is more than one upload may be).
+    work, (staged,) = _staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch,
+                                   (unpack.CLASS_BYTES, 1))
     work_dirs.append(work)
     with sandbox.Box(work, bwrap=sandbox.check() is None) as box:
         boxed = Boxed(box, work)
@@ -566,6 +580,8 @@ def class_students(class_path, work_dirs, scratch=None, out=None):
         path = os.path.join(boxed.out, student['path'])
         if os.path.realpath(path) != os.path.normpath(path) or not os.path.lexists(path):
             raise unpack.UnpackError('the intake named %s, which is a link or missing' % student['path'])
+        if student.get('refused') is not None and refused is not None:
+            refused[path] = student['refused']
         students.append((student['name'], path))
     return _unique(students, kept_folders(out))
 
@@ -598,7 +614,8 @@ def kept_folders(out):
 
 def _unique(students, kept=None):
     """Each student's name made unique (``Jane Doe``, ``Jane Doe_2``): it is the student's folder in
-    OUT. A participant that ``kept`` (:func:`kept_folders`) gives a folder keeps it, and no other
+    OUT, which never ends like one of the class's files (:func:`~exam_lab.grader.boxed.unpack.student_name`).
+    A participant that ``kept`` (:func:`kept_folders`) gives a folder keeps it, and no other
     student takes a folder of OUT that is a participant's: a classmate whose name cleans to the same
     (``Jane Doe.``) submitting late never takes the first one's folder, its kept measurements or its
     row (the rows of hand.csv and the worksheet are keyed by the number anyway)."""
@@ -622,10 +639,16 @@ def _unique(students, kept=None):
 
 
 def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
-                  unsandboxed=False, jobs=1):
+                  unsandboxed=False, jobs=1, refused=None):
     """Grade one student of a class into ``out_dir/name``; return the record. Anything the grader
     raises is this student's record ("could not grade"), never the class's. Both engines grade a
-    student with it: a local pool's thread and a Slurm task."""
+    student with it: a local pool's thread and a Slurm task.
+
+    :param refused: why the class's intake did not unpack this student's files (its own bounds): the
+        student is not graded, with that sentence, and its measurements are kept for a rescore.
+    """
+    if refused is not None:
+        return _refused_at_intake(name, folder, os.path.join(out_dir, name), sheet, refused)
     try:
         return grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
                                 on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
@@ -641,19 +664,40 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
         return record
 
 
+def _refused_at_intake(name, folder, out_dir, sheet, why):
+    """The record of a student whose files the class's intake refused: nothing of it ran."""
+    folder_name = os.path.basename(folder)
+    measured = {'student': name, 'sheet': sheet or 'altitude', 'static': {}, 'notes': [], 'fixes': [],
+                'comments': None, 'isolate': None, 'how_run': None,
+                'session': {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % why},
+                'extra': {'participant': moodle.participant_number(folder_name), 'folder': folder_name,
+                          'documents': [], 'seconds': 0.0}}
+    os.makedirs(out_dir, exist_ok=True)
+    with open(os.path.join(out_dir, MEASUREMENTS), 'w') as f:
+        json.dump(measured, f, indent=1, sort_keys=True)
+    record = score(measured)
+    report.write_grade(out_dir, record)
+    return record
+
+
 def class_similarity(klass, out, records_):
     """The similarity check over a class's submissions, each named as its grade record names it, run in
     a box (:mod:`exam_lab.grader.boxed.similarity` ``--class``: unpacking and comparing, SIMILARITY_BOUNDS)
     and read back as a :class:`~exam_lab.grader.score.records.SimilarityRecord`; written to
     ``out/similarity.json``. ``{"error"}`` when it could not run (the grades stand)."""
-    work_dirs = []
+    work_dirs, refused = [], {}
     try:
         by_folder = {r.get('folder'): r['student'] for r in records_}
-        submissions = [(by_folder.get(os.path.basename(folder), name), folder)
-                       for name, folder in class_students(klass, work_dirs)]
+        listed = [(by_folder.get(os.path.basename(folder), name), folder)
+                  for name, folder in class_students(klass, work_dirs, refused=refused)]
+        intake = [(name, folder) for name, folder in listed if folder not in refused]
         python = similarity.ensure_venv()  # as root: an installation, from PyPI, of no student's bytes
-        work, staged = _staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in submissions])
+        # Each student staged by its own bounds: one over them is not compared, the others are.
+        work, staged = _staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in intake],
+                                    refused=refused)
         work_dirs.append(work)
+        kept = [(student, path) for student, path in zip(intake, staged) if path is not None]
+        submissions, staged = [student for student, _ in kept], [path for _, path in kept]
         similarity.boilerplate(os.path.join(work, 'upload', 'boilerplate'))
         venv = os.path.dirname(os.path.dirname(python))
         with sandbox.Box(work, [venv], bwrap=sandbox.check() is None) as box:
@@ -666,6 +710,8 @@ def class_similarity(klass, out, records_):
                 json.dump(job, f)
             result = boxed.run('exam_lab.grader.boxed.similarity', ['--class', boxed.path(f.name)],
                                records.SimilarityRecord, SIMILARITY_BOUNDS, python=python).value
+        result['notes'] = ['%s: not compared (its files were refused: %s)' % (name, refused[folder])
+                           for name, folder in listed if folder in refused] + result.get('notes', [])
     except Exception as err:  # a bug of the check, or its box failing, must not cost the class its page
         result = {'error': str(err) if isinstance(err, (InspectionFailed, unpack.UnpackError)) else repr(err)}
     finally:
@@ -714,9 +760,9 @@ def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progre
         raise sandbox.SandboxUnavailable(refusal)
     os.makedirs(out_dir, exist_ok=True)
     jobs = jobs or default_jobs()
-    work_dirs = []
+    work_dirs, refused = [], {}
     try:
-        students = class_students(class_path, work_dirs, out=out_dir)
+        students = class_students(class_path, work_dirs, refused=refused, out=out_dir)
         underlay = ensure_underlay(default_underlay())
         isolate = can_isolate() if isolate is None else isolate
         records = [None] * len(students)
@@ -729,7 +775,7 @@ def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progre
                 progress.started(name)
             record = grade_student(name, folder, out_dir, sheet, underlay, isolate,
                                    (lambda step: progress.step(name, step)) if progress else None, unsandboxed,
-                                   jobs=jobs)
+                                   jobs=jobs, refused=refused.get(folder))
             if progress:
                 progress.finished(record)
             return record

@@ -149,7 +149,11 @@ def main(argv=None):
     os.makedirs(os.path.join(args.ws, 'src'), exist_ok=True)
     if args.toplevel:
         os.symlink(args.toplevel, os.path.join(args.ws, 'src', 'CMakeLists.txt'))
-    records.write(args.out, records.InspectRecord, inspect(args.upload, args.ws, args.out, args.sheet))
+    try:
+        records.write(args.out, records.InspectRecord, inspect(args.upload, args.ws, args.out, args.sheet))
+    except records.RecordError as err:  # a sentence for the teacher, not a traceback
+        sys.stderr.write('inspect: its record exceeds a bound: %s\n' % err)
+        return 4
     return 0
 
 

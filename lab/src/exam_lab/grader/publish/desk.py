@@ -67,6 +67,7 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
     :param title: the class's name (:func:`moodle.class_name`); the output folder's name when None.
     :param show: what the students' feedback pages show (:func:`feedback.write`); None: lab/check_visibility.ini.
     """
+    records = safe_text.cleaned(records)  # as grade_record made them; a record read back is made so again
     lines, notes, entries = [], [], {}
     for record in records:
         entry = entries[record['student']] = _student(out, record, single)

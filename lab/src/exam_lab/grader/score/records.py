@@ -104,7 +104,7 @@ def check(value, schema, where='record'):
         if not isinstance(value, list):
             raise RecordError('%s: a list expected, got %s' % (where, type(value).__name__))
         if len(value) > schema.limit:
-            raise RecordError('%s: %d items (at most %d)' % (where, len(value), schema.limit))
+            raise RecordError('%s: %d %s (at most %d)' % (where, len(value), _noun(where), schema.limit))
         return [check(item, schema.schema, '%s[%d]' % (where, index)) for index, item in enumerate(value)]
     if isinstance(schema, dict):
         if not isinstance(value, dict):
@@ -121,6 +121,12 @@ def check(value, schema, where='record'):
             checked[key] = check(value[key], inner, '%s.%s' % (where, key))
         return checked
     raise TypeError('not a schema: %r' % (schema,))
+
+
+def _noun(where):
+    """What a list at ``where`` holds, for its cap's sentence: ``inspect.json.comments.files`` holds files."""
+    key = where.rsplit('.', 1)[-1]
+    return key.replace('_', ' ') if re.match(r'^[a-z_]+s$', key) else 'items'
 
 
 def _shown(value):
@@ -230,11 +236,13 @@ class InspectRecord(Record):
 
 class IntakeRecord(Record):
     """A class archive unpacked by :mod:`exam_lab.grader.boxed.intake` (``intake.json``): ``students``,
-    each ``{"name", "path"}`` with ``path`` relative to the intake's output folder."""
+    each ``{"name", "path"}`` with ``path`` relative to the intake's output folder, and ``refused``
+    (why) when that student's files were not unpacked. A class may be larger than any other list's cap."""
     FILE = 'intake.json'
-    MAX_BYTES = 4 << 20
+    MAX_BYTES = 16 << 20
+    MAX_STUDENTS = 10000
     SCHEMA = {'uid': Number(0, 2 ** 32, integer=True),
-              'students': [{'name': Text(255), 'path': Text(4096)}]}
+              'students': Items({'name': Text(255), 'path': Text(4096), 'refused': Optional(Text())}, MAX_STUDENTS)}
 
     def validate(self):
         for index, student in enumerate(self.students):
