@@ -25,7 +25,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.publish.page` (index.html), :mod:`~.publish.flightplot`, :mod:`~.publish.moodle` (the
   offline grading worksheet), :mod:`~.publish.gradescope` (results.json), :mod:`~.publish.progress`
   (k of n, the time left; a run's steps), :mod:`~.publish.hand` (the teacher's hand points, hand.csv),
-  :mod:`~.publish.feedback` (each student's page for Moodle, moodle-feedback.zip),
+  :mod:`~.publish.feedback` (each student's page for Moodle, moodle-feedback.zip), :mod:`~.publish.cells`
+  (a CSV cell a spreadsheet cannot run, read back exactly),
   :mod:`~.publish.provenance` (what made a grade), :mod:`~.publish.student_view` (what ``make check``
   shows a student).
 - :mod:`~exam_lab.grader.runner` -- one submission or a class, top to bottom: stage, inspect (boxed),

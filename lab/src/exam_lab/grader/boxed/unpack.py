@@ -779,7 +779,7 @@ def _write_student(opened, kind, place, plan, archive_at_top):
 
 #: Endings of the files a class's run writes in OUT beside the students' folders (grades.csv, index.html,
 #: hand.csv, similarity.json, the filled worksheet...): a student's folder never has one.
-OUTPUT_ENDINGS = ('.csv', '.html', '.json', '.jsonl', '.md', '.png', '.txt', '.log')
+OUTPUT_ENDINGS = ('.csv', '.html', '.json', '.jsonl', '.md', '.png', '.txt', '.log', '.zip')
 
 
 def student_name(folder):
