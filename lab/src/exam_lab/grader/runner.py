@@ -384,7 +384,9 @@ def score(measured, how='run'):
     """The grade record of one submission from what its run measured (:data:`MEASUREMENTS`): the one
     place the rubric is applied, by a run and by a rescore alike. ``how`` goes into its provenance."""
     static, session = measured['static'], measured['session']
-    extra = dict(measured['extra'], doubts=rubric.doubts(static, session), provenance=provenance.stamp(how))
+    run_value = rubric.threshold_run_value(static, session)
+    extra = dict(measured['extra'], doubts=rubric.doubts(static, session), provenance=provenance.stamp(how),
+                 threshold_run={'value': run_value} if run_value is not None else None)
     return report.grade_record(measured['student'], measured['sheet'], rubric.score(measured['sheet'], static, session),
                                hints(static, session, measured['notes'] + measured['fixes'], measured['comments'],
                                      measured['isolate'], measured['how_run']),

@@ -58,6 +58,15 @@ def threshold_probe(session):
     return runs[0]['probe'] if runs and runs[0].get('probe') else None
 
 
+def threshold_run_value(static, session):
+    """The threshold run's value, which no output a student reads may show: as flown (its probe's
+    plan), else as drawn by the inspection (a run skipped or failed); None when there was none."""
+    probe = threshold_probe(session)
+    if probe and probe.get('threshold') is not None:
+        return probe['threshold']
+    return ((static or {}).get('threshold') or {}).get('run_value')
+
+
 def node_ran(session):
     probe = main_probe(session)
     return bool(probe and probe.get('nodes'))
@@ -555,7 +564,7 @@ def missing_evidence(static, session):
     elif not calls(probe) and code.get('service_calls') and not unreached_legs(probe, ['long_up']):
         out.append('the node never called %s in the whole flight (its own value above the threshold for %.1f s), '
                    'yet its code calls it at %s: no call to judge Q13, Q14a, Q14b on; read its code to see why '
-                   'the call is never reached' % (sheet.service, schedule['long_down'] - _reached(probe, 'long_up'),
+                   'the call is never reached' % ('/' + sheet.service.lstrip('/'), schedule['long_down'] - _reached(probe, 'long_up'),
                                                   ', '.join(code['service_calls'][:3])))
     return out
 
