@@ -228,3 +228,16 @@ def test_a_node_that_never_published_while_its_code_publishes_is_a_hand_grade():
     status, reason = rubric.status(dict(STATIC, code=CODE), silent)
     assert status == rubric.HAND_GRADE and 'never published its value' in reason and \
         'scripts/exam_node.py:62' in reason, reason
+
+
+def test_a_private_parameter_read_before_init_node_is_no_reading_of_it():
+    """rospy resolves ``~threshold`` against ``/unnamed`` before init_node: not the node's parameter,
+    so no half point from the code, and the evidence says where and why."""
+    skipped = dict(measured(threshold_run=False), threshold_skipped='the node never warned in the main run')
+    static = dict(STATIC, threshold={'name': '/exam/threshold', 'value': 1300}, params_in_code=['~threshold'])
+    assert points(skipped, static)['Q14a'] == 0.5
+    early = dict(static, code=dict(CODE, private_before_init=['scripts/exam_node.py:6: ~threshold']))
+    assert points(skipped, early)['Q14a'] == 0.0
+    evidence = _item(rubric.score('altitude', early, skipped), 'Q14a')['evidence']
+    assert 'it reads ~threshold before init_node (scripts/exam_node.py:6), where rospy resolves it as ' \
+        '.../unnamed/threshold (its name until then)' in evidence, evidence

@@ -148,3 +148,20 @@ def test_a_file_that_does_not_parse_is_read_as_text_and_said_so(tmp_path):
     assert source.param_names(str(pkg)) == ['~seuil']
     assert not source.calls_a_service(str(pkg)), 'the comment is dropped before the text is read'
     assert source.code_evidence(str(pkg))['service_calls'] == []
+
+
+def test_a_private_parameter_read_before_init_node_is_named(tmp_path):
+    """Before ``init_node`` rospy's caller id is ``<ns>/unnamed`` (rospy/names.py), so ``~threshold``
+    then reads ``/unnamed/threshold``, never the node's: named with its line, and so is one read when
+    the module is imported (before ``main()`` starts the node). A relative or global name read then, a
+    private one read after, and one in a function of its own are not."""
+    pkg = tmp_path / 'exam'
+    write(pkg / 'scripts' / 'exam_node.py', 'import rospy\nLIMIT = rospy.get_param("~early", 1)\n'
+                                            'def helper():\n    return rospy.get_param("~later")\n'
+                                            'def main():\n    t = rospy.get_param("~threshold", 1300)\n'
+                                            '    g = rospy.get_param("threshold")\n    rospy.init_node("exam")\n'
+                                            '    r = rospy.get_param("~rate")\n'
+                                            'if __name__ == "__main__":\n    main()\n')
+    assert source.private_before_init(str(pkg)) == ['scripts/exam_node.py:2: ~early', 'scripts/exam_node.py:6: ~threshold']
+    write(pkg / 'scripts' / 'exam_node.py', 'import rospy\nt = rospy.get_param("~threshold")\nrospy.init_node("e")\n')
+    assert source.private_before_init(str(pkg)) == ['scripts/exam_node.py:2: ~threshold']

@@ -91,7 +91,8 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     fixes.extend(source.make_runnable(pkg, launched))
     static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses], 'package': name,
               'python2': source.python2_evidence(pkg), 'params_in_code': source.param_names(pkg),
-              'args_in_code': source.args_read(pkg), 'code': source.code_evidence(pkg),
+              'args_in_code': source.args_read(pkg),
+              'code': dict(source.code_evidence(pkg), private_before_init=source.private_before_init(pkg)),
               'launch': None, 'threshold': None, 'uploads': uploads}
     record.update(sheet=sheet, static=static, threshold_value=SHEETS[sheet].threshold,
                   calls_service=source.calls_a_service(pkg))

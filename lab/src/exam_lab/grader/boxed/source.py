@@ -196,6 +196,42 @@ def param_names(package_dir):
     return sorted(names)
 
 
+def _scope_calls(scope):
+    """The calls of one scope (a module or a function), not those of the functions and classes it defines."""
+    todo = list(ast.iter_child_nodes(scope))
+    while todo:
+        node = todo.pop()
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef, ast.Lambda)):
+            continue
+        if isinstance(node, ast.Call):
+            yield node
+        todo.extend(ast.iter_child_nodes(node))
+
+
+def private_before_init(package_dir):
+    """Private parameters (``~name``) the code reads before it starts its node, ``"file:line: ~name"``:
+    in the function that calls ``init_node``, above that call, or in the module's own body (run on
+    import, before ``main()``). Until ``init_node`` rospy's caller id is ``<ns>/unnamed``
+    (``rospy/names.py``), so such a read never sees the node's parameter; relative and global names
+    resolve alike before and after."""
+    found = []
+    for f in parsed(package_dir):
+        if f.tree is None or not f.calls('init_node'):
+            continue
+        scopes = [f.tree] + [n for n in ast.walk(f.tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))]
+        for scope in scopes:
+            calls = list(_scope_calls(scope))
+            inits = [c.lineno for c in calls if call_name(c) == 'init_node']
+            if not inits and scope is not f.tree:
+                continue
+            first = min(inits) if inits else float('inf')  # the module's body runs before any function's init
+            for call in calls:
+                name = _first_string(call, 'param_name') if call_name(call) in PARAM_READERS else None
+                if name and name.startswith('~') and call.lineno < first:
+                    found.append('%s: %s' % (f.where(call), name))
+    return sorted(set(found), key=lambda w: (w.split(':')[0], int(w.split(':')[1])))
+
+
 def _argv_sources(tree):
     """Names bound to the node's arguments (``argv = rospy.myargv()``, ``args = sys.argv``)."""
     names = set()

@@ -185,7 +185,8 @@ def write(folder, record_type, value):
 STATIC = {
     'launch_files': [str], 'package': Text(255), 'python2': [str], 'params_in_code': [str],
     'args_in_code': Optional([str]),
-    'code': Optional({'service_calls': [str], 'publishes': [str], 'timers': [str]}),
+    'code': Optional({'service_calls': [str], 'publishes': [str], 'timers': [str],
+                      'private_before_init': Optional([str])}),
     'launch': Maybe({'file': str, 'starts_drone': bool, 'exam_type': str, 'exam_name': str, 'package': Text(255),
                      'comments': Number(0, 1e9, integer=True), 'exam_type_found': bool}),
     'threshold': Maybe({'name': str, 'value': Maybe((str, Number(), bool)), 'where': str,

@@ -421,7 +421,19 @@ def _reads(static, threshold):
         if name.startswith('-'):
             return [a for a in found if a == name]
         return [a for a in found if a == name or not a.startswith(('-', 'argv['))]
-    return [p for p in static.get('params_in_code', []) if p.strip('~/').split('/')[-1] == name.split('/')[-1]]
+    early = _read_too_early(static)
+    return [p for p in static.get('params_in_code', []) if p.strip('~/').split('/')[-1] == name.split('/')[-1]
+            and p not in early]
+
+
+def _read_too_early(static):
+    """{private parameter name: where} the code reads before init_node (then rospy resolves it against
+    ``<ns>/unnamed``, never the node's name: ``rospy/names.py``)."""
+    out = {}
+    for entry in ((static.get('code') or {}).get('private_before_init') or []):
+        where, _, name = entry.rpartition(': ')
+        out.setdefault(name, where)
+    return out
 
 
 def score_q14a(sheet, static, session):
@@ -441,6 +453,11 @@ def score_q14a(sheet, static, session):
         'argument' if threshold.get('how') == 'args' else 'parameter')
     if read and not stayed_up(session):
         static_note += ', but the node died (see runs)'
+    early = [(n, w) for n, w in sorted(_read_too_early(static).items())
+             if n.strip('~/').split('/')[-1] == name.split('/')[-1]]
+    if early:
+        static_note += '; it reads %s before init_node (%s), where rospy resolves it as .../unnamed/%s (its name ' \
+                       'until then), not as the node\'s parameter' % (early[0][0], early[0][1], early[0][0].lstrip('~'))
     probe2 = threshold_probe(session)
     skipped = session.get('threshold_skipped')
     if probe2 is None:
