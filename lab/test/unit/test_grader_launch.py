@@ -364,3 +364,30 @@ def test_every_way_a_launch_file_hands_over_the_threshold(tmp_path, monkeypatch,
         assert before.replace('1300', '1040.0') == after, (before, after)
     again = launch.threshold_param(launch.analyse(derived, pkg), 'altitude')[0]
     assert (again.name, launch.as_number(again.value)) == (found_name, 1040.0)
+
+
+@pytest.mark.parametrize('draw', [0.0, 0.5, 0.999])
+def test_the_threshold_run_value_is_drawn_once_written_and_planned(tmp_path, draw):
+    """Issue 36 point 7: the threshold run's value comes from a draw made at grading time, is computed
+    once (sheets.threshold_run_value, in the inspection), written into the derived launch file where
+    the student set the threshold (here an <arg> given to args=), kept in the record's static facts (the
+    measurements), and planned by the runner as it is, with the main run's margin."""
+    from exam_lab.grader import runner
+    from exam_lab.grader.boxed import inspect
+    from exam_lab.grader.score import records, sheets
+    ws = tmp_path / 'ws'
+    (ws / 'src').mkdir(parents=True)
+    found = inspect.inspect(os.path.join(SUBMISSIONS, 'args_threshold', 'exam'), str(ws), str(tmp_path / 'out'),
+                            None, draw)
+    value = sheets.threshold_run_value(1300.0, draw)
+    assert 1300 - 4 * 130 <= value <= 1300 - 2.5 * 130
+    assert found['threshold_run_value'] == found['static']['threshold']['run_value'] == value
+    assert found['static']['threshold']['how'] == 'args' and found['static']['args_in_code'] == ['--threshold']
+    derived = os.path.join(str(ws), found['threshold_launch'])
+    again = launch.threshold_param(launch.analyse(derived, os.path.join(str(ws), 'src', 'exam')), 'altitude')[0]
+    assert (again.name, launch.as_number(again.value)) == ('--threshold', value)
+    job = runner.plan_job(records.InspectRecord(records.check(found, records.InspectRecord.SCHEMA)))
+    main, threshold = [run['plan'] for run in job['runs']]
+    assert threshold == dict(main, kind='threshold', threshold=value), 'the main run\'s plan around the new value'
+    with pytest.raises(ValueError):
+        sheets.threshold_run_value(1300.0, 1.0)
