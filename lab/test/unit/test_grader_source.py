@@ -135,6 +135,7 @@ def test_code_is_read_as_code_never_comments_or_strings(tmp_path):
                      'publishes': ['scripts/exam_node.py:%d' % (14 + offset)],
                      'timers': ['scripts/exam_node.py:%d' % (13 + offset)]}
     assert source.sheets_in_code(str(pkg)) == ['altitude']
+    assert source.private_before_init(str(pkg)) == [], 'the comment\'s ~threshold above init_node is no read'
     assert source.unparsed(str(pkg)) == []
 
 
