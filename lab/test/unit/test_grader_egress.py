@@ -18,7 +18,7 @@ def inspect_record(**changes):
                          'threshold': {'name': '/threshold', 'value': 1300, 'where': 'launch/exam.launch'}},
               'threshold_value': 1300.0, 'calls_service': True, 'namespace': '/',
               'main_launch': 'src/exam/launch/.grader-main-exam.launch',
-              'threshold_launch': 'src/exam/launch/.grader-threshold-exam.launch',
+              'threshold_launch': 'src/exam/launch/.grader-threshold-exam.launch', 'threshold_run_value': 912.4,
               'handed_in_launch': 'exam/launch/exam.launch',
               'comments': {'comments': 3, 'code': 40, 'files': ['scripts/exam_node.py']},
               'facts': {'participant': 1234, 'folder': 'Jane Doe_1234_assignsubmission_file_', 'documents': []}}
@@ -50,6 +50,7 @@ def test_a_good_record_is_read(tmp_path):
     ({'main_launch': '/etc/shadow'}, 'not a path inside the workspace'),
     ({'threshold_launch': 'src/../../../root/x.launch'}, 'not a path inside the workspace'),
     ({'main_launch': None}, 'a threshold run without a main run'),
+    ({'threshold_run_value': None}, 'a threshold run without its value'),
     ({'extra': 1}, "unexpected key(s) 'extra'"),
     ({'facts': {'participant': None, 'folder': 'x'}}, 'documents is missing'),
 ])

@@ -27,6 +27,7 @@ import hashlib
 import json
 import os
 import pwd
+import random
 import re
 import shutil
 import subprocess
@@ -226,8 +227,10 @@ def inspect(box, work, upload, wanted_sheet):
         ws = BOX_WS
     else:
         boxed, ws = Boxed(box, work), box.workspace
+    # Where the threshold run's value lies in its range, drawn now, by the grader (issue 36 point 7).
     args = ['--upload', boxed.path(upload), '--ws', ws, '--out', boxed.path(boxed.out),
-            '--toplevel', os.path.join(_package_path('catkin'), 'cmake', 'toplevel.cmake')]
+            '--toplevel', os.path.join(_package_path('catkin'), 'cmake', 'toplevel.cmake'),
+            '--draw', repr(random.SystemRandom().random())]
     return boxed.run('exam_lab.grader.boxed.inspect', args + (['--sheet', wanted_sheet] if wanted_sheet else []),
                      records.InspectRecord, INSPECT_BOUNDS)
 
@@ -245,10 +248,10 @@ def plan_job(record):
             'late_warning': LATE_WARNING_S if record.calls_service else 0.0}
     runs = [{'tag': 'main', 'launch': record.main_launch, 'plan': plan}]
     if record.threshold_launch is not None:
-        lowered = threshold - 2 * margin
+        # The value the inspection wrote into the derived launch file (drawn at grading time,
+        # sheets.threshold_run_value), flown as the main run around it, with the main run's margin.
         runs.append({'tag': 'threshold', 'launch': record.threshold_launch,
-                     'plan': dict(plan, kind='threshold', threshold=lowered,
-                                  targets={'start': lowered - margin, 'step': threshold - margin})})
+                     'plan': dict(plan, kind='threshold', threshold=record.threshold_run_value)})
     return {'namespace': record.namespace, 'build_timeout': BUILD_TIMEOUT, 'run_timeout': RUN_TIMEOUT, 'runs': runs,
             'handed_in_launch': record.handed_in_launch}
 
@@ -381,7 +384,9 @@ def score(measured, how='run'):
     """The grade record of one submission from what its run measured (:data:`MEASUREMENTS`): the one
     place the rubric is applied, by a run and by a rescore alike. ``how`` goes into its provenance."""
     static, session = measured['static'], measured['session']
-    extra = dict(measured['extra'], doubts=rubric.doubts(static, session), provenance=provenance.stamp(how))
+    run_value = rubric.threshold_run_value(static, session)
+    extra = dict(measured['extra'], doubts=rubric.doubts(static, session), provenance=provenance.stamp(how),
+                 threshold_run={'value': run_value} if run_value is not None else None)
     return report.grade_record(measured['student'], measured['sheet'], rubric.score(measured['sheet'], static, session),
                                hints(static, session, measured['notes'] + measured['fixes'], measured['comments'],
                                      measured['isolate'], measured['how_run']),

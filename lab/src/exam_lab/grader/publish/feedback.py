@@ -160,7 +160,9 @@ def page(record, name, show, threshold_run, svg=None):
         cells = ['<td>%s</td>' % _e(entry['id']), '<td>%s%s</td>' % (_e(what), _e(by)),
                  '<td class="num">%s / %s</td>' % (_points(entry['points']), _points(entry['max']))]
         if evidence:
-            cells.append('<td>%s</td>' % _e(student_view.student_evidence(entry, threshold_run)))
+            # The first line, as make check shows it, every form of the threshold run's value hidden.
+            cells.append('<td>%s</td>' % _e(student_view.scrub(student_view.student_evidence(entry, threshold_run),
+                                                               student_view.hidden(record))))
         rows.append('<tr%s>%s</tr>' % (' class="lost"' if entry['points'] < entry['max'] else '', ''.join(cells)))
     reason = student_view.student_reason(record, show, threshold_run)
     parts = ['<!DOCTYPE html>', '<html lang="en"><head><meta charset="utf-8">',

@@ -190,9 +190,13 @@ def write(folder, record_type, value):
 #: What the inspection read of the package for the rubric (``static`` of :func:`~exam_lab.grader.score.rubric.score`).
 STATIC = {
     'launch_files': [str], 'package': Text(255), 'python2': [str], 'params_in_code': [str],
+    'args_in_code': Optional([str]),
+    'code': Optional({'service_calls': [str], 'publishes': [str], 'timers': [str],
+                      'private_before_init': Optional([str])}),
     'launch': Maybe({'file': str, 'starts_drone': bool, 'exam_type': str, 'exam_name': str, 'package': Text(255),
                      'comments': Number(0, 1e9, integer=True), 'exam_type_found': bool}),
     'threshold': Maybe({'name': str, 'value': Maybe((str, Number(), bool)), 'where': str,
+                        'how': Optional(OneOf('param', 'args')), 'run_value': Optional(float),
                         'not_rewritable': Optional(str)}),
     'threshold_reason': str,
     'uploads': Optional(Items({'files': [str], 'chosen': str, 'why': str, 'ambiguous': bool}, 20)),
@@ -219,6 +223,7 @@ class InspectRecord(Record):
         'calls_service': bool,
         'namespace': str,
         'main_launch': Maybe(str), 'threshold_launch': Maybe(str),
+        'threshold_run_value': Optional(Maybe(float)),
         'handed_in_launch': Optional(Maybe(str)),
         'comments': Maybe({'comments': Number(0, 1e9, integer=True), 'code': Number(0, 1e9, integer=True),
                            'files': [str]}),
@@ -232,6 +237,8 @@ class InspectRecord(Record):
                 _relative(getattr(self, key), 'inspect.json.%s' % key)
         if self.threshold_launch is not None and self.main_launch is None:
             raise RecordError('inspect.json: a threshold run without a main run')
+        if self.threshold_launch is not None and self.threshold_run_value is None:
+            raise RecordError('inspect.json: a threshold run without its value')
 
 
 class IntakeRecord(Record):
