@@ -42,6 +42,7 @@ from exam_lab.grader.boxed import similarity, unpack
 
 from exam_lab.grader.host import egress, sandbox
 from exam_lab.grader.host.sandbox import BOX_WS
+from exam_lab.grader.judge.session import budget_sentence
 
 from exam_lab.grader.score import records, rubric
 
@@ -50,11 +51,19 @@ from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, SHEETS, margin_o
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
 #: Time limits, s: the student's catkin_make, the node's start (to registering with the master),
-#: the probe of one run (a late WARNING is waited for up to LATE_WARNING_S), the whole session.
+#: the probe of one run (a late WARNING is waited for up to LATE_WARNING_S).
 BUILD_TIMEOUT = 180.0
 START_TIMEOUT = 20.0
 RUN_TIMEOUT = 90.0 + LATE_WARNING_S
-SESSION_TIMEOUT = 420.0 + 2 * LATE_WARNING_S
+#: One student's whole grading, s: staging, inspection, roslaunch's check, build and runs together;
+#: every step's limit (above, INSPECT_BOUNDS) is also bounded by what is left of it. A usual grading
+#: takes about 45 s, the slowest honest one measured (a WARNING 50 s late) 134 s: docs/grading.md, "Speed".
+STUDENT_BUDGET = 280.0
+#: What a grading may take past its budget: the session's kill if it overran (SESSION_KILL_S), ending
+#: the box, copying the logs and scoring. STUDENT_BUDGET + AFTER_BUDGET_S is a student's worst case
+#: (:func:`worst_case`).
+AFTER_BUDGET_S = 20.0
+SESSION_KILL_S = 5.0
 #: The simulator packages of the underlay.
 SIMULATORS = ('node_kit', 'drone_sim', 'mydrone', 'submarinedrone')
 #: Bounds of the boxes that read student bytes: (wall clock s, CPU s, address space bytes). One upload's
@@ -212,9 +221,9 @@ class Boxed(object):
         raise InspectionFailed('%s%s' % (why, ': %s' % tail if tail else ''))
 
 
-def inspect(box, work, upload, wanted_sheet):
+def inspect(box, work, upload, wanted_sheet, timeout=None):
     """Run :mod:`exam_lab.grader.boxed.inspect` on the staged ``upload`` (a path below ``<work>/upload``)
-    in ``box`` (:class:`Boxed`), bounded by INSPECT_BOUNDS; return its checked
+    in ``box`` (:class:`Boxed`), bounded by INSPECT_BOUNDS (its wall clock by ``timeout`` if less); return its checked
     :class:`~exam_lab.grader.score.records.InspectRecord`. The package is written, as the box's uid, to
     the workspace the build box sees: ``<work>/ws/src`` (read-only there), or unsandboxed the box's
     own copy.
@@ -232,7 +241,7 @@ def inspect(box, work, upload, wanted_sheet):
             '--toplevel', os.path.join(_package_path('catkin'), 'cmake', 'toplevel.cmake'),
             '--draw', repr(random.SystemRandom().random())]
     return boxed.run('exam_lab.grader.boxed.inspect', args + (['--sheet', wanted_sheet] if wanted_sheet else []),
-                     records.InspectRecord, INSPECT_BOUNDS)
+                     records.InspectRecord, (min(INSPECT_BOUNDS[0], timeout or INSPECT_BOUNDS[0]),) + INSPECT_BOUNDS[1:])
 
 
 def plan_job(record):
@@ -256,9 +265,20 @@ def plan_job(record):
             'handed_in_launch': record.handed_in_launch}
 
 
-def run_session(job, work, underlay, isolate, box, on_step=None):
+def worst_case(students, jobs):
+    """Seconds a class of ``students`` takes at most, ``jobs`` side by side, when every grading uses
+    its whole budget: ceil(students / jobs) gradings one after the other, each STUDENT_BUDGET +
+    AFTER_BUDGET_S (the class's own steps, its intake and similarity check, aside: INTAKE_BOUNDS,
+    SIMILARITY_BOUNDS)."""
+    return -(-students // max(1, jobs)) * (STUDENT_BUDGET + AFTER_BUDGET_S)
+
+
+def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BUDGET):
     """Run the session of one submission, its student steps in ``box``; return what it measured (or
     why it could not).
+
+    :param left: seconds left of the student's budget: the session's own (it stops its steps in time),
+        and killed SESSION_KILL_S after.
 
     :param isolate: in a network namespace of its own with only loopback
         (:func:`~exam_lab.grader.host.sandbox.network_namespace`).
@@ -270,7 +290,7 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
         os.makedirs(folder, mode=0o700, exist_ok=True)
     runs = [dict(run, launch=os.path.join(box.workspace, run['launch'])) for run in job['runs']]
     job = dict(job, workspace=box.workspace, runs=runs, underlay=underlay, log_dir=log_dir,
-               judge_home=judge_home, box=box.describe())
+               judge_home=judge_home, box=box.describe(), budget=left, student_budget=STUDENT_BUDGET)
     job_path = os.path.join(work, 'job.json')
     with open(job_path, 'w') as f:
         json.dump(job, f, indent=1, sort_keys=True)
@@ -278,7 +298,7 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
     if isolate:
         argv = sandbox.network_namespace(argv)
     with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
-        status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT, env=dict(os.environ, HOME=judge_home))
+        status, output, _ = sup.run('session', argv, timeout=left + SESSION_KILL_S, env=dict(os.environ, HOME=judge_home))
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
     survivors = box.end()  # the box's uid: nothing may be left once its PID namespaces are gone
     path = os.path.join(log_dir, 'session.json')
@@ -287,8 +307,10 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
             result = json.load(f)
         result['survivors'] = result.get('survivors', 0) + survivors
         return result
-    why = 'the session did not finish within %.0f s' % SESSION_TIMEOUT if status is None else \
-        'the session failed (exit %s): %s' % (status, session_tail(output))
+    if status is None:
+        why = budget_sentence(STUDENT_BUDGET, 'the session was killed after %.0f s' % (left + SESSION_KILL_S))
+        return {'build': None, 'runs': [], 'error': why, 'budget_used': why, 'survivors': survivors}
+    why = 'the session failed (exit %s): %s' % (status, session_tail(output))
     return {'build': None, 'runs': [], 'error': why, 'survivors': survivors}
 
 
@@ -327,6 +349,8 @@ def hints(static, session, notes, comments, isolate, how_run=None):
                    'ran WITHOUT network isolation (no network namespace could be made): the student code could '
                    'reach the network')
         out.append(how_run or 'not run')
+    if (session or {}).get('budget_used'):
+        out.append(session['budget_used'])
     if (session or {}).get('survivors'):
         out.append('%d processes of the student were still alive after its steps ended: killed'
                    % session['survivors'])
@@ -464,6 +488,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     isolate = can_isolate() if isolate is None else isolate
     underlay = underlay or ensure_underlay(default_underlay())  # raises: the grader cannot run
     os.makedirs(out_dir, exist_ok=True)
+    deadline = time.monotonic() + STUDENT_BUDGET  # the student's own time starts here, the simulators built
     # In the system's temp folder, not under OUT (which may be private): the box's user must reach
     # <work>/upload, <work>/ws and <work>/box, and may not list <work>.
     work = tempfile.mkdtemp(prefix='exam-grade-')
@@ -482,7 +507,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None,
                              cpus=sandbox.box_cpus(jobs)) as box:
                 notes.extend(box.notes)
-                found = inspect(box, work, upload, sheet)
+                found = inspect(box, work, upload, sheet, timeout=deadline - time.monotonic())
                 notes.append(_how_read(box, found.uid))
                 notes.extend(found.notes)
                 fixes.extend(found.fixes)
@@ -494,9 +519,14 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                 if job is None:
                     session = {'build': None, 'runs': [], 'no_node': True,
                                'error': 'no script of the package starts a ROS node'}
+                elif deadline - time.monotonic() < START_TIMEOUT:
+                    why = budget_sentence(STUDENT_BUDGET, 'nothing was run (%.0f s left after the inspection)'
+                                          % (deadline - time.monotonic()))
+                    session = {'build': None, 'runs': [], 'error': why, 'budget_used': why}
                 else:
                     how_run = _how_run(box)
-                    session = run_session(job, work, underlay, isolate, box, on_step)
+                    session = run_session(job, work, underlay, isolate, box, on_step,
+                                          left=deadline - time.monotonic())
         except (unpack.UnpackError, sandbox.UploadRefused) as err:
             session = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % err}
         except InspectionFailed as err:

@@ -95,7 +95,7 @@ def score_runs(session):
     if build is None:
         return item('runs', 0, (session or {}).get('error', 'the submission could not be prepared'))
     if build['status'] is None:
-        return item('runs', 0, 'catkin_make did not finish within %.0f s' % build['timeout'])
+        return item('runs', 0, build.get('stopped') or 'catkin_make did not finish within %.0f s' % build['timeout'])
     if build['status'] != 0:
         return item('runs', 0, 'catkin_make failed (exit %s) in a workspace of its own next to the '
                     'simulators; its last lines:\n%s' % (build['status'], build['tail']))
@@ -591,7 +591,8 @@ def status(static, session, fixes=()):
     one line, '' when graded).
 
     Not graded: the upload was refused or unreadable, or the grader could not run it. Needs a hand
-    grade: the package has no node, does not build, its node does not start or dies (the traceback's
+    grade: its grading used up its budget (a step stopped or left out), the package has no node, does
+    not build, its node does not start or dies (the traceback's
     last line and file:line; Python 2 named), a run's measurement was refused (the node set the time,
     its master went over its memory bound), a leg of a flight was not reached (nothing judged there), or a
     rule could not be observed while the code holds it (:func:`missing_evidence`: the code's file:line).
@@ -603,6 +604,8 @@ def status(static, session, fixes=()):
         return NOT_GRADED, _one_line(session.get('error', 'the upload was refused'))
     if build is None and not session.get('no_node'):
         return NOT_GRADED, _one_line(session.get('error', 'the submission could not be graded'))
+    if session.get('budget_used'):  # a step stopped or left out: what it would have measured is missing
+        return HAND_GRADE, _one_line(session['budget_used'])
     python2 = static.get('python2') or []
     python2_words = 'Python 2 code (%s): it cannot start under ROS Noetic\'s Python 3; read its algorithm by hand' \
         % ', '.join(python2[:3])
