@@ -22,7 +22,7 @@ import pytest
 
 from exam_lab.grader import runner
 from exam_lab.grader.host import sandbox
-from exam_lab.grader.judge import session
+from exam_lab.grader.host import session
 from exam_lab.grader.score import rubric
 from exam_lab.grader.score.sheets import ITEMS
 

@@ -18,7 +18,7 @@ import re
 import pytest
 
 from exam_lab.grader import runner
-from exam_lab.grader.judge import session
+from exam_lab.grader.host import session
 
 from exam_lab.grader.publish import desk, flightplot, gradescope, moodle, page, progress, report
 from exam_lab.grader.score import safe_text

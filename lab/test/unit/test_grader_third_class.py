@@ -242,7 +242,7 @@ class _Here(object):
 
 
 def test_roslaunch_verdict_on_the_file_as_handed_in(tmp_path):
-    from exam_lab.grader.judge import session
+    from exam_lab.grader.host import session
     launch = tmp_path / 'src' / 'exam' / 'launch'
     launch.mkdir(parents=True)
     (launch / 'dup.launch').write_text('<launch><node pkg="mydrone" name="mydrone" type="mydrone_node.py"/>'

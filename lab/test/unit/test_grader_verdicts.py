@@ -4,7 +4,7 @@ import math
 import os
 
 from exam_lab.grader import runner
-from exam_lab.grader.judge import session
+from exam_lab.grader.host import session
 from exam_lab.grader.judge.probe import NodeWatch
 from exam_lab.grader.score import rubric
 

@@ -9,7 +9,7 @@ the source scan, PDF facts and comment statistics. Root reads back one capped, s
 (:mod:`~exam_lab.grader.host.egress`, :mod:`~exam_lab.grader.score.records`) and plans the runs from it;
 the workspace stays the box uid's, read-only in the build and run box. A class archive is unpacked by
 :mod:`~exam_lab.grader.boxed.intake`, the similarity check runs in a box too. Then
-:mod:`exam_lab.grader.judge.session` runs in a network namespace with only loopback
+:mod:`exam_lab.grader.host.session` runs in a network namespace with only loopback
 (:func:`~exam_lab.grader.host.sandbox.network_namespace`: ``unshare --net`` as root, a user namespace of
 its own too otherwise), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an overall time
 limit;
@@ -42,7 +42,7 @@ from exam_lab.grader.boxed import similarity, unpack
 
 from exam_lab.grader.host import egress, sandbox
 from exam_lab.grader.host.sandbox import BOX_WS
-from exam_lab.grader.judge.session import budget_sentence
+from exam_lab.grader.host.session import budget_sentence
 
 from exam_lab.grader.score import records, rubric
 
@@ -245,7 +245,7 @@ def inspect(box, work, upload, wanted_sheet, timeout=None):
 
 
 def plan_job(record):
-    """The session's job (:mod:`exam_lab.grader.judge.session`) from a checked inspection record: the
+    """The session's job (:mod:`exam_lab.grader.host.session`) from a checked inspection record: the
     runs' plans are computed here, from its numbers; the launch files stay relative to the workspace.
     None when there is nothing to run."""
     if record.main_launch is None:
@@ -294,7 +294,7 @@ def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BU
     job_path = os.path.join(work, 'job.json')
     with open(job_path, 'w') as f:
         json.dump(job, f, indent=1, sort_keys=True)
-    argv = [sys.executable, '-m', 'exam_lab.grader.judge.session', job_path]
+    argv = [sys.executable, '-m', 'exam_lab.grader.host.session', job_path]
     if isolate:
         argv = sandbox.network_namespace(argv)
     with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:

@@ -1,6 +1,6 @@
 """The grader's probe: plays the drone for a student's node and measures what the rubric asks.
 
-Run inside its own rospy process, on the master of one submission, by :mod:`exam_lab.grader.judge.session`::
+Run inside its own rospy process, on the master of one submission, by :mod:`exam_lab.grader.host.session`::
 
     python3 -m exam_lab.grader.judge.probe PLAN.json RESULT.json
 

@@ -1,7 +1,7 @@
 """The rubric: points for each item from what was measured, and why. Pure functions, no rospy.
 
 Input: ``static`` (what the runner read in the package: the launch file, the threshold parameter,
-the parameters the code reads) and ``session`` (what :mod:`exam_lab.grader.judge.session` measured: the
+the parameters the code reads) and ``session`` (what :mod:`exam_lab.grader.host.session` measured: the
 build, the main run and the threshold run, each with the probe's result). Output: one
 ``{"id", "points", "max", "evidence"}`` per item of :data:`exam_lab.grader.score.sheets.ITEMS`.
 

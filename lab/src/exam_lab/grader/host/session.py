@@ -2,7 +2,7 @@
 
 The runner starts this module as root, alone in a network namespace that has only loopback::
 
-    python3 -m exam_lab.grader.judge.session JOB.json
+    python3 -m exam_lab.grader.host.session JOB.json
 
 This orchestrator stays root (it starts the boxes, which drop root themselves) but parses no byte of the
 student's: it reads roslaunch's output and the probe's JSON, both capped. The judge (a master per run,
@@ -411,7 +411,7 @@ def session(job):
 
 def main(argv):
     if len(argv) != 1:
-        sys.stderr.write('usage: python3 -m exam_lab.grader.judge.session JOB.json\n')
+        sys.stderr.write('usage: python3 -m exam_lab.grader.host.session JOB.json\n')
         return 2
     with open(argv[0]) as f:
         job = json.load(f)
