@@ -60,14 +60,13 @@ def main(argv=None):
         print('check: grading %s (about a minute)...' % args.package)
         record = runner.grade_submission(args.package, out, args.sheet, student='your package', underlay=underlay,
                                          on_step=progress.StepProgress(), unsandboxed=why is not None)
-        threshold_run = os.path.exists(os.path.join(out, 'logs', 'plan-threshold.json'))
     except RuntimeError as err:
         sys.stderr.write('check: %s\n' % err)
         return 1
     finally:
         shutil.rmtree(out, ignore_errors=True)
     print('\nyour package, sheet %s (%s):' % (SHEETS[record['sheet']].seed, record['sheet']))
-    for line in student_view.lines(record, show, threshold_run):
+    for line in student_view.lines(record, show):  # the threshold run, if any, is the record's
         print(line)
     return 0
 

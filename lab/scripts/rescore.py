@@ -5,7 +5,7 @@
 
 For each student of OUT (or the one submission graded there), the rubric is applied to the
 measurements.json that ``make grade`` kept beside its grade.json; grade.json (with the points it had,
-``previous``, and its provenance), grade.md, grades.csv, the page, results.json and hand.csv (the
+``previous``, and its provenance), grade.md, grades.csv, the page, results.json, moodle-feedback.zip and hand.csv (the
 teacher's points kept) are written again, and each student whose points or status moved is printed
 with the items that moved. No ROS, no sandbox, no root. A change of the rubric that needs measurements
 the run did not make (a new flight, another input) needs make grade again (docs/grading.md).

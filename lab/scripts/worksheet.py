@@ -5,7 +5,8 @@ teacher's hand points (OUT/hand.csv), on the worksheet's own scale (docs/grading
     worksheet.py --out OUT --worksheet WORKSHEET.csv     (make worksheet OUT=... WORKSHEET=...)
 
 Writes OUT/<worksheet>-whole.csv, each grade out of the worksheet's maximum grade (30 points scaled),
-each feedback comment listing every item, the machine's and the teacher's. A student whose hand
+each feedback comment listing every item, the machine's and the teacher's; and OUT/moodle-feedback.zip,
+each released student's page with the whole grade (publish/feedback.py). A student whose hand
 points are not all given, or whose status waits for the teacher, is left as it was and listed. A
 student's hand points are the row of hand.csv with its participant number (the name only where the
 class has no numbers): a row that could be another student's stops it, naming both. Exits 0 when the
@@ -18,7 +19,7 @@ import json
 import os
 import sys
 
-from exam_lab.grader.publish import hand, moodle
+from exam_lab.grader.publish import feedback, hand, moodle
 from exam_lab.grader.score import safe_text
 
 
@@ -72,6 +73,8 @@ def main(argv=None):
               % (len(missing), path))
         for record in missing:
             print('  %s: %s' % (safe_text.one_line(record['student']), ', '.join(record['missing'])))
+    for line in feedback.write(args.out, records, single=not glob.glob(os.path.join(args.out, '*', 'grade.json'))):
+        print(line)
     return 0
 
 

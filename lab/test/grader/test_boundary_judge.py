@@ -5,18 +5,24 @@ good student's package, graded beside the burner: it keeps its 17 points and its
 few seconds), ``c_clock`` (sets ``/use_sim_time`` and publishes a ``/clock`` 5/7 as fast as the wall's,
 so its node warns 7 s late while a grader on that clock sees 5 s: refused, a hand grade), and
 ``d_param_flood`` (ten ``setParam`` calls of 64 MB: the master stays within its memory bound, the run is
-refused and the class goes on). ``c_clock`` and ``d_param_flood`` run the good student's node beside
-their payload (copied in here). Payloads in lab/test/grader/hostile/, doing nothing as root. About 3
-minutes on two cores.
+refused and the class goes on), ``e_hooked`` (a launch file roslaunch refuses, and a catkin environment
+hook that answers for roslaunch's check when the student's workspace is sourced for it: issue 36 point
+4), ``f_respawner`` (a chatty node that dies once, started again by roslaunch's ``respawn``: its death
+lies in the middle of the launch log the grader cuts; issue 36 point 4). All but ``a_burner`` run the
+good student's node beside their payload (copied in here). Payloads in lab/test/grader/hostile/, doing
+nothing as root. About 4 minutes on two cores; and one submission, ``sleeper``, graded alone with a
+budget of BUDGET_S (issue 36 point 6), a minute of sleep.
 """
 import json
 import os
 import shutil
+import time
 
 import pytest
 
 from exam_lab.grader import runner
 from exam_lab.grader.host import sandbox
+from exam_lab.grader.host import session
 from exam_lab.grader.score import rubric
 from exam_lab.grader.score.sheets import ITEMS
 
@@ -25,9 +31,12 @@ HOSTILE = os.path.join(HERE, 'hostile')
 GOOD = os.path.join(HERE, 'submissions', 'good_student', 'exam')
 FULL = {item: points for item, (points, _) in ITEMS.items()}
 CLASS = [('a_burner', os.path.join(HOSTILE, 'burner', 'exam')), ('b_good', GOOD),
-         ('c_clock', os.path.join(HOSTILE, 'clock', 'exam')), ('d_param_flood', os.path.join(HOSTILE, 'param_flood', 'exam'))]
+         ('c_clock', os.path.join(HOSTILE, 'clock', 'exam')), ('d_param_flood', os.path.join(HOSTILE, 'param_flood', 'exam')),
+         ('e_hooked', os.path.join(HOSTILE, 'hooked', 'exam')), ('f_respawner', os.path.join(HOSTILE, 'respawner', 'exam'))]
 #: The good student's node beside the payload of these.
-WITH_GOOD_NODE = ('c_clock', 'd_param_flood')
+WITH_GOOD_NODE = ('c_clock', 'd_param_flood', 'e_hooked', 'f_respawner')
+#: The budget the sleeper is graded with (its build sleeps 120 s).
+BUDGET_S = 45.0
 #: The most seconds the good student's node may take to register beside the burner (it took 15.9 s of
 #: the 20 s limit beside 60 burners, and never started beside 140, before each box had a CPU quota).
 NODE_UP_S = 10.0
@@ -43,6 +52,7 @@ def judged_class(tmp_path_factory):
         target = klass / name / 'exam'
         shutil.copytree(package, str(target), ignore=shutil.ignore_patterns('__pycache__'))
         if name in WITH_GOOD_NODE:
+            os.makedirs(str(target / 'scripts'), exist_ok=True)
             shutil.copy2(os.path.join(GOOD, 'scripts', 'exam_node.py'), str(target / 'scripts' / 'exam_node.py'))
     out = root / 'out'
     records = {r['student']: r for r in runner.grade_class(str(klass), str(out), jobs=2)}
@@ -107,3 +117,50 @@ def test_no_judge_process_is_left(judged_class):
     test_sandbox checks those), no process is left once the class is graded."""
     assert [uid for uid in range(sandbox.JUDGE_UID_BASE, sandbox.JUDGE_UID_BASE + sandbox.SLOTS)
             if sandbox.pids_of_uid(uid)] == []
+
+
+def points_of(record):
+    return {i['id']: i['points'] for i in record['items']}
+
+
+def test_an_environment_hook_cannot_answer_for_roslaunch(judged_class):
+    """Its launch file names two nodes /exam: roslaunch refuses it, whatever the hook (sourced with the
+    student's workspace) would have said; Q12 is lost and the teacher told. The run itself, without the
+    drone's node, keeps every other point."""
+    check = session_of(judged_class, 'e_hooked')['launch_check']
+    assert check['status'] == 1 and 'multiple nodes named [/exam]' in check['refused'], check
+    record = judged_class['records']['e_hooked']
+    assert points_of(record) == dict(FULL, Q12=0.0), evidence(record)
+    assert [d for d in record['doubts'] if 'roslaunch refuses' in d], record['doubts']
+
+
+def test_a_death_lost_in_the_cut_log_is_seen_by_the_judge(judged_class):
+    """The chatter's death and respawn: roslaunch's words lie in the middle cut from the log, the probe's
+    watch saw its pid change; it costs the runs point and a hand grade, like any death."""
+    assert 'bytes cut by the grader' in logs_of(judged_class, 'f_respawner', 'launch-main.log'), \
+        'the chatter did not fill the log: this test proves nothing'
+    main = session_of(judged_class, 'f_respawner')['runs'][0]
+    watched = [e for e in main['launch']['ended'] if e['detail'].startswith('seen by the judge')]
+    assert [e['node'] for e in watched] == ['/chatter'], main['launch']['ended']
+    record = judged_class['records']['f_respawner']
+    assert points_of(record)['runs'] == 1.0 and record['status'] == rubric.HAND_GRADE, evidence(record)
+    assert 'died' in record['status_reason'], record['status_reason']
+
+
+def test_a_grading_past_its_budget_ends_at_it_and_says_so(tmp_path, monkeypatch):
+    """The sleeper's build sleeps past a budget of BUDGET_S: its grading ends within the budget and
+    what follows it, the build stopped, and its row says which budget, how large, and what it stopped."""
+    if os.geteuid() != 0:
+        pytest.skip('the sandbox is made by root (docs/grading.md, "Isolation")')
+    runner.ensure_underlay(runner.default_underlay())  # built before the student's time starts
+    monkeypatch.setattr(runner, 'STUDENT_BUDGET', BUDGET_S)
+    start = time.monotonic()
+    record = runner.grade_submission(os.path.join(HOSTILE, 'sleeper', 'exam'), str(tmp_path / 'out'), student='sleeper')
+    took = time.monotonic() - start
+    with open(str(tmp_path / 'out' / 'logs' / 'build.log')) as f:
+        assert 'sleeper: sleeping through the build' in f.read(), 'the build did not sleep: this test proves nothing'
+    assert took <= BUDGET_S + runner.AFTER_BUDGET_S, took
+    assert record['status'] == rubric.HAND_GRADE, evidence(record)
+    assert record['status_reason'].startswith('its grading used up its budget of %.0f s' % BUDGET_S), record['status_reason']
+    assert 'catkin_make was stopped after' in record['status_reason'], record['status_reason']
+    assert took >= BUDGET_S - 2 * session.STEP_STOP_S - 10, took  # stopped at the budget, not before

@@ -208,13 +208,21 @@ FAIR_EXPECTED = {
     'float64_pressure': {'Q10': 1.0},     # /pressure as Float64, the input that moves: Q10 alone, the rest flown
     'led_colours': {'Q13': 2.0},          # "RED"/"GREEN" (depth sheet): read as WARNING/NORMAL, half of 13 once
     'two_uploads': {},                    # exam.zip (14:52, no delay) and exam_v2.zip (16:58, complete)
+    # Every way a launch file hands the node its threshold (issue 35 point 4): nothing lost.
+    'args_threshold': {},                 # args="--threshold $(arg threshold)", read with argparse on myargv
+    'rosparam_threshold': {},             # inline <rosparam> in the node's tag, read as ~threshold
+    'included_threshold': {},             # <arg value> passed to an included launch file; read before init_node
+    # One misplaced line: the WARNING call is never reached. Not a silent zero (issue 35 point 5): the
+    # points the run could not give, and a hand grade naming the call's line.
+    'never_warns': {'Q13': 0.0, 'Q14a': 0.5, 'Q14b': 0.0},
 }
 FAIR_STATUS = {'lowercase_service': 'needs a hand grade', 'duplicate_names': 'graded with fixes',
                'float64_temperature': 'graded with fixes', 'float64_pressure': 'graded with fixes',
-               'led_colours': 'needs a hand grade', 'two_uploads': 'graded'}
+               'led_colours': 'needs a hand grade', 'two_uploads': 'graded', 'args_threshold': 'graded',
+               'rosparam_threshold': 'graded', 'included_threshold': 'graded', 'never_warns': 'needs a hand grade'}
 FAIR_SHEETS = {'led_colours': 'depth'}
 #: Who must be in the page's "needs the teacher" box, whatever the status.
-FAIR_DOUBTS = ('lowercase_service', 'duplicate_names', 'led_colours', 'two_uploads')
+FAIR_DOUBTS = ('lowercase_service', 'duplicate_names', 'led_colours', 'two_uploads', 'never_warns')
 
 
 def dated_zip(source, path, when):
@@ -229,7 +237,7 @@ def dated_zip(source, path, when):
 
 @pytest.fixture(scope='module')
 def fair(tmp_path_factory):
-    """A class of six graded with the default JOBS, and its desk (the page) written."""
+    """A class of ten graded with the default JOBS, and its desk (the page) written."""
     from exam_lab.grader.publish import desk
     root = tmp_path_factory.mktemp('fair')
     klass = root / 'class'
@@ -292,6 +300,19 @@ def test_fair_evidence_is_what_happened(fair):
         assert '>%s</a>' % name in box, name
     assert '>float64_temperature</a>' not in box
     assert os.path.isfile(os.path.join(str(out), 'lowercase_service', 'flight.png'))
+    never = records['never_warns']['status_reason']
+    assert 'never called /altitude_warning in the whole flight' in never, never
+    assert 'its code calls it at scripts/exam_node.py:68' in never, never
+    assert any('scripts/exam_node.py:68' in doubt for doubt in records['never_warns']['doubts'])
+    for name in ('args_threshold', 'rosparam_threshold', 'included_threshold'):
+        q14a = evidence[name]['Q14a']
+        assert 'the node warned' in q14a, q14a
+        with open(os.path.join(str(out), name, 'measurements.json')) as f:
+            measured = json.load(f)
+        drawn = measured['static']['threshold']['run_value']
+        assert 1300 - 4 * 130 <= drawn <= 1300 - 2.5 * 130, drawn
+        assert 'set to %g' % drawn in q14a, (drawn, q14a)
+    assert "argument --threshold" in evidence['args_threshold']['Q14a']
 
 
 def test_our_node_on_the_depth_sheet(tmp_path):

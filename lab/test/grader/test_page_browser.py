@@ -1,24 +1,29 @@
 """The teacher's page in a real browser: a class of two graded by the real grader (about 1.5 minutes),
 its desk written (plots, similarity, page), then OUT/index.html opened by headless Chromium from the
 file system: no console message, one table row per student, every flight plot an image that loaded,
-the table sorts, the screenshot is a picture of the page.
+the table sorts, the screenshot is a picture of the page. Then the students' pages of
+OUT/moodle-feedback.zip, and docs/feedback_example.html, the same way: nothing loaded or logged, the
+plot drawn, the threshold run's value in none.
 
 Chromium is installed by tools/install_deps.sh (Debian's ``chromium``); without it the test is
-skipped, saying so. GRADER_PAGE_SCREENSHOT=<path> keeps the screenshot (docs/figures/grader_page.png).
+skipped, saying so. GRADER_PAGE_SCREENSHOT=<path> keeps the screenshot (docs/figures/grader_page.png),
+GRADER_FEEDBACK_SCREENSHOT=<path> the example feedback page's (docs/figures/feedback_page.png).
 """
 import json
 import os
 import re
 import shutil
 import subprocess
+import zipfile
 
 import pytest
 
 from exam_lab.grader import runner
 
-from exam_lab.grader.publish import desk
+from exam_lab.grader.publish import desk, feedback
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+DOCS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(HERE))), 'docs')
 SUBMISSIONS = os.path.join(HERE, 'submissions')
 CHROMIUM = shutil.which('chromium') or shutil.which('chromium-browser')
 STUDENTS = {'Jane Doe_101_assignsubmission_file_': 'good_student', 'Paul Martin_102_assignsubmission_file_': 'no_kelvin'}
@@ -128,3 +133,92 @@ def test_a_screenshot_of_the_page(graded, tmp_path):
     assert os.path.getsize(shot) > 50000  # a page with plots, not a blank one
     if os.environ.get('GRADER_PAGE_SCREENSHOT'):
         shutil.copyfile(shot, os.environ['GRADER_PAGE_SCREENSHOT'])
+
+
+#: Appended to a copy of a feedback page without its Content-Security-Policy (which lets no script run):
+#: what the browser drew, into the DOM it dumps.
+FEEDBACK_CHECK = """<script>
+window.addEventListener('load', function () {
+  var svg = document.querySelector('svg.plot'), box = svg ? svg.getBoundingClientRect() : null;
+  document.body.setAttribute('data-check', JSON.stringify({
+    plot: box ? [box.width, box.height] : null, texts: svg ? svg.querySelectorAll('text').length : 0,
+    rows: document.querySelectorAll('table.items tbody tr').length}));
+});
+</script>"""
+
+
+def open_feedback(path):
+    """A feedback page in Chromium: ``(what it drew, the console messages)``. The page itself is opened
+    as it is (a load its policy blocked would be logged), then a copy with the check."""
+    with open(path) as f:
+        text = f.read()
+    _, console = chromium(['--dump-dom'], path)
+    check = path + '.check.html'
+    with open(check, 'w') as f:
+        f.write(re.sub(r'<meta http-equiv="Content-Security-Policy"[^>]*>', '', text).replace(
+            '</body>', FEEDBACK_CHECK + '</body>'))
+    dom, more = chromium(['--dump-dom'], check)
+    found = re.search(r'data-check="([^"]*)"', dom)
+    assert found, dom[-2000:]
+    return json.loads(found.group(1).replace('&quot;', '"').replace('&amp;', '&')), console + more
+
+
+def test_the_students_feedback_pages_in_a_browser(graded, tmp_path):
+    out, records, lines = graded
+    folders = ['Jane Doe_101_assignfeedback_file_', 'Paul Martin_102_assignfeedback_file_']
+    with zipfile.ZipFile(os.path.join(out, feedback.FILE)) as archive:  # the desk's, with the setting shipped
+        assert archive.namelist() == [f + '/' + feedback.PAGE for f in folders]
+        shipped = {name.split('/')[0]: archive.read(name).decode('utf-8') for name in archive.namelist()}
+    assert any(l.startswith('moodle feedback: %s: a page for 2 student(s)' % os.path.join(out, feedback.FILE))
+               for l in lines)
+    with open(os.path.join(out, 'Jane Doe', 'logs', 'plan-threshold.json')) as f:
+        hidden = '%g' % json.load(f)['threshold']
+    number = re.compile(r'(?<![\w.])%s(?:\.0+)?(?![\d])' % re.escape(hidden))
+    assert number.search(json.dumps(records[0]))  # the teacher's record names it
+    feedback.write(out, records, show='points')
+    with zipfile.ZipFile(os.path.join(out, feedback.FILE)) as archive:
+        points = {name.split('/')[0]: archive.read(name).decode('utf-8') for name in archive.namelist()}
+    if feedback.read_show() == 'points':
+        assert points == shipped
+    feedback.write(out, records, show='evidence')
+    with zipfile.ZipFile(os.path.join(out, feedback.FILE)) as archive:
+        evidence = {name.split('/')[0]: archive.read(name).decode('utf-8') for name in archive.namelist()}
+    for folder in folders:
+        assert not number.search(points[folder]), folder
+        assert '<svg' not in points[folder] and '<svg' in evidence[folder]
+        # Q11's evidence names the main run's readings, one of which the threshold run took as its value
+        # (the rest leg's): make check shows the same line; nowhere else is the value.
+        shown = re.sub(r'<tr[^>]*><td>Q11</td>.*?</tr>', '', evidence[folder])
+        assert not number.search(shown), folder
+        assert 'threshold run (lowered' not in evidence[folder] and 'threshold run' not in shown.replace(
+            'a problem in the threshold run', '')
+        for show, text in (('points', points[folder]), ('evidence', evidence[folder])):
+            page = str(tmp_path / ('%s-%s.html' % (folder.split('_')[0], show)))
+            with open(page, 'w') as f:
+                f.write(text)
+            drawn, console = open_feedback(page)
+            assert console == [], console
+            assert drawn['rows'] == 7
+            if show == 'evidence':
+                assert drawn['plot'][0] > 500 and drawn['plot'][1] > 150 and drawn['texts'] > 10, drawn
+            else:
+                assert drawn['plot'] is None
+
+
+def test_the_docs_example_feedback_page_in_a_browser(tmp_path):
+    """docs/feedback_example.html (lab/report/grading_examples.py) opens offline, draws its plot, and its
+    folder is the one docs/grading.md names."""
+    page = str(tmp_path / 'feedback.html')
+    shutil.copyfile(os.path.join(DOCS, 'feedback_example.html'), page)
+    drawn, console = open_feedback(page)
+    assert console == [], console
+    assert drawn['rows'] == 7 and drawn['plot'][0] > 500 and drawn['plot'][1] > 150, drawn
+    with open(os.path.join(DOCS, 'grading.md')) as f:
+        assert 'Paul Martin_102_assignfeedback_file_/feedback.html' in f.read()
+    shot = str(tmp_path / 'feedback.png')
+    chromium(['--hide-scrollbars', '--window-size=1000,1750', '--screenshot=%s' % shot], page)
+    with open(shot, 'rb') as f:
+        head = f.read(24)
+    assert head[:8] == b'\x89PNG\r\n\x1a\n' and os.path.getsize(shot) > 30000
+    if os.environ.get('GRADER_FEEDBACK_SCREENSHOT'):
+        shutil.copyfile(shot, os.environ['GRADER_FEEDBACK_SCREENSHOT'])

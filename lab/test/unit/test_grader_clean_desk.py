@@ -18,7 +18,7 @@ import re
 import pytest
 
 from exam_lab.grader import runner
-from exam_lab.grader.judge import session
+from exam_lab.grader.host import session
 
 from exam_lab.grader.publish import desk, flightplot, gradescope, moodle, page, progress, report
 from exam_lab.grader.score import safe_text
@@ -297,3 +297,66 @@ def test_a_page_that_cannot_be_made_is_replaced_by_a_plain_one(tmp_path, monkeyp
     assert 'the page could not be made' in html and 'ValueError: no page' in html and CONTROL.search(html) is None
     assert all('<a href="%s/grade.md">' % r['student'] in html for r in records)
     assert any('the page could not be made' in l for l in lines) and os.path.isfile(str(out / 'ws-filled.csv'))
+
+
+#: A name in bytes that are not UTF-8, as Python reads it from a student's tar (surrogate escapes).
+NOT_UTF8 = 'notes\udcff\udce9.py'
+
+
+def not_utf8_record():
+    """:func:`hostile_record` whose name, evidence, notes and documents carry a name in any bytes."""
+    record = hostile_record(NAME + '\udcff')
+    record['status_reason'] += ' in %s' % NOT_UTF8
+    record['for_the_teacher'].append('comments (not scored): in scripts/%s' % NOT_UTF8)
+    record['documents'] = [{'name': 'rapport\udce9.pdf', 'pages': 1}]
+    for item in record['items']:
+        if item['id'] == 'Q11':  # the item the terminal shows (not full points)
+            item['evidence'] = 'most recent call last: %s' % NOT_UTF8
+    return record
+
+
+@pytest.mark.parametrize('output', OUTPUTS, ids=lambda f: f.__name__[len('out_'):])
+def test_a_name_in_any_bytes_survives_every_output(output, tmp_path, monkeypatch, capsys):
+    """Issue 36 point 3: a file name that is not UTF-8 is shown escaped (each byte ``\\xNN``) in every
+    output; none refuses it (the page emptied, grade.md never written)."""
+    texts = output(tmp_path, not_utf8_record(), monkeypatch, capsys)
+    assert [t for t in texts if re.search('[\ud800-\udfff]', t)] == []
+    texts = [t.replace('&#92;', '\\') for t in texts]  # the worksheet's HTML writes a backslash so
+    assert any('\\xff' in t for t in texts)
+    assert output in NO_EVIDENCE or any('notes\\xff\\xe9.py' in t for t in texts)
+
+
+def test_a_name_in_any_bytes_is_kept_exactly_by_a_rescore(tmp_path):
+    """The measurements keep the name as it was (surrogate escapes in JSON); a rescore shows it
+    escaped, run after run."""
+    out = tmp_path / 'out'
+    measured = {'student': 'Cy', 'sheet': 'altitude', 'static': {}, 'notes': ['link %s dropped' % NOT_UTF8],
+                'fixes': [], 'comments': {'comments': 1, 'code': 2, 'files': ['scripts/' + NOT_UTF8]},
+                'isolate': True, 'how_run': None, 'session': {'build': None, 'runs': [], 'error': 'x'},
+                'extra': {'participant': 3, 'folder': 'Cy_3_assignsubmission_file_', 'documents': [], 'seconds': 1.0}}
+    os.makedirs(str(out / 'Cy'))
+    with open(str(out / 'Cy' / runner.MEASUREMENTS), 'w') as f:
+        json.dump(measured, f)
+    for _ in range(2):
+        records, _ = runner.rescore(str(out))
+        assert desk.finish(str(out), records)[-1].startswith('page: ')
+    with open(str(out / 'Cy' / runner.MEASUREMENTS)) as f:
+        assert json.load(f)['comments']['files'] == ['scripts/' + NOT_UTF8]
+    assert 'scripts/notes\\xff\\xe9.py' in _read(str(out / 'Cy' / 'grade.md'))
+    assert 'scripts/notes\\xff\\xe9.py' in _read(str(out / 'index.html'))
+    assert 'Cy' in _read(str(out / 'grades.csv'))
+
+
+def test_the_class_outputs_never_name_a_student(tmp_path):
+    """Every file a class's desk writes in OUT ends like an output (unpack.OUTPUT_ENDINGS), which no
+    student's folder does (:func:`unpack.student_name`): a student named ``grades.csv`` cannot take
+    the table's place."""
+    from exam_lab.grader.boxed import unpack
+    out, records, worksheet = class_desk(tmp_path)
+    report.write_csv(str(out / 'grades.csv'), records)
+    desk.finish(str(out), records, similar={'pairs': [], 'students': 3}, worksheet=worksheet, title='Class')
+    written = [n for n in os.listdir(str(out)) if not os.path.isdir(str(out / n))]
+    assert written and [n for n in written if not n.lower().endswith(unpack.OUTPUT_ENDINGS)] == []
+    for name in written + ['hand.csv.zip', 'Index.HTML', 'grades.csv_12_assignsubmission_file_']:
+        shown = unpack.student_name(name)
+        assert shown not in written and not shown.lower().endswith(unpack.OUTPUT_ENDINGS), (name, shown)

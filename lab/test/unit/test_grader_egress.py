@@ -18,7 +18,7 @@ def inspect_record(**changes):
                          'threshold': {'name': '/threshold', 'value': 1300, 'where': 'launch/exam.launch'}},
               'threshold_value': 1300.0, 'calls_service': True, 'namespace': '/',
               'main_launch': 'src/exam/launch/.grader-main-exam.launch',
-              'threshold_launch': 'src/exam/launch/.grader-threshold-exam.launch',
+              'threshold_launch': 'src/exam/launch/.grader-threshold-exam.launch', 'threshold_run_value': 912.4,
               'handed_in_launch': 'exam/launch/exam.launch',
               'comments': {'comments': 3, 'code': 40, 'files': ['scripts/exam_node.py']},
               'facts': {'participant': 1234, 'folder': 'Jane Doe_1234_assignsubmission_file_', 'documents': []}}
@@ -43,13 +43,14 @@ def test_a_good_record_is_read(tmp_path):
     ({'uid': '0'}, 'uid: an integer expected'),
     ({'sheet': 'rm -rf'}, 'sheet:'),
     ({'notes': 'one note'}, 'notes: a list expected'),
-    ({'notes': ['x'] * (records.MAX_ITEMS + 1)}, 'items'),
+    ({'notes': ['x'] * (records.MAX_ITEMS + 1)}, 'notes: 501 notes (at most 500)'),
     ({'notes': ['x' * (records.MAX_TEXT + 1)]}, 'characters'),
     ({'threshold_value': True}, 'threshold_value: a number expected'),
     ({'calls_service': 1}, 'calls_service: true or false'),
     ({'main_launch': '/etc/shadow'}, 'not a path inside the workspace'),
     ({'threshold_launch': 'src/../../../root/x.launch'}, 'not a path inside the workspace'),
     ({'main_launch': None}, 'a threshold run without a main run'),
+    ({'threshold_run_value': None}, 'a threshold run without its value'),
     ({'extra': 1}, "unexpected key(s) 'extra'"),
     ({'facts': {'participant': None, 'folder': 'x'}}, 'documents is missing'),
 ])
@@ -117,3 +118,26 @@ def test_similarity_html_holds_only_the_highlight(tmp_path):
         egress.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
     assert egress.read_record(write(tmp_path, {'error': 'no venv', 'notes': []}, 'similarity.json'),
                               records.SimilarityRecord).value == {'error': 'no venv', 'notes': []}
+
+
+def test_a_cap_hit_is_a_sentence_naming_the_cap_and_the_value(tmp_path):
+    """Issue 36: a list over its cap reads "501 files (at most 500)", where it is; a box that would
+    write such a record says that sentence (and no traceback) when it stops."""
+    files = ['scripts/n%d.py' % i for i in range(records.MAX_ITEMS + 1)]
+    record = inspect_record(comments={'comments': 1, 'code': 2, 'files': files})
+    with pytest.raises(records.RecordError) as refused:
+        egress.read_record(write(tmp_path, record), records.InspectRecord)
+    assert str(refused.value) == 'inspect.json.comments.files: 501 files (at most 500)'
+    with pytest.raises(records.RecordError, match=r'^inspect.json.notes: 501 notes \(at most 500\)$'):
+        records.write(str(tmp_path), records.InspectRecord, inspect_record(notes=['n'] * 501))
+    with pytest.raises(records.RecordError, match=r'inspect.json: 1048577 bytes \(at most 1048576\)$'):
+        egress.read_record(write(tmp_path, b' ' * ((1 << 20) + 1)), records.InspectRecord)
+
+
+def test_a_class_larger_than_a_list_cap_is_one_intake(tmp_path):
+    """A class of more students than any other list may hold, one of them refused with its reason."""
+    students = [{'name': 'S %d' % i, 'path': 'class/S %d' % i} for i in range(records.MAX_ITEMS + 100)]
+    students[7]['refused'] = 'the files of S 7: 5001 more files, beyond the 5000 a submission may unpack'
+    got = egress.read_record(write(tmp_path, {'uid': 61000, 'students': students}, 'intake.json'),
+                             records.IntakeRecord, records.IntakeRecord.MAX_BYTES)
+    assert len(got.students) == 600 and got.students[7]['refused'].startswith('the files of S 7')

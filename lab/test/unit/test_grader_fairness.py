@@ -7,7 +7,8 @@ import pytest
 
 from exam_lab.grader.boxed import launch, source
 
-from exam_lab.grader.judge import probe, session
+from exam_lab.grader.host import session
+from exam_lab.grader.judge import probe
 
 from exam_lab.grader.score import rubric
 

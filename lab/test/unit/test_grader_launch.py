@@ -286,3 +286,108 @@ def test_yaml_alias_bomb_is_refused_at_once(tmp_path):
     assert launch.load_yaml('a: {b: 1}\nc: [1, 2]\n') == {'a': {'b': 1}, 'c': [1, 2]}
     with pytest.raises(launch.yaml.YAMLError):
         launch.load_yaml('base: &b {x: 1}\nd:\n  <<: *b\n')
+
+
+def roslaunch_sees(path, search, monkeypatch):
+    """What roslaunch's own loader makes of ``path`` (the exam package found below ``search``): each
+    node's args, and the parameters it sets (rospy's ``_name:=value`` words among them, as
+    ``init_node`` sets them)."""
+    import roslaunch.config
+    monkeypatch.setenv('ROS_PACKAGE_PATH', search)
+    config = roslaunch.config.load_config_default([path], None, verbose=False)
+    params = {name: p.value for name, p in config.params.items() if name not in ('/rosdistro', '/rosversion')}
+    args = {}
+    for node in config.nodes:
+        full = '/'.join([node.namespace.rstrip('/'), node.name])
+        args[full] = node.args
+        for word in node.args.split():
+            if word.startswith('_') and not word.startswith('__') and ':=' in word:
+                name, value = word[1:].split(':=', 1)
+                params['%s/%s' % (full, name)] = launch._yaml_value(value)
+    return args, params
+
+
+PACKAGE_XML = ('<package format="2"><name>exam</name><version>0.0.0</version><description>x</description>'
+               '<maintainer email="a@b.c">a</maintainer><license>x</license></package>')
+
+
+@pytest.mark.parametrize('files, found_name, how', [
+    # args= read with rospy.myargv / argparse: an option and its value
+    ({'launch/exam.launch': '<launch><node pkg="exam" type="n.py" name="exam" args="--threshold 1300"/></launch>'},
+     '--threshold', 'args'),
+    # the whole args a $(arg) with a default: myargv()[1]
+    ({'launch/exam.launch': '<launch><arg name="threshold" default="1300"/>'
+                            '<node pkg="exam" type="n.py" name="exam" args="$(arg threshold)"/></launch>'},
+     'argv[1]', 'args'),
+    # --name=$(arg) in an included file that gets every arg (pass_all_args), set by <arg value>
+    ({'launch/exam.launch': '<launch><arg name="alt_max" value="1300"/><arg name="rate" default="10"/>'
+                            '<include file="$(dirname)/node.launch" pass_all_args="true"/></launch>',
+      'launch/node.launch': '<launch><arg name="alt_max" default="1"/><arg name="rate"/>'
+                            '<node pkg="exam" type="n.py" name="exam" args="--rate $(arg rate) '
+                            '--limit=$(arg alt_max)"/></launch>'},
+     '--limit', 'args'),
+    # rospy's private parameter on the command line
+    ({'launch/exam.launch': '<launch><node pkg="exam" type="n.py" name="exam" args="_seuil:=1300 __log:=x"/></launch>'},
+     '/exam/seuil', 'param'),
+    # inline <rosparam> with subst_value, in the node
+    ({'launch/exam.launch': '<launch><arg name="t" default="1300"/><node pkg="exam" type="n.py" name="exam">'
+                            '<rosparam subst_value="true">threshold: $(arg t)\nrate: 10</rosparam></node></launch>'},
+     '/exam/threshold', 'param'),
+    # a relative <param> in a <group ns>, read by a node of the group as "threshold"
+    ({'launch/exam.launch': '<launch><group ns="drone"><param name="threshold" type="double" value="1300"/>'
+                            '<node pkg="exam" type="n.py" name="exam"/></group></launch>'},
+     '/drone/threshold', 'param'),
+])
+def test_every_way_a_launch_file_hands_over_the_threshold(tmp_path, monkeypatch, files, found_name, how):
+    """Issue 35 point 4: the threshold found however the launch file hands it to the node, and the
+    derived file changes it where it is set: roslaunch's own loader sees 1040 where it saw 1300, and
+    nothing else moved."""
+    pkg = package(tmp_path, dict(files, **{'package.xml': PACKAGE_XML}))
+    path = os.path.join(pkg, 'launch', 'exam.launch')
+    analysis = launch.analyse(path, pkg)
+    assert analysis.problems == []
+    found, why = launch.threshold_param(analysis, 'altitude')
+    assert found is not None and found.name == found_name, why
+    assert isinstance(found, launch.NodeArg) == (how == 'args')
+    assert launch.as_number(found.value) == 1300.0
+    args, params = roslaunch_sees(path, str(tmp_path), monkeypatch)
+    derived = launch.derive(analysis, 'threshold', {found.origin: 1040.0})
+    args2, params2 = roslaunch_sees(derived, str(tmp_path), monkeypatch)
+    changed = lambda before, after: {k: (before.get(k), after.get(k)) for k in set(before) | set(after)
+                                     if before.get(k) != after.get(k)}
+    if how == 'param':
+        assert changed(params, params2) == {found.name: (1300, 1040.0)}
+        assert args == args2 or found.origin.kind == 'args', 'only rospy\'s _name:= word changes the args'
+    else:
+        assert params == params2
+        (node, (before, after)), = changed(args, args2).items()
+        assert before.replace('1300', '1040.0') == after, (before, after)
+    again = launch.threshold_param(launch.analyse(derived, pkg), 'altitude')[0]
+    assert (again.name, launch.as_number(again.value)) == (found_name, 1040.0)
+
+
+@pytest.mark.parametrize('draw', [0.0, 0.5, 0.999])
+def test_the_threshold_run_value_is_drawn_once_written_and_planned(tmp_path, draw):
+    """Issue 36 point 7: the threshold run's value comes from a draw made at grading time, is computed
+    once (sheets.threshold_run_value, in the inspection), written into the derived launch file where
+    the student set the threshold (here an <arg> given to args=), kept in the record's static facts (the
+    measurements), and planned by the runner as it is, with the main run's margin."""
+    from exam_lab.grader import runner
+    from exam_lab.grader.boxed import inspect
+    from exam_lab.grader.score import records, sheets
+    ws = tmp_path / 'ws'
+    (ws / 'src').mkdir(parents=True)
+    found = inspect.inspect(os.path.join(SUBMISSIONS, 'args_threshold', 'exam'), str(ws), str(tmp_path / 'out'),
+                            None, draw)
+    value = sheets.threshold_run_value(1300.0, draw)
+    assert 1300 - 4 * 130 <= value <= 1300 - 2.5 * 130
+    assert found['threshold_run_value'] == found['static']['threshold']['run_value'] == value
+    assert found['static']['threshold']['how'] == 'args' and found['static']['args_in_code'] == ['--threshold']
+    derived = os.path.join(str(ws), found['threshold_launch'])
+    again = launch.threshold_param(launch.analyse(derived, os.path.join(str(ws), 'src', 'exam')), 'altitude')[0]
+    assert (again.name, launch.as_number(again.value)) == ('--threshold', value)
+    job = runner.plan_job(records.InspectRecord(records.check(found, records.InspectRecord.SCHEMA)))
+    main, threshold = [run['plan'] for run in job['runs']]
+    assert threshold == dict(main, kind='threshold', threshold=value), 'the main run\'s plan around the new value'
+    with pytest.raises(ValueError):
+        sheets.threshold_run_value(1300.0, 1.0)

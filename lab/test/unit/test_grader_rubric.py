@@ -14,7 +14,7 @@ def good_calls():
 
 def measured(calls=None, rate=10.0, formula_error=0.0, output=('/altitude', 'std_msgs/Float32'),
              subscribed=('/temperature', '/pressure'), warned_in_threshold_run=True, threshold_run=True,
-             died=False):
+             died=False, threshold_shape='step'):
     main = {'nodes': ['/exam'], 'node_seen_s': 1.0, 'delay': 5.0, 'start_timeout': 20.0,
             'subscribed': {t: (['/exam'] if t in subscribed else []) for t in ('/temperature', '/pressure')},
             'output': {'expected': '/altitude', 'topic': output[0], 'type': output[1], 'candidates': []},
@@ -27,7 +27,14 @@ def measured(calls=None, rate=10.0, formula_error=0.0, output=('/altitude', 'std
     runs = [{'tag': 'main', 'probe': main, 'seconds': 30.0,
              'launch': {'ended': [{'node': 'exam-1', 'how': 'died', 'detail': 'exit code 1'}] if died else [],
                         'not_started': [], 'tail': ''}}]
-    if threshold_run:
+    if threshold_run and threshold_shape == 'main':  # flown as the main run, around a drawn value
+        second = {'nodes': ['/exam'], 'threshold': 912.4, 'schedule': dict(SCHEDULE),
+                  'calibration': {'by': 'own', 'lo': {'value': 782.4, 'target': 782.4},
+                                  'hi': {'value': 1042.4, 'target': 1042.4}},
+                  'calls': good_calls() if warned_in_threshold_run else [[-2.0, 'NORMAL']]}
+        runs.append({'tag': 'threshold', 'probe': second, 'seconds': 30.0,
+                     'launch': {'ended': [], 'not_started': [], 'tail': ''}})
+    elif threshold_run:  # as measurements kept from before flew it: one step
         second = {'nodes': ['/exam'], 'threshold': 1040.0, 'schedule': {'start': 0.0, 'step': 3.0, 'end': 10.5},
                   'calls': [[8.02, 'WARNING']] if warned_in_threshold_run else []}
         runs.append({'tag': 'threshold', 'probe': second, 'seconds': 12.0,
@@ -160,3 +167,77 @@ def test_nothing_built():
     assert 'CMake Error' in items[0]['evidence']
     refused = {'build': None, 'runs': [], 'error': 'submission refused: entry climbs out'}
     assert 'refused' in rubric.score('altitude', {}, refused)[0]['evidence']
+
+
+def _item(items, item_id):
+    return [i for i in items if i['id'] == item_id][0]
+
+
+def test_threshold_run_flown_as_the_main_run():
+    """Issue 36 point 7: the threshold run flies the main run's legs around its drawn value; Q14a is
+    the WARNING in its long excursion, flown below the launch file's value."""
+    assert lost(measured(threshold_shape='main')) == {}
+    q14a = _item(rubric.score('altitude', STATIC, measured(threshold_shape='main')), 'Q14a')['evidence']
+    assert 'set to 912.4, the node warned 5.05 s after its own value went above it, flown at 1042.4' in q14a, q14a
+    assert lost(measured(threshold_shape='main', warned_in_threshold_run=False)) == {'Q14a': 1.0}
+    assert rubric.threshold_run_value(STATIC, measured(threshold_shape='main')) == 912.4
+    static = dict(STATIC, threshold=dict(STATIC['threshold'], run_value=877.5))
+    assert rubric.threshold_run_value(static, measured(threshold_run=False)) == 877.5, 'drawn, not flown'
+    assert rubric.threshold_run_value(STATIC, measured(threshold_run=False)) is None
+
+
+def test_a_threshold_given_as_an_argument():
+    """Issue 35 point 4: args="--threshold 1300" read with argparse on rospy.myargv(), or by index."""
+    static = dict(STATIC, threshold={'name': '--threshold', 'value': 1300, 'how': 'args'}, params_in_code=[],
+                  args_in_code=['--threshold'])
+    assert lost(measured(threshold_shape='main'), static) == {}
+    assert 'launch file argument --threshold = 1300' in _item(
+        rubric.score('altitude', static, measured(threshold_shape='main')), 'Q14a')['evidence']
+    skipped = dict(measured(threshold_run=False), threshold_skipped='the node never warned in the main run')
+    assert points(skipped, static)['Q14a'] == 0.5
+    assert points(skipped, dict(static, args_in_code=['--rate']))['Q14a'] == 0.0
+    positional = dict(static, threshold={'name': 'argv[1]', 'value': 1300, 'how': 'args'})
+    for read, got in ((['argv[1]'], 0.5), (['threshold'], 0.5), (['argv[2]'], 0.0), (['--limit'], 0.0)):
+        assert points(skipped, dict(positional, args_in_code=read))['Q14a'] == got, read
+
+
+CODE = {'service_calls': ['scripts/exam_node.py:68', 'scripts/exam_node.py:71'],
+        'publishes': ['scripts/exam_node.py:62'], 'timers': ['scripts/exam_node.py:55']}
+
+
+def test_a_rule_not_observed_while_the_code_holds_it_is_a_hand_grade():
+    """Issue 35 point 5: a node that never called the service in a whole flight whose code calls it
+    keeps the points the run gave, but is a hand grade naming the call's line, and a doubt; without
+    such code, the zero is the grade."""
+    never = dict(measured(calls=[], threshold_run=False), threshold_skipped='the node never warned in the main run')
+    static = dict(STATIC, code=CODE)
+    assert lost(never, static) == lost(never) == {'Q13': 4.0, 'Q14a': 0.5, 'Q14b': 3.0}
+    status, reason = rubric.status(static, never)
+    assert status == rubric.HAND_GRADE, reason
+    assert 'never called /altitude_warning in the whole flight' in reason and \
+        'its code calls it at scripts/exam_node.py:68, scripts/exam_node.py:71' in reason, reason
+    assert [d for d in rubric.doubts(static, never) if 'scripts/exam_node.py:68' in d]
+    assert rubric.status(dict(STATIC, code=dict(CODE, service_calls=[])), never) == (rubric.GRADED, '')
+    assert rubric.doubts(dict(STATIC, code=dict(CODE, service_calls=[])), never) == []
+    assert rubric.status(static, measured()) == (rubric.GRADED, ''), 'a node that calls is judged on its calls'
+
+
+def test_a_node_that_never_published_while_its_code_publishes_is_a_hand_grade():
+    silent = measured(calls=[], threshold_run=False)
+    silent['runs'][0]['probe']['rate'] = {'samples': 0, 'hz': None, 'max_gap': None}
+    status, reason = rubric.status(dict(STATIC, code=CODE), silent)
+    assert status == rubric.HAND_GRADE and 'never published its value' in reason and \
+        'scripts/exam_node.py:62' in reason, reason
+
+
+def test_a_private_parameter_read_before_init_node_is_no_reading_of_it():
+    """rospy resolves ``~threshold`` against ``/unnamed`` before init_node: not the node's parameter,
+    so no half point from the code, and the evidence says where and why."""
+    skipped = dict(measured(threshold_run=False), threshold_skipped='the node never warned in the main run')
+    static = dict(STATIC, threshold={'name': '/exam/threshold', 'value': 1300}, params_in_code=['~threshold'])
+    assert points(skipped, static)['Q14a'] == 0.5
+    early = dict(static, code=dict(CODE, private_before_init=['scripts/exam_node.py:6: ~threshold']))
+    assert points(skipped, early)['Q14a'] == 0.0
+    evidence = _item(rubric.score('altitude', early, skipped), 'Q14a')['evidence']
+    assert 'it reads ~threshold before init_node (scripts/exam_node.py:6), where rospy resolves it as ' \
+        '.../unnamed/threshold (its name until then)' in evidence, evidence

@@ -1,5 +1,5 @@
 """What the session reads in roslaunch's output, and when it runs the threshold check."""
-from exam_lab.grader.judge import session
+from exam_lab.grader.host import session
 
 DIED = ('\x1b[1mprocess[exam-1]: started with pid [17908]\x1b[0m\n'
         'Traceback (most recent call last):\n'

@@ -156,3 +156,25 @@ def test_code_files_are_the_package_code(tmp_path):
         os.makedirs(os.path.dirname(str(tmp_path / relative)) or str(tmp_path), exist_ok=True)
         (tmp_path / relative).write_text('x = 1\n')
     assert similarity.code_files(str(tmp_path)) == ['CMakeLists.txt', 'launch/x.launch', 'package.xml', 'scripts/a.py']
+
+
+def test_what_is_read_of_a_student_is_its_code_bounded(tmp_path, monkeypatch):
+    """Issue 36 point 3: a student's data (YAML, logs) is never read, and of its code at most
+    MAX_STUDENT_FILES / MAX_STUDENT_BYTES, programs first: no student can make the check too slow for
+    the class. What was left out is said."""
+    package = tmp_path / 'up' / 'exam'
+    for relative, size in (('scripts/exam_node.py', 100), ('src/helper.cpp', 100), ('launch/a.launch', 100),
+                           ('package.xml', 100), ('config/big.yaml', 1000), ('config/more.yml', 1000)):
+        os.makedirs(os.path.dirname(str(package / relative)), exist_ok=True)
+        (package / relative).write_text('x' * size)
+    assert similarity.code_files(str(package)) == ['launch/a.launch', 'package.xml', 'scripts/exam_node.py',
+                                                   'src/helper.cpp']
+    monkeypatch.setattr(similarity, 'MAX_STUDENT_FILES', 3)
+    monkeypatch.setattr(similarity, 'MAX_STUDENT_BYTES', 250)
+    assert similarity.student_code(str(package)) == (['scripts/exam_node.py', 'src/helper.cpp'],
+                                                     ['launch/a.launch', 'package.xml'])
+    staged, notes = similarity.stage([('dee', str(tmp_path / 'up'))], str(tmp_path / 'staged'))
+    assert sorted(os.listdir(os.path.join(staged['dee'], 'scripts'))) == ['exam_node.py']
+    assert not os.path.exists(os.path.join(staged['dee'], 'config'))
+    assert notes == ["dee: 2 code file(s) compared, 2 left out (at most 3 files and 250 bytes of a student): "
+                     "'launch/a.launch', 'package.xml'"]

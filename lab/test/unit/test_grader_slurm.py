@@ -140,3 +140,19 @@ def test_out_of_time_cancels_and_says_where_each_student_was(array, monkeypatch)
     assert records[1]['status_reason'] == \
         'could not grade: Slurm said: no grade within 10 s; last seen PENDING, Resources'
     assert ['scancel', '100'] in fake.calls
+
+
+def test_a_task_of_a_student_the_intake_refused_says_why(tmp_path):
+    """Issue 36 point 3: the manifest carries the intake's refusal; the task writes that student's
+    "not graded" row with it (nothing of the student is run) and its measurements for a rescore."""
+    from exam_lab.grader import runner
+    manifest = tmp_path / '.slurm' / 'manifest.jsonl'
+    (tmp_path / '.slurm' / 'results').mkdir(parents=True)
+    why = "the files of 'Bob_12_assignsubmission_file_': 5001 more files, beyond the 5000 a submission may unpack"
+    manifest.write_text(json.dumps({'student': 'Bob', 'submission': str(tmp_path / 'Bob_12_assignsubmission_file_'),
+                                    'refused': why}) + '\n')
+    record = slurm.run_task(str(manifest), 0, str(tmp_path))
+    assert (record['status'], record['status_reason']) == ('not graded', 'submission refused: %s' % why)
+    assert record['participant'] == 12
+    assert json.loads((tmp_path / '.slurm' / 'results' / '0.json').read_text())['status_reason'] == record['status_reason']
+    assert [r['status_reason'] for r in runner.rescore(str(tmp_path))[0]] == [record['status_reason']]

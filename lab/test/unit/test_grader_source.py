@@ -82,3 +82,88 @@ def test_a_launched_type_without_its_py_is_run_as_the_script(tmp_path):
     derived = ET.parse(launch.derive(analysis, 'main', changes)).getroot()
     assert [n.get('type') for n in derived.findall('node')] == ['exam_node.py', 'helper.py', 'nothing']
     assert path.read_text() == text
+
+
+#: A node that does everything the checks look for, each in a comment and a string only.
+MENTIONS = '''#!/usr/bin/env python3
+"""Docstring: rospy.init_node('x'), rospy.get_param('~threshold'), rospy.ServiceProxy('w', W),
+led('WARNING'), pub.publish(1.0), rospy.Timer(d, f), '/temperature', '/pressure', argv[1]."""
+# rospy.init_node('x'); t = rospy.get_param('~threshold'); led = rospy.ServiceProxy('w', W); led('WARNING')
+# pub.publish(1.0); rospy.Rate(10); parser.add_argument('--threshold'); rospy.myargv()[1]
+text = "rospy.init_node('x') rospy.get_param('~threshold') rospy.ServiceProxy('w', W) wait_for_service"
+more = "pub.publish(x) rospy.Timer(d, f) rospy.myargv()[1] add_argument('--threshold') sys.argv[2]"
+'''
+#: The same calls in code, with the lines they are on.
+CODE = '''#!/usr/bin/env python3
+import argparse, sys, rospy
+def main():
+    argv = rospy.myargv(argv=sys.argv)
+    parser = argparse.ArgumentParser()
+    parser.add_argument('--threshold', type=float)
+    rospy.init_node('exam')
+    limit = rospy.get_param(param_name='~seuil')
+    led = rospy.ServiceProxy('/altitude_warning', W)
+    rospy.Subscriber('/temperature', F, f)
+    rospy.Subscriber('pressure', F, g)
+    pub = rospy.Publisher('/altitude', F, queue_size=1)
+    rate = rospy.Rate(10)
+    pub.publish(float(argv[1]))
+    led('WARNING')
+    led.call('NORMAL')
+    rospy.ServiceProxy('/altitude_warning', W)('NORMAL')
+'''
+
+
+def test_code_is_read_as_code_never_comments_or_strings(tmp_path):
+    """Issue 36 point 5: each check that reads the code holds against a comment and a string (a
+    docstring too) that mention what it looks for; the same calls as code are found, with their lines."""
+    pkg = tmp_path / 'exam'
+    write(pkg / 'scripts' / 'exam_node.py', MENTIONS)
+    assert source.node_scripts(str(pkg)) == []
+    assert source.param_names(str(pkg)) == []
+    assert source.args_read(str(pkg)) == []
+    assert not source.calls_a_service(str(pkg))
+    assert source.code_evidence(str(pkg)) == {'service_calls': [], 'publishes': [], 'timers': []}
+    assert source.sheets_in_code(str(pkg)) == [], 'a docstring names no topic the node uses'
+    write(pkg / 'scripts' / 'exam_node.py', MENTIONS + CODE.split('\n', 1)[1])
+    assert [os.path.basename(p) for p in source.node_scripts(str(pkg))] == ['exam_node.py']
+    assert source.param_names(str(pkg)) == ['~seuil']
+    assert source.args_read(str(pkg)) == ['--threshold', 'argv[1]']
+    assert source.calls_a_service(str(pkg))
+    offset = len(MENTIONS.splitlines()) - 1
+    found = source.code_evidence(str(pkg))
+    assert found == {'service_calls': ['scripts/exam_node.py:%d' % (n + offset) for n in (15, 16, 17)],
+                     'publishes': ['scripts/exam_node.py:%d' % (14 + offset)],
+                     'timers': ['scripts/exam_node.py:%d' % (13 + offset)]}
+    assert source.sheets_in_code(str(pkg)) == ['altitude']
+    assert source.private_before_init(str(pkg)) == [], 'the comment\'s ~threshold above init_node is no read'
+    assert source.unparsed(str(pkg)) == []
+
+
+def test_a_file_that_does_not_parse_is_read_as_text_and_said_so(tmp_path):
+    pkg = tmp_path / 'exam'
+    write(pkg / 'scripts' / 'exam_node.py', '#!/usr/bin/env python\nimport rospy\n# rospy.ServiceProxy\n'
+                                            'rospy.init_node("e")\nt = rospy.get_param("~seuil")\nprint "x"\n')
+    assert source.unparsed(str(pkg)) == ['scripts/exam_node.py does not parse as Python 3 (SyntaxError at line 6): '
+                                         'what it does was read from its text, comments dropped']
+    assert [os.path.basename(p) for p in source.node_scripts(str(pkg))] == ['exam_node.py']
+    assert source.param_names(str(pkg)) == ['~seuil']
+    assert not source.calls_a_service(str(pkg)), 'the comment is dropped before the text is read'
+    assert source.code_evidence(str(pkg))['service_calls'] == []
+
+
+def test_a_private_parameter_read_before_init_node_is_named(tmp_path):
+    """Before ``init_node`` rospy's caller id is ``<ns>/unnamed`` (rospy/names.py), so ``~threshold``
+    then reads ``/unnamed/threshold``, never the node's: named with its line, and so is one read when
+    the module is imported (before ``main()`` starts the node). A relative or global name read then, a
+    private one read after, and one in a function of its own are not."""
+    pkg = tmp_path / 'exam'
+    write(pkg / 'scripts' / 'exam_node.py', 'import rospy\nLIMIT = rospy.get_param("~early", 1)\n'
+                                            'def helper():\n    return rospy.get_param("~later")\n'
+                                            'def main():\n    t = rospy.get_param("~threshold", 1300)\n'
+                                            '    g = rospy.get_param("threshold")\n    rospy.init_node("exam")\n'
+                                            '    r = rospy.get_param("~rate")\n'
+                                            'if __name__ == "__main__":\n    main()\n')
+    assert source.private_before_init(str(pkg)) == ['scripts/exam_node.py:2: ~early', 'scripts/exam_node.py:6: ~threshold']
+    write(pkg / 'scripts' / 'exam_node.py', 'import rospy\nt = rospy.get_param("~threshold")\nrospy.init_node("e")\n')
+    assert source.private_before_init(str(pkg)) == ['scripts/exam_node.py:2: ~threshold']

@@ -229,8 +229,11 @@ class _Here(object):
     """A stand-in for the box and the supervisor: the check runs here, as the test's user."""
     home = '/tmp'
 
-    def argv(self, argv, env):
-        return argv
+    workspace = None  # where the box's steps start when no cwd is given (its workspace)
+
+    def argv(self, argv, env, cwd=None):
+        cwd = cwd or self.workspace
+        return (['env', '-C', cwd] if cwd else []) + argv
 
     def run(self, name, argv, timeout, env=None):
         import subprocess
@@ -239,15 +242,13 @@ class _Here(object):
 
 
 def test_roslaunch_verdict_on_the_file_as_handed_in(tmp_path):
-    from exam_lab.grader.judge import session
+    from exam_lab.grader.host import session
     launch = tmp_path / 'src' / 'exam' / 'launch'
     launch.mkdir(parents=True)
     (launch / 'dup.launch').write_text('<launch><node pkg="mydrone" name="mydrone" type="mydrone_node.py"/>'
                                        '<node pkg="exam" name="mydrone" type="exam_node.py"/></launch>')
     (launch / 'odd.launch').write_text('<launch><node pkg="exam" name="exam" type="exam_node.py">'
                                        '<parm name="threshold" value="1"/></node></launch>')
-    (tmp_path / 'devel').mkdir()  # the student's workspace, sourced before the check: ours is sourced already
-    (tmp_path / 'devel' / 'setup.bash').write_text('true\n')
     here, env = _Here(), dict(os.environ)
     job = {'workspace': str(tmp_path), 'handed_in_launch': 'exam/launch/dup.launch'}
     refused = session.launch_verdict(here, job, env, here)

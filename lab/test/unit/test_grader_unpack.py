@@ -38,7 +38,7 @@ def test_links_are_dropped_and_noted_never_followed(tmp_path):
 
 
 def test_bombs_and_crowds_are_refused(tmp_path):
-    bomb = make_zip(tmp_path / 'bomb.zip', [('exam/big', b'\0' * (5 * 1024 * 1024))])
+    bomb = make_zip(tmp_path / 'bomb.zip', [('exam/big', b'\0' * (unpack.RATIO_FROM_BYTES + 1))])
     with pytest.raises(unpack.UnpackError, match='bomb'):
         unpack.safe_extract(bomb, str(tmp_path / 'out'))
     crowd = make_zip(tmp_path / 'crowd.zip', [('f%d' % i, 'x') for i in range(20)])
@@ -104,3 +104,73 @@ def test_copy_skips_build_products_and_links(tmp_path):
     assert sorted(os.listdir(str(tmp_path / 'copy'))) == ['scripts']
     assert os.listdir(str(tmp_path / 'copy' / 'scripts')) == ['exam_node.py']
     assert any('link' in n for n in notes)
+
+
+def test_a_compressible_file_in_an_upload_is_no_bomb(tmp_path):
+    """A few MB of log or a one-colour screenshot compress 1000x: the budget bounds them, not the ratio."""
+    upload = make_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML),
+                                              ('exam/run.log', b'[INFO] altitude 1300.0\n' * 100000)])
+    assert unpack.safe_extract(upload, str(tmp_path / 'out')) == 2
+
+
+def moodle_class(path, students):
+    """A Moodle "download all submissions" zip: ``{folder name: [(file, bytes)]}`` (Moodle's naming:
+    ``Full Name_<participant>_assignsubmission_file_/``), each entry deflated as Moodle does."""
+    return make_zip(path, [('%s/%s' % (folder, name), data) for folder, files in sorted(students.items())
+                           for name, data in files])
+
+
+def test_a_class_zip_judges_each_student_by_its_own_bounds(tmp_path, monkeypatch):
+    """Issue 36 point 3: a one-colour screenshot (5 MB of one byte) is no reason to refuse anyone; a
+    student over its own bounds is refused alone, on its own row, with the reason; the others are
+    unpacked."""
+    monkeypatch.setattr(unpack, 'MAX_FILES', 3)
+    package = [('exam.zip', open(make_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML)]), 'rb').read())]
+    archive = moodle_class(tmp_path / 'class.zip', {
+        'Ann Lee_11_assignsubmission_file_': package + [('screenshot.bmp', b'\xff' * (5 << 20))],
+        'Bob Crowd_12_assignsubmission_file_': package + [('f%d.txt' % i, 'x') for i in range(4)],
+        'Cy Fine_13_assignsubmission_file_': package})
+    refused = {}
+    students = unpack.list_students(archive, str(tmp_path / 'scratch'), refused)
+    assert [name for name, _ in students] == ['Ann Lee', 'Bob Crowd', 'Cy Fine']
+    paths = dict(students)
+    assert list(refused) == [paths['Bob Crowd']] and os.listdir(paths['Bob Crowd']) == []
+    assert refused[paths['Bob Crowd']] == "the files of 'Bob Crowd_12_assignsubmission_file_': 5 more files, " \
+        "beyond the 3 a submission may unpack"
+    assert os.path.getsize(os.path.join(paths['Ann Lee'], 'screenshot.bmp')) == 5 << 20
+    assert os.path.isfile(os.path.join(paths['Cy Fine'], 'exam.zip'))
+
+
+def test_a_class_zip_is_bounded_as_a_whole(tmp_path, monkeypatch):
+    """What no student's bounds can say refuses the class: more entries or bytes than a class holds, an
+    entry outside every student's folder."""
+    students = {'S%d_%d_assignsubmission_file_' % (i, i): [('a.txt', 'x' * 100)] for i in range(3)}
+    archive = moodle_class(tmp_path / 'class.zip', students)
+    monkeypatch.setattr(unpack, 'CLASS_BYTES', 250)
+    with pytest.raises(unpack.UnpackError, match=r'come to 300 bytes \(at most 250 for a class\)'):
+        unpack.list_students(archive, str(tmp_path / 'a'))
+    monkeypatch.setattr(unpack, 'CLASS_FILES', 2)
+    with pytest.raises(unpack.UnpackError, match=r'holds 3 entries \(at most 2 for a class\)'):
+        unpack.list_students(archive, str(tmp_path / 'b'))
+    monkeypatch.setattr(unpack, 'CLASS_FILES', 100)
+    with zipfile.ZipFile(archive, 'a') as zf:
+        zf.writestr('../outside.txt', 'x')
+    with pytest.raises(unpack.UnpackError, match='outside'):
+        unpack.list_students(archive, str(tmp_path / 'c'))
+
+
+def test_a_student_named_like_an_output_gets_a_folder_of_its_own(tmp_path):
+    """``grades.csv.zip`` and ``index.html.zip`` at a class's top, a Moodle folder ``hand.csv_7_...``:
+    none is named like the class's files."""
+    archive = make_zip(tmp_path / 'class.zip', [
+        ('grades.csv.zip', 'z'), ('index.html.zip', 'z'), ('hand.csv_7_assignsubmission_file_/exam.zip', 'z')])
+    names = [name for name, _ in unpack.list_students(archive, str(tmp_path / 'scratch'))]
+    assert names == ['grades_csv', 'hand_csv', 'index_html']
+
+
+def test_a_name_in_any_bytes_is_shown_as_its_bytes():
+    """A byte that is not UTF-8 (surrogateescape) reads ``\\xNN`` in a note, as on the page; a name
+    that merely holds a backslash is not taken for one."""
+    assert unpack.shown_name(b'exam/lien\xfe'.decode('utf-8', 'surrogateescape')) == "'exam/lien\\xfe'"
+    assert unpack.shown_name('a\\udcff') == "'a\\\\udcff'"
+    assert unpack.shown_name('Größe\n') == "'Größe\\n'"

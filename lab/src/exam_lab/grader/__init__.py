@@ -10,12 +10,13 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it,
   the derived launch files the grader runs), :mod:`~.boxed.documents` (participant number, PDF
   reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own).
-- ``judge/`` -- not root, never reading the student's files: :mod:`~.judge.session` (builds and runs
-  one submission: the student's steps in its box, the master and the probe outside) and
-  :mod:`~.judge.probe` (rospy: plays the drone with the harness's fake drone, measures).
-- ``host/`` -- root: :mod:`~.host.sandbox` (the box: bubblewrap, a uid of its own, limits; the
-  capped, regular-file-only copy of what a box leaves) and :mod:`~.host.egress` (the only reader of a
-  box's record: capped, never a link, checked against its schema).
+- ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`
+  (rospy: plays the drone with the harness's fake drone, measures, watches the node's pid).
+- ``host/`` -- root: :mod:`~.host.session` (builds and runs one submission: the student's steps in its
+  box, the master and the probe as the slot's judge uid), :mod:`~.host.sandbox` (the box: bubblewrap, a
+  uid of its own, limits; the capped, regular-file-only copy of what a box leaves) and
+  :mod:`~.host.egress` (the only reader of a box's record: capped, never a link, checked against its
+  schema).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima) and
   :mod:`~.score.rubric` (points, evidence and status from the measurements), :mod:`~.score.safe_text`
   (student-derived text without control characters, for every record and output), :mod:`~.score.records`
@@ -25,6 +26,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.publish.page` (index.html), :mod:`~.publish.flightplot`, :mod:`~.publish.moodle` (the
   offline grading worksheet), :mod:`~.publish.gradescope` (results.json), :mod:`~.publish.progress`
   (k of n, the time left; a run's steps), :mod:`~.publish.hand` (the teacher's hand points, hand.csv),
+  :mod:`~.publish.feedback` (each student's page for Moodle, moodle-feedback.zip), :mod:`~.publish.cells`
+  (a CSV cell a spreadsheet cannot run, read back exactly),
   :mod:`~.publish.provenance` (what made a grade), :mod:`~.publish.student_view` (what ``make check``
   shows a student).
 - :mod:`~exam_lab.grader.runner` -- one submission or a class, top to bottom: stage, inspect (boxed),

@@ -9,7 +9,7 @@ the source scan, PDF facts and comment statistics. Root reads back one capped, s
 (:mod:`~exam_lab.grader.host.egress`, :mod:`~exam_lab.grader.score.records`) and plans the runs from it;
 the workspace stays the box uid's, read-only in the build and run box. A class archive is unpacked by
 :mod:`~exam_lab.grader.boxed.intake`, the similarity check runs in a box too. Then
-:mod:`exam_lab.grader.judge.session` runs in a network namespace with only loopback
+:mod:`exam_lab.grader.host.session` runs in a network namespace with only loopback
 (:func:`~exam_lab.grader.host.sandbox.network_namespace`: ``unshare --net`` as root, a user namespace of
 its own too otherwise), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an overall time
 limit;
@@ -27,6 +27,7 @@ import hashlib
 import json
 import os
 import pwd
+import random
 import re
 import shutil
 import subprocess
@@ -41,6 +42,7 @@ from exam_lab.grader.boxed import similarity, unpack
 
 from exam_lab.grader.host import egress, sandbox
 from exam_lab.grader.host.sandbox import BOX_WS
+from exam_lab.grader.host.session import budget_sentence
 
 from exam_lab.grader.score import records, rubric
 
@@ -49,11 +51,19 @@ from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, SHEETS, margin_o
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
 #: Time limits, s: the student's catkin_make, the node's start (to registering with the master),
-#: the probe of one run (a late WARNING is waited for up to LATE_WARNING_S), the whole session.
+#: the probe of one run (a late WARNING is waited for up to LATE_WARNING_S).
 BUILD_TIMEOUT = 180.0
 START_TIMEOUT = 20.0
 RUN_TIMEOUT = 90.0 + LATE_WARNING_S
-SESSION_TIMEOUT = 420.0 + 2 * LATE_WARNING_S
+#: One student's whole grading, s: staging, inspection, roslaunch's check, build and runs together;
+#: every step's limit (above, INSPECT_BOUNDS) is also bounded by what is left of it. A usual grading
+#: takes about 45 s, the slowest honest one measured (a WARNING 50 s late) 134 s: docs/grading.md, "Speed".
+STUDENT_BUDGET = 280.0
+#: What a grading may take past its budget: the session's kill if it overran (SESSION_KILL_S), ending
+#: the box, copying the logs and scoring. STUDENT_BUDGET + AFTER_BUDGET_S is a student's worst case
+#: (:func:`worst_case`).
+AFTER_BUDGET_S = 20.0
+SESSION_KILL_S = 5.0
 #: The simulator packages of the underlay.
 SIMULATORS = ('node_kit', 'drone_sim', 'mydrone', 'submarinedrone')
 #: Bounds of the boxes that read student bytes: (wall clock s, CPU s, address space bytes). One upload's
@@ -211,9 +221,9 @@ class Boxed(object):
         raise InspectionFailed('%s%s' % (why, ': %s' % tail if tail else ''))
 
 
-def inspect(box, work, upload, wanted_sheet):
+def inspect(box, work, upload, wanted_sheet, timeout=None):
     """Run :mod:`exam_lab.grader.boxed.inspect` on the staged ``upload`` (a path below ``<work>/upload``)
-    in ``box`` (:class:`Boxed`), bounded by INSPECT_BOUNDS; return its checked
+    in ``box`` (:class:`Boxed`), bounded by INSPECT_BOUNDS (its wall clock by ``timeout`` if less); return its checked
     :class:`~exam_lab.grader.score.records.InspectRecord`. The package is written, as the box's uid, to
     the workspace the build box sees: ``<work>/ws/src`` (read-only there), or unsandboxed the box's
     own copy.
@@ -226,14 +236,16 @@ def inspect(box, work, upload, wanted_sheet):
         ws = BOX_WS
     else:
         boxed, ws = Boxed(box, work), box.workspace
+    # Where the threshold run's value lies in its range, drawn now, by the grader (issue 36 point 7).
     args = ['--upload', boxed.path(upload), '--ws', ws, '--out', boxed.path(boxed.out),
-            '--toplevel', os.path.join(_package_path('catkin'), 'cmake', 'toplevel.cmake')]
+            '--toplevel', os.path.join(_package_path('catkin'), 'cmake', 'toplevel.cmake'),
+            '--draw', repr(random.SystemRandom().random())]
     return boxed.run('exam_lab.grader.boxed.inspect', args + (['--sheet', wanted_sheet] if wanted_sheet else []),
-                     records.InspectRecord, INSPECT_BOUNDS)
+                     records.InspectRecord, (min(INSPECT_BOUNDS[0], timeout or INSPECT_BOUNDS[0]),) + INSPECT_BOUNDS[1:])
 
 
 def plan_job(record):
-    """The session's job (:mod:`exam_lab.grader.judge.session`) from a checked inspection record: the
+    """The session's job (:mod:`exam_lab.grader.host.session`) from a checked inspection record: the
     runs' plans are computed here, from its numbers; the launch files stay relative to the workspace.
     None when there is nothing to run."""
     if record.main_launch is None:
@@ -245,17 +257,28 @@ def plan_job(record):
             'late_warning': LATE_WARNING_S if record.calls_service else 0.0}
     runs = [{'tag': 'main', 'launch': record.main_launch, 'plan': plan}]
     if record.threshold_launch is not None:
-        lowered = threshold - 2 * margin
+        # The value the inspection wrote into the derived launch file (drawn at grading time,
+        # sheets.threshold_run_value), flown as the main run around it, with the main run's margin.
         runs.append({'tag': 'threshold', 'launch': record.threshold_launch,
-                     'plan': dict(plan, kind='threshold', threshold=lowered,
-                                  targets={'start': lowered - margin, 'step': threshold - margin})})
+                     'plan': dict(plan, kind='threshold', threshold=record.threshold_run_value)})
     return {'namespace': record.namespace, 'build_timeout': BUILD_TIMEOUT, 'run_timeout': RUN_TIMEOUT, 'runs': runs,
             'handed_in_launch': record.handed_in_launch}
 
 
-def run_session(job, work, underlay, isolate, box, on_step=None):
+def worst_case(students, jobs):
+    """Seconds a class of ``students`` takes at most, ``jobs`` side by side, when every grading uses
+    its whole budget: ceil(students / jobs) gradings one after the other, each STUDENT_BUDGET +
+    AFTER_BUDGET_S (the class's own steps, its intake and similarity check, aside: INTAKE_BOUNDS,
+    SIMILARITY_BOUNDS)."""
+    return -(-students // max(1, jobs)) * (STUDENT_BUDGET + AFTER_BUDGET_S)
+
+
+def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BUDGET):
     """Run the session of one submission, its student steps in ``box``; return what it measured (or
     why it could not).
+
+    :param left: seconds left of the student's budget: the session's own (it stops its steps in time),
+        and killed SESSION_KILL_S after.
 
     :param isolate: in a network namespace of its own with only loopback
         (:func:`~exam_lab.grader.host.sandbox.network_namespace`).
@@ -267,15 +290,15 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
         os.makedirs(folder, mode=0o700, exist_ok=True)
     runs = [dict(run, launch=os.path.join(box.workspace, run['launch'])) for run in job['runs']]
     job = dict(job, workspace=box.workspace, runs=runs, underlay=underlay, log_dir=log_dir,
-               judge_home=judge_home, box=box.describe())
+               judge_home=judge_home, box=box.describe(), budget=left, student_budget=STUDENT_BUDGET)
     job_path = os.path.join(work, 'job.json')
     with open(job_path, 'w') as f:
         json.dump(job, f, indent=1, sort_keys=True)
-    argv = [sys.executable, '-m', 'exam_lab.grader.judge.session', job_path]
+    argv = [sys.executable, '-m', 'exam_lab.grader.host.session', job_path]
     if isolate:
         argv = sandbox.network_namespace(argv)
     with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
-        status, output, _ = sup.run('session', argv, timeout=SESSION_TIMEOUT, env=dict(os.environ, HOME=judge_home))
+        status, output, _ = sup.run('session', argv, timeout=left + SESSION_KILL_S, env=dict(os.environ, HOME=judge_home))
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
     survivors = box.end()  # the box's uid: nothing may be left once its PID namespaces are gone
     path = os.path.join(log_dir, 'session.json')
@@ -284,8 +307,10 @@ def run_session(job, work, underlay, isolate, box, on_step=None):
             result = json.load(f)
         result['survivors'] = result.get('survivors', 0) + survivors
         return result
-    why = 'the session did not finish within %.0f s' % SESSION_TIMEOUT if status is None else \
-        'the session failed (exit %s): %s' % (status, session_tail(output))
+    if status is None:
+        why = budget_sentence(STUDENT_BUDGET, 'the session was killed after %.0f s' % (left + SESSION_KILL_S))
+        return {'build': None, 'runs': [], 'error': why, 'budget_used': why, 'survivors': survivors}
+    why = 'the session failed (exit %s): %s' % (status, session_tail(output))
     return {'build': None, 'runs': [], 'error': why, 'survivors': survivors}
 
 
@@ -324,6 +349,8 @@ def hints(static, session, notes, comments, isolate, how_run=None):
                    'ran WITHOUT network isolation (no network namespace could be made): the student code could '
                    'reach the network')
         out.append(how_run or 'not run')
+    if (session or {}).get('budget_used'):
+        out.append(session['budget_used'])
     if (session or {}).get('survivors'):
         out.append('%d processes of the student were still alive after its steps ended: killed'
                    % session['survivors'])
@@ -381,7 +408,9 @@ def score(measured, how='run'):
     """The grade record of one submission from what its run measured (:data:`MEASUREMENTS`): the one
     place the rubric is applied, by a run and by a rescore alike. ``how`` goes into its provenance."""
     static, session = measured['static'], measured['session']
-    extra = dict(measured['extra'], doubts=rubric.doubts(static, session), provenance=provenance.stamp(how))
+    run_value = rubric.threshold_run_value(static, session)
+    extra = dict(measured['extra'], doubts=rubric.doubts(static, session), provenance=provenance.stamp(how),
+                 threshold_run={'value': run_value} if run_value is not None else None)
     return report.grade_record(measured['student'], measured['sheet'], rubric.score(measured['sheet'], static, session),
                                hints(static, session, measured['notes'] + measured['fixes'], measured['comments'],
                                      measured['isolate'], measured['how_run']),
@@ -459,6 +488,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     isolate = can_isolate() if isolate is None else isolate
     underlay = underlay or ensure_underlay(default_underlay())  # raises: the grader cannot run
     os.makedirs(out_dir, exist_ok=True)
+    deadline = time.monotonic() + STUDENT_BUDGET  # the student's own time starts here, the simulators built
     # In the system's temp folder, not under OUT (which may be private): the box's user must reach
     # <work>/upload, <work>/ws and <work>/box, and may not list <work>.
     work = tempfile.mkdtemp(prefix='exam-grade-')
@@ -477,7 +507,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None,
                              cpus=sandbox.box_cpus(jobs)) as box:
                 notes.extend(box.notes)
-                found = inspect(box, work, upload, sheet)
+                found = inspect(box, work, upload, sheet, timeout=deadline - time.monotonic())
                 notes.append(_how_read(box, found.uid))
                 notes.extend(found.notes)
                 fixes.extend(found.fixes)
@@ -489,9 +519,14 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                 if job is None:
                     session = {'build': None, 'runs': [], 'no_node': True,
                                'error': 'no script of the package starts a ROS node'}
+                elif deadline - time.monotonic() < START_TIMEOUT:
+                    why = budget_sentence(STUDENT_BUDGET, 'nothing was run (%.0f s left after the inspection)'
+                                          % (deadline - time.monotonic()))
+                    session = {'build': None, 'runs': [], 'error': why, 'budget_used': why}
                 else:
                     how_run = _how_run(box)
-                    session = run_session(job, work, underlay, isolate, box, on_step)
+                    session = run_session(job, work, underlay, isolate, box, on_step,
+                                          left=deadline - time.monotonic())
         except (unpack.UnpackError, sandbox.UploadRefused) as err:
             session = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % err}
         except InspectionFailed as err:
@@ -518,10 +553,13 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             shutil.rmtree(work, ignore_errors=True)  # never follows a link the box left (rmtree does not)
 
 
-def _staged_work(prefix, sources, parent=None):
+def _staged_work(prefix, sources, parent=None, bounds=None, refused=None):
     """A work folder for a box (in ``parent``, by default the system's temp folder: the box's user must
     reach it), with each ``(name, path)`` of ``sources`` staged read-only as
-    ``<work>/upload/<index>/<name>``; returns ``(work, [staged paths])``."""
+    ``<work>/upload/<index>/<name>``, within ``bounds`` (``(bytes, files)``; one upload's when None);
+    returns ``(work, [staged paths])``. With ``refused`` (a dict), a source over its bounds is not
+    staged (None in its place) and ``refused`` receives ``{its path: why}``; otherwise it raises
+    :class:`~exam_lab.grader.host.sandbox.UploadRefused`."""
     work = tempfile.mkdtemp(prefix=prefix, dir=parent)
     os.chmod(work, 0o711)
     staged = []
@@ -530,11 +568,18 @@ def _staged_work(prefix, sources, parent=None):
     for index, (name, path) in enumerate(sources):
         os.mkdir(os.path.join(work, 'upload', str(index)), 0o755)
         staged.append(os.path.join(work, 'upload', str(index), name if name not in ('', '.', '..') else 'upload'))
-        sandbox.stage_upload(path, staged[-1])
+        try:
+            sandbox.stage_upload(path, staged[-1], *(bounds or ()))
+        except sandbox.UploadRefused as err:
+            if refused is None:
+                raise
+            refused[path] = str(err)
+            shutil.rmtree(os.path.dirname(staged[-1]), ignore_errors=True)
+            staged[-1] = None
     return work, staged
 
 
-def class_students(class_path, work_dirs, scratch=None, out=None):
+def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
     """``[(student, folder or archive)]`` of a class, each name unique (``Jane Doe``, ``Jane Doe_2``):
     the students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`); with
     ``out``, the folder of an earlier run of the class, each student keeps the name (the folder in OUT)
@@ -542,7 +587,9 @@ def class_students(class_path, work_dirs, scratch=None, out=None):
     folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.boxed.unpack.list_students`
     opens no file of a folder); an archive is unpacked by :mod:`exam_lab.grader.boxed.intake` in a box of
     its own (INTAKE_BOUNDS), in a work folder made in ``scratch`` (default: the system's temp folder) and
-    appended to ``work_dirs`` (the caller removes it once the students are graded).
+    appended to ``work_dirs`` (the caller removes it once the students are graded). ``refused`` (a
+    dict) receives ``{folder: why}`` of the students whose files the intake refused by their own
+    bounds (:func:`grade_student`'s ``refused``).
 
     :raises unpack.UnpackError: the archive could not be unpacked (why, and the end of the box's log).
     """
@@ -551,7 +598,9 @@ def class_students(class_path, work_dirs, scratch=None, out=None):
         return _unique(unpack.list_students(class_path, None), kept_folders(out))
     if scratch:
         os.makedirs(scratch, mode=0o711, exist_ok=True)
-    work, (staged,) = _staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch)
+    # One file, bounded as a class (a class of 60 with its PDFs is more than one upload may be).
+    work, (staged,) = _staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch,
+                                   (unpack.CLASS_BYTES, 1))
     work_dirs.append(work)
     with sandbox.Box(work, bwrap=sandbox.check() is None) as box:
         boxed = Boxed(box, work)
@@ -566,6 +615,8 @@ def class_students(class_path, work_dirs, scratch=None, out=None):
         path = os.path.join(boxed.out, student['path'])
         if os.path.realpath(path) != os.path.normpath(path) or not os.path.lexists(path):
             raise unpack.UnpackError('the intake named %s, which is a link or missing' % student['path'])
+        if student.get('refused') is not None and refused is not None:
+            refused[path] = student['refused']
         students.append((student['name'], path))
     return _unique(students, kept_folders(out))
 
@@ -598,7 +649,8 @@ def kept_folders(out):
 
 def _unique(students, kept=None):
     """Each student's name made unique (``Jane Doe``, ``Jane Doe_2``): it is the student's folder in
-    OUT. A participant that ``kept`` (:func:`kept_folders`) gives a folder keeps it, and no other
+    OUT, which never ends like one of the class's files (:func:`~exam_lab.grader.boxed.unpack.student_name`).
+    A participant that ``kept`` (:func:`kept_folders`) gives a folder keeps it, and no other
     student takes a folder of OUT that is a participant's: a classmate whose name cleans to the same
     (``Jane Doe.``) submitting late never takes the first one's folder, its kept measurements or its
     row (the rows of hand.csv and the worksheet are keyed by the number anyway)."""
@@ -622,10 +674,16 @@ def _unique(students, kept=None):
 
 
 def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
-                  unsandboxed=False, jobs=1):
+                  unsandboxed=False, jobs=1, refused=None):
     """Grade one student of a class into ``out_dir/name``; return the record. Anything the grader
     raises is this student's record ("could not grade"), never the class's. Both engines grade a
-    student with it: a local pool's thread and a Slurm task."""
+    student with it: a local pool's thread and a Slurm task.
+
+    :param refused: why the class's intake did not unpack this student's files (its own bounds): the
+        student is not graded, with that sentence, and its measurements are kept for a rescore.
+    """
+    if refused is not None:
+        return _refused_at_intake(name, folder, os.path.join(out_dir, name), sheet, refused)
     try:
         return grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
                                 on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
@@ -641,19 +699,40 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
         return record
 
 
+def _refused_at_intake(name, folder, out_dir, sheet, why):
+    """The record of a student whose files the class's intake refused: nothing of it ran."""
+    folder_name = os.path.basename(folder)
+    measured = {'student': name, 'sheet': sheet or 'altitude', 'static': {}, 'notes': [], 'fixes': [],
+                'comments': None, 'isolate': None, 'how_run': None,
+                'session': {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % why},
+                'extra': {'participant': moodle.participant_number(folder_name), 'folder': folder_name,
+                          'documents': [], 'seconds': 0.0}}
+    os.makedirs(out_dir, exist_ok=True)
+    with open(os.path.join(out_dir, MEASUREMENTS), 'w') as f:
+        json.dump(measured, f, indent=1, sort_keys=True)
+    record = score(measured)
+    report.write_grade(out_dir, record)
+    return record
+
+
 def class_similarity(klass, out, records_):
     """The similarity check over a class's submissions, each named as its grade record names it, run in
     a box (:mod:`exam_lab.grader.boxed.similarity` ``--class``: unpacking and comparing, SIMILARITY_BOUNDS)
     and read back as a :class:`~exam_lab.grader.score.records.SimilarityRecord`; written to
     ``out/similarity.json``. ``{"error"}`` when it could not run (the grades stand)."""
-    work_dirs = []
+    work_dirs, refused = [], {}
     try:
         by_folder = {r.get('folder'): r['student'] for r in records_}
-        submissions = [(by_folder.get(os.path.basename(folder), name), folder)
-                       for name, folder in class_students(klass, work_dirs)]
+        listed = [(by_folder.get(os.path.basename(folder), name), folder)
+                  for name, folder in class_students(klass, work_dirs, refused=refused)]
+        intake = [(name, folder) for name, folder in listed if folder not in refused]
         python = similarity.ensure_venv()  # as root: an installation, from PyPI, of no student's bytes
-        work, staged = _staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in submissions])
+        # Each student staged by its own bounds: one over them is not compared, the others are.
+        work, staged = _staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in intake],
+                                    refused=refused)
         work_dirs.append(work)
+        kept = [(student, path) for student, path in zip(intake, staged) if path is not None]
+        submissions, staged = [student for student, _ in kept], [path for _, path in kept]
         similarity.boilerplate(os.path.join(work, 'upload', 'boilerplate'))
         venv = os.path.dirname(os.path.dirname(python))
         with sandbox.Box(work, [venv], bwrap=sandbox.check() is None) as box:
@@ -666,6 +745,8 @@ def class_similarity(klass, out, records_):
                 json.dump(job, f)
             result = boxed.run('exam_lab.grader.boxed.similarity', ['--class', boxed.path(f.name)],
                                records.SimilarityRecord, SIMILARITY_BOUNDS, python=python).value
+        result['notes'] = ['%s: not compared (its files were refused: %s)' % (name, refused[folder])
+                           for name, folder in listed if folder in refused] + result.get('notes', [])
     except Exception as err:  # a bug of the check, or its box failing, must not cost the class its page
         result = {'error': str(err) if isinstance(err, (InspectionFailed, unpack.UnpackError)) else repr(err)}
     finally:
@@ -714,9 +795,9 @@ def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progre
         raise sandbox.SandboxUnavailable(refusal)
     os.makedirs(out_dir, exist_ok=True)
     jobs = jobs or default_jobs()
-    work_dirs = []
+    work_dirs, refused = [], {}
     try:
-        students = class_students(class_path, work_dirs, out=out_dir)
+        students = class_students(class_path, work_dirs, refused=refused, out=out_dir)
         underlay = ensure_underlay(default_underlay())
         isolate = can_isolate() if isolate is None else isolate
         records = [None] * len(students)
@@ -729,7 +810,7 @@ def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progre
                 progress.started(name)
             record = grade_student(name, folder, out_dir, sheet, underlay, isolate,
                                    (lambda step: progress.step(name, step)) if progress else None, unsandboxed,
-                                   jobs=jobs)
+                                   jobs=jobs, refused=refused.get(folder))
             if progress:
                 progress.finished(record)
             return record

@@ -18,13 +18,14 @@ other failure exits non-zero with its traceback on stderr (the runner keeps a ca
 """
 import argparse
 import os
+import random
 import re
 import sys
 
 from exam_lab.grader.boxed import documents, launch, source, unpack
 from exam_lab.grader.host import sandbox
 from exam_lab.grader.score import records
-from exam_lab.grader.score.sheets import PACKAGE, SHEETS, margin_of
+from exam_lab.grader.score.sheets import PACKAGE, SHEETS, threshold_run_value
 
 
 def detect_sheet(wanted, package_dir, analyses):
@@ -53,14 +54,19 @@ def _executable_in(pkg, name):
     return False
 
 
-def inspect(upload, ws, out, wanted_sheet=None):
+def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     """The record (a dict, :class:`~exam_lab.grader.score.records.InspectRecord`'s fields) of the
-    submission ``upload``; its package is written to ``ws/src/<name>``, scratch goes below ``out``."""
+    submission ``upload``; its package is written to ``ws/src/<name>``, scratch goes below ``out``.
+
+    :param draw: in [0, 1), drawn by the grader at grading time: where the threshold run's value lies
+        in its range (:func:`~exam_lab.grader.score.sheets.threshold_run_value`); drawn here if None.
+    """
     notes, fixes = [], []
+    draw = random.SystemRandom().random() if draw is None else draw
     record = {'uid': os.getuid(), 'refused': None, 'sheet': wanted_sheet or 'altitude', 'notes': notes,
               'fixes': fixes, 'static': None, 'threshold_value': SHEETS[wanted_sheet or 'altitude'].threshold,
               'calls_service': False, 'namespace': '/', 'main_launch': None, 'threshold_launch': None,
-              'handed_in_launch': None,
+              'threshold_run_value': None, 'handed_in_launch': None,
               'comments': None, 'facts': documents.submission_facts(upload)}
     uploads = []
     try:
@@ -85,9 +91,12 @@ def inspect(upload, ws, out, wanted_sheet=None):
     fixes.extend(source.make_runnable(pkg, launched))
     static = {'launch_files': [os.path.relpath(a.path, pkg) for a in analyses], 'package': name,
               'python2': source.python2_evidence(pkg), 'params_in_code': source.param_names(pkg),
+              'args_in_code': source.args_read(pkg),
+              'code': dict(source.code_evidence(pkg), private_before_init=source.private_before_init(pkg)),
               'launch': None, 'threshold': None, 'uploads': uploads}
     record.update(sheet=sheet, static=static, threshold_value=SHEETS[sheet].threshold,
                   calls_service=source.calls_a_service(pkg))
+    notes.extend(source.unparsed(pkg))
     if static['python2']:
         notes.append('Python 2 code, which ROS Noetic cannot run: %s' % ', '.join(static['python2']))
     for analysis in analyses:
@@ -109,17 +118,18 @@ def inspect(upload, ws, out, wanted_sheet=None):
             if value is not None:
                 record['threshold_value'] = value
             static['threshold'] = {'name': param.name, 'value': param.value,
+                                   'how': 'args' if isinstance(param, launch.NodeArg) else 'param',
                                    'where': param.origin.describe(pkg) if param.origin else '?'}
             notes.append('threshold parameter: %s, set in %s' % (why, static['threshold']['where']))
         record['main_launch'] = os.path.relpath(launch.derive(chosen, 'main', types), ws)
         record['handed_in_launch'] = os.path.relpath(chosen.path, os.path.join(ws, 'src'))
         record['namespace'] = chosen.drone_namespace(sheet)
         if param is not None and param.origin is not None:
-            margin = margin_of(record['threshold_value'])
-            lowered = record['threshold_value'] - 2 * margin
+            lowered = threshold_run_value(record['threshold_value'], draw)
             changes = dict(types)
             changes[param.origin] = lowered
             record['threshold_launch'] = os.path.relpath(launch.derive(chosen, 'threshold', changes), ws)
+            record['threshold_run_value'] = static['threshold']['run_value'] = lowered
         elif param is not None:
             static['threshold']['not_rewritable'] = 'its value comes from no literal the grader can change'
     else:
@@ -142,6 +152,7 @@ def main(argv=None):
     parser.add_argument('--out', required=True)
     parser.add_argument('--sheet', choices=sorted(SHEETS))
     parser.add_argument('--toplevel', help="catkin's toplevel.cmake, linked as WS/src/CMakeLists.txt")
+    parser.add_argument('--draw', type=float, help='in [0, 1): where the threshold run\'s value lies in its range')
     args = parser.parse_args(argv)
     if os.getuid() == 0:
         sys.stderr.write('inspect: refusing to read a student\'s upload as root\n')
@@ -149,7 +160,11 @@ def main(argv=None):
     os.makedirs(os.path.join(args.ws, 'src'), exist_ok=True)
     if args.toplevel:
         os.symlink(args.toplevel, os.path.join(args.ws, 'src', 'CMakeLists.txt'))
-    records.write(args.out, records.InspectRecord, inspect(args.upload, args.ws, args.out, args.sheet))
+    try:
+        records.write(args.out, records.InspectRecord, inspect(args.upload, args.ws, args.out, args.sheet, args.draw))
+    except records.RecordError as err:  # a sentence for the teacher, not a traceback
+        sys.stderr.write('inspect: its record exceeds a bound: %s\n' % err)
+        return 4
     return 0
 
 

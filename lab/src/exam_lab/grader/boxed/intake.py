@@ -5,7 +5,9 @@ The runner starts it in a box of its own, without network, bounded in time and m
     python3 -m exam_lab.grader.boxed.intake --class /box/upload/<class.zip> --out /box/out
 
 and reads back ``OUT/intake.json``, an :class:`~exam_lab.grader.score.records.IntakeRecord`: each
-student's name and the path of its submission relative to ``OUT``. (A class that is a folder is not
+student's name and the path of its submission relative to ``OUT``, and why its files were refused when
+they were (:func:`~exam_lab.grader.boxed.unpack.unpack_class`: that student's row says so, the others
+are graded). (A class that is a folder is not
 unpacked: root lists its entries by name, and stages each student's upload for that student's box.)
 """
 import argparse
@@ -24,14 +26,20 @@ def main(argv=None):
     if os.getuid() == 0:
         sys.stderr.write('intake: refusing to unpack a class archive as root\n')
         return 2
+    refused = {}
     try:
-        students = unpack.list_students(args.klass, args.out)
+        students = unpack.list_students(args.klass, args.out, refused)
     except unpack.UnpackError as err:
         sys.stderr.write('intake: the class archive cannot be opened safely: %s\n' % err)
         return 3
-    records.write(args.out, records.IntakeRecord, {
-        'uid': os.getuid(), 'students': [{'name': name, 'path': os.path.relpath(path, args.out)}
-                                         for name, path in students]})
+    try:
+        records.write(args.out, records.IntakeRecord, {
+            'uid': os.getuid(), 'students': [dict({'name': name, 'path': os.path.relpath(path, args.out)},
+                                                  **({'refused': refused[path][:records.MAX_TEXT]} if path in refused else {}))
+                                             for name, path in students]})
+    except records.RecordError as err:  # a sentence for the teacher, not a traceback
+        sys.stderr.write('intake: its record exceeds a bound: %s\n' % err)
+        return 4
     return 0
 
 

@@ -30,6 +30,7 @@ import collections
 import errno
 import os
 import re
+import shlex
 import xml.etree.ElementTree as ET
 
 import yaml
@@ -51,6 +52,10 @@ MAX_FILES = 50
 Node = collections.namedtuple('Node', 'pkg type name ns file type_origin')
 #: A parameter: full name, value, where its literal lives (:class:`Origin` or None), owning node.
 Param = collections.namedtuple('Param', 'name value origin node')
+#: A value a node gets on its command line (``args=``), read with ``rospy.myargv`` / argparse: ``name``
+#: is the option (``--threshold``) or the place (``argv[1]``), ``label`` the words that name it (the
+#: option, or the ``$(arg)`` its value comes from).
+NodeArg = collections.namedtuple('NodeArg', 'name value origin node label')
 
 
 class Unsupported(Exception):
@@ -61,7 +66,8 @@ class Origin(object):
     """Where a literal value lives, so that it can be changed in a derived file.
 
     ``kind`` is ``'attr'`` (``element.get(key)``), ``'yaml'`` (key path ``key`` in the inline YAML text
-    of ``element``) or ``'yaml_file'`` (key path ``key`` in the file named by ``element``'s ``file``).
+    of ``element``), ``'yaml_file'`` (key path ``key`` in the file named by ``element``'s ``file``) or
+    ``'args'`` (``key`` = (index, prefix): the index-th word of ``element``'s ``args``, after ``prefix``).
     """
 
     def __init__(self, path, element, kind, key, yaml_file=None):
@@ -75,6 +81,9 @@ class Origin(object):
         where = os.path.relpath(self.yaml_file or self.path, package_dir)
         if self.kind == 'attr':
             return '%s: <%s name="%s"> %s' % (where, self.element.tag, self.element.get('name'), self.key)
+        if self.kind == 'args':
+            return '%s: <%s name="%s"> args, word %d' % (where, self.element.tag, self.element.get('name'),
+                                                        self.key[0] + 1)
         return '%s: YAML key %s' % (where, '/'.join(self.key))
 
 
@@ -91,6 +100,8 @@ class Analysis(object):
         self.files_read = 0
         self.nodes = []
         self.params = []
+        #: What the nodes get on their command line (:class:`NodeArg`).
+        self.node_args = []
         #: Drone packages started through an ``<include>`` of their own launch files.
         self.included_drones = []
         self.problems = []
@@ -122,6 +133,10 @@ class Analysis(object):
     def exam_params(self):
         """Parameters the exam node can see: global ones and the exam nodes' private ones."""
         return [p for p in self.params if p.node is None or p.node.pkg == self.package]
+
+    def exam_args(self):
+        """What the exam nodes get on their command line (:class:`NodeArg`)."""
+        return [a for a in self.node_args if a.node.pkg == self.package]
 
     def comments(self):
         """XML comments in the launch file and the package's files it includes (question 12's half)."""
@@ -316,6 +331,7 @@ def _read_children(analysis, parent, scope, ns, node, depth):
             this = Node(scope.substitute(element.get('pkg'))[0], node_type, name, node_ns, scope.path,
                         type_origin or Origin(scope.path, element, 'attr', 'type'))
             analysis.nodes.append(this)
+            _read_node_args(analysis, element, scope, _join(node_ns, name), this)
             _read_children(analysis, element, scope, _join(node_ns, name), this, depth)
         elif tag == 'param':
             _read_param(analysis, element, scope, ns, node)
@@ -340,6 +356,76 @@ def _read_arg(element, scope):
         scope.args[name] = scope.passed[name]
     else:
         scope.args[name] = ('', None)  # declared without a value: an error only if used
+
+
+#: A substitution kept whole when a launch file's ``args`` is cut into words.
+_WHOLE_SUBST = re.compile(r'\$\([^)]*\)')
+
+
+def _words(text):
+    """``args`` cut into words as roslaunch does (``shlex.split``), each word as written: its
+    substitutions not yet evaluated (roslaunch evaluates them first; a ``$(arg)`` value is one word)."""
+    kept = []
+
+    def keep(match):
+        kept.append(match.group(0))
+        return '\x00%d\x00' % (len(kept) - 1)
+    words = shlex.split(_WHOLE_SUBST.sub(keep, text))
+    return [re.sub('\x00(\\d+)\x00', lambda m: kept[int(m.group(1))], w) for w in words]
+
+
+def _word_value(scope, element, index, prefix, written):
+    """The value of the part ``written`` of the index-th word and where its literal lives: the
+    ``$(arg)`` it is exactly, else the word itself."""
+    value, origin = scope.substitute(written)
+    return value, origin or Origin(scope.path, element, 'args', (index, prefix))
+
+
+def _read_node_args(analysis, element, scope, full_name, node):
+    """A node's ``args``: ``_name:=value`` words are private parameters (rospy's init_node sets
+    them, :func:`rospy.client.load_command_line_node_params`); the other words are what
+    ``rospy.myargv()`` returns after the script's path: ``--name value``, ``--name=value``, positional
+    values (``argv[1]``...)."""
+    text = element.get('args')
+    if not text:
+        return
+    try:
+        words = _words(text)
+    except ValueError as err:
+        analysis.problems.append('args of node %s not read: %s' % (full_name, err))
+        return
+    position, skip = 0, False
+    for index, word in enumerate(words):
+        if skip:
+            skip = False
+            position += 1
+            continue
+        remap = re.match(r'^(_[A-Za-z][\w/]*:=)(.*)$', word)
+        if remap:
+            value, origin = _word_value(scope, element, index, remap.group(1), remap.group(2))
+            analysis.params.append(Param(_join(full_name, remap.group(1)[1:-2]), _yaml_value(str(value)),
+                                         origin, node))
+            continue
+        if ':=' in word:
+            continue  # a remapping or a special key (__ns, __name): not in myargv
+        position += 1
+        option = re.match(r'^(--?[A-Za-z][\w-]*)(=(.*))?$', word)
+        if option and option.group(2):
+            value, origin = _word_value(scope, element, index, option.group(1) + '=', option.group(3))
+            analysis.node_args.append(NodeArg(option.group(1), _yaml_value(str(value)), origin, node, option.group(1)))
+        elif option:
+            following = words[index + 1] if index + 1 < len(words) else None
+            if following is not None and ':=' not in following and \
+                    (not following.startswith('-') or as_number(following) is not None):
+                value, origin = _word_value(scope, element, index + 1, '', following)
+                analysis.node_args.append(NodeArg(option.group(1), _yaml_value(str(value)), origin, node,
+                                                  option.group(1)))
+                skip = True
+        else:
+            value, origin = _word_value(scope, element, index, '', word)
+            whole = _SUBST.fullmatch(word.strip())
+            label = whole.group(2).strip() if whole and whole.group(1) == 'arg' else ''
+            analysis.node_args.append(NodeArg('argv[%d]' % position, _yaml_value(str(value)), origin, node, label))
 
 
 def _read_param(analysis, element, scope, ns, node):
@@ -416,6 +502,9 @@ def _read_include(analysis, element, scope, ns, depth):
         analysis.problems.append('include %s not found' % element.get('file'))
         return
     passed = {}
+    all_args = element.get('pass_all_args')
+    if all_args is not None and _truth(scope.substitute(all_args)[0]):
+        passed = dict(scope.args)  # roslaunch: every arg of the including file, overridden below
     for child in element:
         if child.tag == 'arg' and child.get('value') is not None:
             value, origin = scope.substitute(child.get('value'))
@@ -451,19 +540,24 @@ def choose(analyses, sheet):
 
 
 def threshold_param(analysis, sheet):
-    """The parameter of the exam node that is its threshold, however named, and why it was chosen.
+    """The value the exam node gets as its threshold, however named and handed over (a parameter, a
+    word of its ``args``), and why it was chosen.
 
-    :returns: ``(Param or None, reason)``. A name that says threshold (``threshold``, ``seuil``,
-        ``alt_max``...) wins over the sheet's default value (1300 / 150) under another name; a name
-        that says something else (rate, delay...) is never taken.
+    :returns: ``(Param or NodeArg or None, reason)``. A name that says threshold (``threshold``,
+        ``seuil``, ``alt_max``, ``--threshold``, ``args="$(arg threshold)"``...) wins over the sheet's
+        default value (1300 / 150) under another name; a name that says something else (rate,
+        delay...) is never taken; a parameter wins over an argument of the same standing.
     """
     default = SHEETS[sheet].threshold
     best, best_score = None, 0
-    for param in analysis.exam_params():
+    for param in list(analysis.exam_params()) + list(analysis.exam_args()):
         number = as_number(param.value)
         if number is None:
             continue
-        base = param.name.rsplit('/', 1)[-1].lower()
+        if isinstance(param, NodeArg):
+            base = param.label.lstrip('-').lower()
+        else:
+            base = param.name.rsplit('/', 1)[-1].lower()
         score = 0
         if 'thresh' in base or 'seuil' in base:
             score = 4
@@ -476,10 +570,12 @@ def threshold_param(analysis, sheet):
         if score > best_score:
             best, best_score = param, score
     if best is None:
-        names = ', '.join(p.name for p in analysis.exam_params()) or 'none'
-        return None, 'no parameter of the launch file looks like a threshold (parameters: %s)' % names
+        names = ', '.join([p.name for p in analysis.exam_params()] +
+                          ['args %s' % a.name for a in analysis.exam_args()]) or 'none'
+        return None, 'no parameter or argument of the launch file looks like a threshold (given: %s)' % names
     how = 'named like a threshold' if best_score >= 3 else 'the sheet\'s value %g' % default
-    return best, '%s = %s (%s)' % (best.name, best.value, how)
+    kind = 'argument %s of node %s' % (best.name, best.node.name) if isinstance(best, NodeArg) else best.name
+    return best, '%s = %s (%s)' % (kind, best.value, how)
 
 
 # --- deriving --------------------------------------------------------------------------------------
@@ -547,6 +643,12 @@ def _create(analysis, path):
 def _apply(origin, value, analysis, tag, yaml_files):
     if origin.kind == 'attr':
         origin.element.set(origin.key, str(value))
+        return
+    if origin.kind == 'args':
+        index, prefix = origin.key
+        words = _words(origin.element.get('args'))
+        words[index] = prefix + str(value)
+        origin.element.set('args', ' '.join(w if not re.search(r'[\s\'"]', w) else shlex.quote(w) for w in words))
         return
     if origin.kind == 'yaml':
         data = load_yaml(origin.element.text or '')

@@ -9,8 +9,11 @@ Python needs nothing new.
 
 What every student got is boilerplate: ``catkin_create_pkg``'s CMakeLists.txt and package.xml (made
 anew here, for both sheets), the launch file's skeleton, and the code of the sheets' packages (the
-drones, which students read and copy idioms from). Only a package's code is compared: Python, launch
-and YAML files, CMakeLists.txt and package.xml.
+drones, which students read and copy idioms from). Only a package's code is compared: Python, C++,
+launch files, CMakeLists.txt and package.xml; never its data (YAML, maps, logs, bags). What is read of
+one student is bounded (MAX_STUDENT_FILES, MAX_STUDENT_BYTES, its code first): a student who hands in
+megabytes of anything costs the check what a large package costs, and cannot switch it off for the
+others.
 
 A pair is flagged when the code of one of the two is at least :data:`THRESHOLD` alike the other's (the
 share of its fingerprinted tokens found in the other). It flags; it never changes a grade.
@@ -31,12 +34,17 @@ NOISE = 25
 WINDOW = 4
 #: Share of a submission's fingerprinted code found in the other's, from which a pair is flagged.
 THRESHOLD = 0.5
-#: Files compared, and the most bytes read of one.
-CODE_SUFFIXES = ('.py', '.launch', '.yaml', '.yml', '.xml')
+#: Files compared (code, not data), and the most bytes read of one.
+CODE_SUFFIXES = ('.py', '.cpp', '.cc', '.cxx', '.c', '.h', '.hpp', '.launch', '.xml')
 CODE_NAMES = ('CMakeLists.txt',)
 MAX_FILE_BYTES = 200 * 1024
+#: What is compared of one student at most (a package's code is a few files of a few kB), its
+#: programs first (:func:`student_code`).
+MAX_STUDENT_FILES = 50
+MAX_STUDENT_BYTES = 512 * 1024
 #: Languages by suffix, for files pygments does not know by name.
-LANGUAGES = {'.launch': 'xml', '.xml': 'xml', '.txt': 'cmake', '.yaml': 'yaml', '.yml': 'yaml', '.py': 'python'}
+LANGUAGES = {'.launch': 'xml', '.xml': 'xml', '.txt': 'cmake', '.py': 'python', '.cpp': 'cpp', '.cc': 'cpp',
+             '.cxx': 'cpp', '.c': 'cpp', '.h': 'cpp', '.hpp': 'cpp'}
 #: The launch file's skeletons students write from the sheets' question 12 (the drone's node or its
 #: launch file, the exam node, the threshold as a parameter or an argument, in the usual orders).
 LAUNCH_TEMPLATES = [
@@ -112,24 +120,50 @@ def code_files(package):
     return sorted(found)
 
 
+def student_code(package):
+    """``(files compared, files left out)`` of one student's package: its code files, programs
+    (Python, C++) before launch files and the build files, within MAX_STUDENT_FILES and
+    MAX_STUDENT_BYTES."""
+    order = {'.launch': 1, '.xml': 2, '.txt': 2}
+    found = sorted(code_files(package), key=lambda r: (order.get(os.path.splitext(r)[1], 0), r))
+    taken, left, size = [], [], 0
+    for relative in found:
+        nbytes = os.path.getsize(os.path.join(package, relative))
+        if len(taken) < MAX_STUDENT_FILES and size + nbytes <= MAX_STUDENT_BYTES:
+            taken.append(relative)
+            size += nbytes
+        else:
+            left.append(relative)
+    return sorted(taken), left
+
+
 def stage(submissions, target):
-    """Copy each submission's package code into ``target/<n>/``.
+    """Copy each submission's package code into ``target/<n>/`` (:func:`student_code`); what was
+    unpacked to find it is removed before the next student's.
 
     :param submissions: ``[(name, folder or zip)]``.
-    :returns: ``({name: staged folder}, [notes on submissions left out])``.
+    :returns: ``({name: staged folder}, [notes on submissions left out or cut])``.
     """
     staged, notes = {}, []
     for index, (name, path) in enumerate(submissions):
         notes_here = []
+        scratch = os.path.join(target, 'unpacked-%d' % index)
         try:
-            package = unpack.open_submission(path, os.path.join(target, 'unpacked-%d' % index), notes_here)
+            package = unpack.open_submission(path, scratch, notes_here)
+            taken, left = student_code(package)
+            folder = os.path.join(target, 'code', str(index))
+            for relative in taken:
+                os.makedirs(os.path.dirname(os.path.join(folder, relative)), exist_ok=True)
+                shutil.copyfile(os.path.join(package, relative), os.path.join(folder, relative))
         except Exception as err:  # a refused or odd upload is compared by nobody, and said so
             notes.append('%s: not compared (%s)' % (name, err))
             continue
-        folder = os.path.join(target, 'code', str(index))
-        for relative in code_files(package):
-            os.makedirs(os.path.dirname(os.path.join(folder, relative)), exist_ok=True)
-            shutil.copyfile(os.path.join(package, relative), os.path.join(folder, relative))
+        finally:
+            shutil.rmtree(scratch, ignore_errors=True)
+        if left:
+            notes.append('%s: %d code file(s) compared, %d left out (at most %d files and %d bytes of a student): %s'
+                         % (name, len(taken), len(left), MAX_STUDENT_FILES, MAX_STUDENT_BYTES,
+                            unpack.listed([unpack.shown_name(r) for r in left])))
         if os.path.isdir(folder):
             staged[name] = folder
         else:

@@ -1,6 +1,14 @@
 """What the grader reads in a student's sources (never runs): the node's scripts, comments, params,
 dependencies; and the fixes a teacher would make before running it. No rospy here.
+
+Code is read as code (issue 36): every check on what the code does (a node, the parameters and
+arguments it reads, a service client and its calls, publishing, timers, the topics it names) walks
+Python's syntax tree (:mod:`ast`), so a comment or a string that mentions ``get_param('threshold')`` or
+``ServiceProxy`` counts for nothing. A file that does not parse as Python 3 (Python 2, a typo) is
+read as text instead, and :func:`unparsed` names it with the line Python stopped at, so the teacher
+knows which facts came from text.
 """
+import ast
 import io
 import os
 import re
@@ -11,9 +19,14 @@ import xml.etree.ElementTree as ET
 
 from exam_lab.grader.score.sheets import SHEETS
 
+#: The text fallback for a file that does not parse (comments dropped first where tokenize can).
 _INIT_NODE = re.compile(r'\binit_node\s*\(')
 _GET_PARAM = re.compile(r'get_param\s*\(\s*[\'"]([^\'"]+)[\'"]')
 _SERVICE_CLIENT = re.compile(r'\b(ServiceProxy|wait_for_service)\b')
+#: rospy's calls that read a parameter by name (its first argument).
+PARAM_READERS = ('get_param', 'get_param_cached', 'search_param', 'has_param')
+#: Calls that make a service client.
+SERVICE_CLIENTS = ('ServiceProxy', 'wait_for_service')
 #: Files whose line endings and BOM a teacher fixes: sources, scripts, launch and build files.
 TEXT_ENDINGS = ('.py', '.launch', '.xml', '.yaml', '.yml', '.txt', '.cfg', '.sh', '.srv', '.msg')
 _BOM = b'\xef\xbb\xbf'
@@ -53,9 +66,101 @@ def _read(path):
         return f.read().decode('utf-8', 'replace')
 
 
+class Parsed(object):
+    """One Python file of the package: its syntax ``tree``, or None with ``error`` (why it does not
+    parse: ``"SyntaxError at line 19"``) and ``code`` (its text without comments, for the fallback)."""
+
+    def __init__(self, path, package_dir):
+        self.path = path
+        self.rel = os.path.relpath(path, package_dir)
+        self.text = _read(path)
+        self.tree, self.error = None, None
+        try:
+            self.tree = ast.parse(self.text, self.rel)
+        except SyntaxError as err:
+            self.error = '%s at line %s' % (type(err).__name__, err.lineno)
+        except (ValueError, RecursionError, MemoryError, OverflowError) as err:  # null bytes, absurd nesting
+            self.error = type(err).__name__
+        self.code = self.text if self.tree is not None else _without_comments(self.text)
+
+    def where(self, node):
+        return '%s:%d' % (self.rel, node.lineno)
+
+    def calls(self, *names):
+        """Every call whose function is named one of ``names`` (``f(...)``, ``x.f(...)``)."""
+        if self.tree is None:
+            return []
+        return [n for n in ast.walk(self.tree) if isinstance(n, ast.Call) and call_name(n) in names]
+
+    def strings(self):
+        """Every string constant of the code but docstrings."""
+        if self.tree is None:
+            return []
+        docstrings = set()
+        for node in ast.walk(self.tree):
+            body = getattr(node, 'body', None)
+            if isinstance(body, list) and body and isinstance(body[0], ast.Expr) \
+                    and isinstance(body[0].value, ast.Constant) and isinstance(body[0].value.value, str):
+                docstrings.add(id(body[0].value))
+        return [n.value for n in ast.walk(self.tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)
+                and id(n) not in docstrings]
+
+
+def _without_comments(text):
+    """``text`` without its comments, where tokenize can read it; as it is otherwise."""
+    try:
+        tokens = [t for t in tokenize.generate_tokens(io.StringIO(text).readline) if t.type != tokenize.COMMENT]
+        return tokenize.untokenize(tokens)
+    except (tokenize.TokenError, IndentationError, SyntaxError, ValueError):
+        return text
+
+
+def call_name(call):
+    """The name a call's function goes by: ``f`` for ``f(...)`` and ``a.b.f(...)``; '' otherwise."""
+    func = call.func
+    if isinstance(func, ast.Name):
+        return func.id
+    if isinstance(func, ast.Attribute):
+        return func.attr
+    return ''
+
+
+def dotted(node):
+    """``a.b.c`` for a name or an attribute chain, else None."""
+    if isinstance(node, ast.Name):
+        return node.id
+    if isinstance(node, ast.Attribute):
+        inner = dotted(node.value)
+        return None if inner is None else '%s.%s' % (inner, node.attr)
+    return None
+
+
+def _first_string(call, keyword=None):
+    args = list(call.args[:1]) + [k.value for k in call.keywords if keyword and k.arg == keyword]
+    for arg in args:
+        if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+            return arg.value
+    return None
+
+
+def parsed(package_dir):
+    """Every Python file of the package, parsed (:class:`Parsed`)."""
+    return [Parsed(p, package_dir) for p in python_files(package_dir)]
+
+
+def unparsed(package_dir):
+    """One note per Python file that does not parse: its facts were read from its text."""
+    return ['%s does not parse as Python 3 (%s): what it does was read from its text, comments dropped'
+            % (f.rel, f.error) for f in parsed(package_dir) if f.tree is None]
+
+
+def _starts_node(f):
+    return bool(f.calls('init_node')) if f.tree is not None else bool(_INIT_NODE.search(f.code))
+
+
 def node_scripts(package_dir):
     """Scripts that start a ROS node (call ``init_node``), the likely exam node first."""
-    scripts = [p for p in python_files(package_dir) if _INIT_NODE.search(_read(p))]
+    scripts = [f.path for f in parsed(package_dir) if _starts_node(f)]
     return sorted(scripts, key=lambda p: ('exam' not in os.path.basename(p), len(p), p))
 
 
@@ -69,18 +174,134 @@ def dependencies(package_dir):
 
 
 def sheets_in_code(package_dir):
-    """Sheets whose input topic names appear in the package's Python sources."""
-    text = '\n'.join(_read(p) for p in python_files(package_dir))
+    """Sheets whose input topic names are strings of the package's Python code."""
+    strings = []
+    for f in parsed(package_dir):
+        strings.extend(f.strings() if f.tree is not None else re.findall(r'[\'"]([^\'"\n]*)[\'"]', f.code))
     return [name for name, sheet in SHEETS.items()
-            if all(re.search(r'[\'"/]%s[\'"]' % topic, text) for topic in sheet.inputs)]
+            if all(any(s.strip('/').split('/')[-1] == topic for s in strings) for topic in sheet.inputs)]
 
 
 def param_names(package_dir):
-    """Parameter names the Python sources read with ``get_param('...')``."""
+    """Parameter names the code reads (``get_param('~x')``, ``search_param``, ``has_param``...)."""
     names = set()
-    for path in python_files(package_dir):
-        names.update(_GET_PARAM.findall(_read(path)))
+    for f in parsed(package_dir):
+        if f.tree is None:
+            names.update(_GET_PARAM.findall(f.code))
+            continue
+        for call in f.calls(*PARAM_READERS):
+            name = _first_string(call, 'param_name')
+            if name:
+                names.add(name)
     return sorted(names)
+
+
+def _scope_calls(scope):
+    """The calls of one scope (a module or a function), not those of the functions and classes it defines."""
+    todo = list(ast.iter_child_nodes(scope))
+    while todo:
+        node = todo.pop()
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef, ast.Lambda)):
+            continue
+        if isinstance(node, ast.Call):
+            yield node
+        todo.extend(ast.iter_child_nodes(node))
+
+
+def private_before_init(package_dir):
+    """Private parameters (``~name``) the code reads before it starts its node, ``"file:line: ~name"``:
+    in the function that calls ``init_node``, above that call, or in the module's own body (run on
+    import, before ``main()``). Until ``init_node`` rospy's caller id is ``<ns>/unnamed``
+    (``rospy/names.py``), so such a read never sees the node's parameter; relative and global names
+    resolve alike before and after."""
+    found = []
+    for f in parsed(package_dir):
+        if f.tree is None or not f.calls('init_node'):
+            continue
+        scopes = [f.tree] + [n for n in ast.walk(f.tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))]
+        for scope in scopes:
+            calls = list(_scope_calls(scope))
+            inits = [c.lineno for c in calls if call_name(c) == 'init_node']
+            if not inits and scope is not f.tree:
+                continue
+            first = min(inits) if inits else float('inf')  # the module's body runs before any function's init
+            for call in calls:
+                name = _first_string(call, 'param_name') if call_name(call) in PARAM_READERS else None
+                if name and name.startswith('~') and call.lineno < first:
+                    found.append('%s: %s' % (f.where(call), name))
+    return sorted(set(found), key=lambda w: (w.split(':')[0], int(w.split(':')[1])))
+
+
+def _argv_sources(tree):
+    """Names bound to the node's arguments (``argv = rospy.myargv()``, ``args = sys.argv``)."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Assign) and _is_argv(node.value, ()):
+            names.update(dotted(t) for t in node.targets if dotted(t))
+    return names
+
+
+def _is_argv(node, names):
+    if isinstance(node, ast.Call) and call_name(node) == 'myargv':
+        return True
+    return dotted(node) in ('sys.argv',) + tuple(names)
+
+
+def args_read(package_dir):
+    """What the code reads of its command line (a launch file's ``args=``): argparse's options and
+    positional names (``--threshold``, ``threshold``), and ``argv[N]`` for an index into
+    ``rospy.myargv()`` or ``sys.argv`` (or a name bound to either)."""
+    found = set()
+    for f in parsed(package_dir):
+        if f.tree is None:
+            continue
+        for call in f.calls('add_argument'):
+            for arg in call.args:
+                if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+                    found.add(arg.value)
+        names = _argv_sources(f.tree)
+        for node in ast.walk(f.tree):
+            if isinstance(node, ast.Subscript) and _is_argv(node.value, names):
+                index = getattr(node.slice, 'value', None) if type(node.slice).__name__ == 'Index' else node.slice
+                if isinstance(index, ast.Constant) and isinstance(index.value, int):
+                    found.add('argv[%d]' % index.value)
+    return sorted(found)
+
+
+def calls_a_service(package_dir):
+    """True when the code makes a service client (``ServiceProxy``, ``wait_for_service``)."""
+    return any(f.calls(*SERVICE_CLIENTS) if f.tree is not None else _SERVICE_CLIENT.search(f.code)
+               for f in parsed(package_dir))
+
+
+def code_evidence(package_dir):
+    """Where the code does what the rules need, as ``file:line`` (for a rule the run could not see):
+    ``service_calls`` (a call of a ``ServiceProxy`` it made, or of one made on the spot),
+    ``publishes`` (``.publish(...)``), ``timers`` (``rospy.Timer``, ``rospy.Rate``). Read from the
+    syntax tree only: a file that does not parse gives none (:func:`unparsed` says so)."""
+    out = {'service_calls': [], 'publishes': [], 'timers': []}
+    for f in parsed(package_dir):
+        if f.tree is None:
+            continue
+        proxies = set()
+        for node in ast.walk(f.tree):
+            if isinstance(node, ast.Assign) and isinstance(node.value, ast.Call) \
+                    and call_name(node.value) == 'ServiceProxy':
+                proxies.update(dotted(t) for t in node.targets if dotted(t))
+        for node in ast.walk(f.tree):
+            if not isinstance(node, ast.Call):
+                continue
+            func = node.func
+            target = dotted(func.value) if isinstance(func, ast.Attribute) and func.attr == 'call' else dotted(func)
+            if target in proxies or (isinstance(func, ast.Call) and call_name(func) == 'ServiceProxy'):
+                out['service_calls'].append(f.where(node))
+            elif call_name(node) == 'publish':
+                out['publishes'].append(f.where(node))
+            elif call_name(node) in ('Timer', 'Rate'):
+                out['timers'].append(f.where(node))
+    for key in out:
+        out[key] = sorted(set(out[key]), key=lambda w: (w.rsplit(':', 1)[0], int(w.rsplit(':', 1)[1])))
+    return out
 
 
 def comment_ratio(paths):
@@ -179,11 +400,6 @@ def python2_evidence(package_dir):
             _, number, words = min(hits)  # the line Python 3 stopped at, if it is one of them
             found.append('%s:%d: %s' % (rel, number, words))
     return found
-
-
-def calls_a_service(package_dir):
-    """True when the Python sources make a service client (``ServiceProxy``, ``wait_for_service``)."""
-    return any(_SERVICE_CLIENT.search(_read(p)) for p in python_files(package_dir))
 
 
 def make_runnable(package_dir, launched=()):

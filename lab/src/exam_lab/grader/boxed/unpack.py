@@ -18,6 +18,7 @@ import stat
 import tarfile
 import xml.etree.ElementTree as ET
 import zipfile
+import zlib
 
 from exam_lab.grader.score.sheets import PACKAGE, drone_packages
 
@@ -25,14 +26,20 @@ from exam_lab.grader.score.sheets import PACKAGE, drone_packages
 MAX_FILES = 5000
 #: Most bytes one submission may unpack, all its archives together.
 MAX_BYTES = 200 * 1024 * 1024
-#: A class archive ("download all submissions") holds every student's uploads.
+#: A class archive ("download all submissions") holds every student's uploads: its bounds as a whole
+#: (entries, bytes of the students it unpacks); each student's files are paid from MAX_FILES / MAX_BYTES.
 CLASS_FILES = 100000
 CLASS_BYTES = 4 * 1024 * 1024 * 1024
-#: Highest ratio of unpacked to packed size of one zip entry (text compresses ~5x; bombs 1000x).
+#: Highest ratio of unpacked to packed size of one zip entry (text compresses ~5x; bombs 1000x), judged
+#: only for an entry larger than RATIO_FROM_BYTES: below it the budget bounds what an entry costs, and
+#: a log or a one-colour screenshot of a few MB compresses 1000x without being a bomb.
 MAX_RATIO = 200
+RATIO_FROM_BYTES = 16 * 1024 * 1024
 #: Linux limits on a name: bytes of one path component, bytes of a whole path.
 NAME_MAX = 255
 PATH_MAX = 4096
+#: Most folders one entry's path may hold (a package is a few deep; a workspace's a few more).
+MAX_PARTS = 64
 #: How many archives deep a package may sit (a zip holding the package's zip, holding ...).
 MAX_NESTING = 2
 #: Folders of a catkin workspace that the student's build made: never unpacked, never copied.
@@ -56,6 +63,8 @@ _UNSUPPORTED = ((b'Rar!\x1a\x07', 'a RAR archive'), (b'7z\xbc\xaf\x27\x1c', 'a 7
 _VERSION = re.compile(r'(?:^|[^0-9])(?:[vV]|[_ -]|\()(\d{1,3})\)?$')
 #: Zip's "no date" (MS-DOS time starts in 1980): a date on or before it says nothing.
 _NO_DATE = datetime.datetime(1980, 1, 2)
+#: A byte that is not UTF-8 as repr() shows its surrogate escape (``\\udcff``).
+_ESCAPED_BYTE = re.compile(r'(?<!\\)((?:\\\\)*)\\udc([89a-f][0-9a-f])')  # not after an escaped backslash
 #: At most this many notes of one kind (links dropped, duplicates) are listed; the rest are counted.
 MAX_LISTED = 5
 
@@ -87,8 +96,9 @@ class Budget(object):
 
 
 def shown_name(name, limit=80):
-    """An archive entry's name as it may be printed: escaped (a newline cannot inject a line), cut."""
-    text = repr(name)
+    """An archive entry's name as it may be printed: escaped (a newline cannot inject a line; a byte
+    that is not UTF-8, kept by surrogateescape, reads ``\\xNN`` as everywhere else), cut."""
+    text = _ESCAPED_BYTE.sub(r'\1\\x\2', repr(name))
     return text if len(text) <= limit else text[:limit - 5] + '...' + text[-2:]
 
 
@@ -102,6 +112,8 @@ def _entry_path(name):
     parts = [p for p in path.split('/') if p not in ('', '.')]
     if '..' in parts:
         raise UnpackError('entry %s climbs out of the folder (..)' % shown_name(name))
+    if len(parts) > MAX_PARTS:
+        raise UnpackError('entry %s is %d folders deep (at most %d)' % (shown_name(name), len(parts), MAX_PARTS))
     if len(path.encode('utf-8', 'surrogateescape')) > PATH_MAX:
         raise UnpackError('entry %s has a path of more than %d bytes' % (shown_name(name), PATH_MAX))
     for part in parts:
@@ -157,16 +169,16 @@ class _Plan(object):
                 '%s (%d entries)' % (k, n) for k, n in sorted(self.products.items()))))
         if self.special:
             out.append('%s: %d special file(s) (FIFO, device) dropped: %s' % (
-                self.label, len(self.special), _listed([shown_name(n) for n in self.special])))
+                self.label, len(self.special), listed([shown_name(n) for n in self.special])))
         duplicates = sorted('/'.join(k) for k, n in self.seen.items() if n > 1)
         if duplicates:
             out.append('%s: %d entr(ies) appear more than once, the last one kept: %s' % (
-                self.label, len(duplicates), _listed([shown_name(n) for n in duplicates])))
+                self.label, len(duplicates), listed([shown_name(n) for n in duplicates])))
         clashes = sorted(' / '.join(sorted('/'.join(k) for k in keys)) for keys in self.folded.values()
                          if len(keys) > 1)
         if clashes:
             out.append('%s: names that differ only by case (one file on Windows or macOS): %s' % (
-                self.label, _listed(clashes)))
+                self.label, listed(clashes)))
         return out
 
     def link_notes(self):
@@ -178,12 +190,13 @@ class _Plan(object):
             out.append('%s: catkin\'s link %s dropped (links are never followed; the grader makes its '
                        'own workspace)' % (self.label, ', '.join(shown_name(n) for n in catkin)))
         if other:
-            out.append('%s: %d link(s) dropped, never followed: %s' % (self.label, len(other), _listed(
+            out.append('%s: %d link(s) dropped, never followed: %s' % (self.label, len(other), listed(
                 ['%s -> %s' % (shown_name(n), shown_name(t, 60)) for n, t in other])))
         return out
 
 
-def _listed(names):
+def listed(names):
+    """The first MAX_LISTED of ``names``, and how many more."""
     shown = ', '.join(names[:MAX_LISTED])
     return shown + (' and %d more' % (len(names) - MAX_LISTED) if len(names) > MAX_LISTED else '')
 
@@ -255,7 +268,7 @@ def _extract_zip(archive, target, label, budget, max_ratio, notes, fixes):
             else:
                 plan.add(info, info.filename, 'file', info.file_size)
         for info, _, size in plan.files:
-            if size > max_ratio * max(info.compress_size, 1024):
+            if size > RATIO_FROM_BYTES and size > max_ratio * max(info.compress_size, 1024):
                 raise UnpackError('entry %s unpacks %d bytes from %d: a zip bomb?'
                                   % (shown_name(info.filename), size, info.compress_size))
         budget.take(len(plan.files), sum(size for _, _, size in plan.files), label)
@@ -482,9 +495,9 @@ def open_submission(path, scratch, notes, fixes=None, budget=None, uploads=None)
     if not found:
         refused = [s for s in seen if '(refused: ' in s or 'cannot be opened' in s]
         if refused:  # the reason is the archive that could not be opened, not a missing package
-            raise UnpackError(_listed(refused))
+            raise UnpackError(listed(refused))
         raise UnpackError('no catkin package (package.xml) in %s%s' % (
-            os.path.basename(path), '; found: %s' % _listed(seen) if seen else ' (it is empty)'))
+            os.path.basename(path), '; found: %s' % listed(seen) if seen else ' (it is empty)'))
     chosen = found[0]
     name = package_name(os.path.join(chosen, 'package.xml'))
     if name != PACKAGE:
@@ -589,23 +602,19 @@ def copy_package(source, target, notes):
     shutil.copytree(source, target, ignore=ignore)
 
 
-def list_students(class_path, scratch):
+def list_students(class_path, scratch, refused=None):
     """``[(student, folder or archive)]`` of a class: one sub-folder per student, as "download all"
     gives.
 
-    ``class_path`` may be an archive of that (unpacked safely below ``scratch``, with a class's budget).
-    A class whose top holds archives instead of folders counts each archive as one student (named
-    after it).
+    ``class_path`` may be an archive of that, unpacked below ``scratch`` by :func:`unpack_class`: the
+    class's bounds as a whole, each student's files by the student's own; a student whose files are
+    refused is listed all the same (an empty folder or file in its place) and ``refused`` (a dict)
+    receives ``{its path: why}``. A class whose top holds archives instead of folders counts each
+    archive as one student (named after it).
     """
     class_path = os.path.abspath(class_path)
     if os.path.isfile(class_path):
-        target = os.path.join(scratch, 'class')
-        safe_extract(class_path, target, budget=Budget(CLASS_BYTES, CLASS_FILES))
-        class_path = target
-        entries = [e for e in os.listdir(class_path) if not e.startswith('.')]
-        if len(entries) == 1 and os.path.isdir(os.path.join(class_path, entries[0])) \
-                and not find_packages(os.path.join(class_path, entries[0]), name=None, max_depth=1):
-            class_path = os.path.join(class_path, entries[0])  # the archive holds the class folder
+        class_path = unpack_class(class_path, os.path.join(scratch, 'class'), {} if refused is None else refused)
     students = []
     for entry in sorted(os.listdir(class_path)):
         full = os.path.join(class_path, entry)
@@ -614,21 +623,176 @@ def list_students(class_path, scratch):
         if os.path.isdir(full):
             students.append((student_name(entry), full))
         elif entry.lower().endswith(ARCHIVE_ENDINGS):
-            stem = entry
-            for ending in sorted(ARCHIVE_ENDINGS, key=len, reverse=True):
-                if stem.lower().endswith(ending):
-                    stem = stem[:-len(ending)]
-                    break
-            students.append((student_name(stem), full))
+            students.append((student_name(_without_ending(entry)), full))
     return students
+
+
+def _without_ending(name):
+    for ending in sorted(ARCHIVE_ENDINGS, key=len, reverse=True):
+        if name.lower().endswith(ending):
+            return name[:-len(ending)]
+    return name
+
+
+def _class_entries(archive, label):
+    """``[(member, name, kind, size, link target)]`` of a class archive, read as far as the class's
+    bounds allow (a compressed tar is decompressed while it is listed); raises UnpackError past them."""
+    entries = []
+    kind = archive_kind(archive)
+    if kind == 'zip':
+        try:
+            with zipfile.ZipFile(archive) as zf:
+                infos = zf.infolist()
+                if len(infos) > CLASS_FILES:
+                    raise UnpackError('%s holds %d entries (at most %d for a class)' % (label, len(infos), CLASS_FILES))
+                for info in infos:
+                    mode = info.external_attr >> 16 if info.create_system == 3 else 0
+                    if stat.S_ISLNK(mode):
+                        entries.append((info, info.filename, 'link', 0, '?'))
+                    elif info.is_dir() or info.filename.endswith('\\'):
+                        entries.append((info, info.filename, 'dir', 0, ''))
+                    else:
+                        entries.append((info, info.filename, 'file', info.file_size, ''))
+        except (zipfile.BadZipFile, OSError) as err:
+            raise UnpackError('%s is not a readable zip: %s' % (label, err))
+        return entries
+    if kind == 'tar':
+        read = 0
+        try:
+            with tarfile.open(archive, 'r:*') as tf:
+                for member in tf:
+                    read += member.size
+                    if len(entries) >= CLASS_FILES or read > CLASS_BYTES:
+                        raise UnpackError('%s holds more than %d entries or %d bytes (the bounds of a class)'
+                                          % (label, CLASS_FILES, CLASS_BYTES))
+                    what = 'link' if member.issym() or member.islnk() else 'dir' if member.isdir() else \
+                        'file' if member.isfile() else 'special'
+                    entries.append((member, member.name, what, member.size if what == 'file' else 0,
+                                    member.linkname))
+        except (tarfile.TarError, OSError, EOFError) as err:
+            raise UnpackError('%s is not a readable tar archive: %s' % (label, err))
+        return entries
+    words = what_it_is(archive)
+    raise UnpackError('%s is %s: the grader opens zip and tar archives (%s); ask for a zip'
+                      % (label, words or 'not a readable zip or tar archive', ', '.join(ARCHIVE_ENDINGS)))
+
+
+def _raw_parts(name):
+    """The parts of an entry's name as written (before any check), and whether it is rooted."""
+    path = name.replace('\\', '/')
+    rooted = path.startswith('/') or (len(path) > 1 and path[1] == ':')
+    return [p for p in path.split('/') if p not in ('', '.')], rooted
+
+
+def unpack_class(archive, target, refused):
+    """Unpack a class archive into ``target``; return the folder that holds one entry per student.
+
+    The class is bounded as a whole: CLASS_FILES entries, CLASS_BYTES unpacked, and an entry that
+    cannot be said to belong to one student (``../``, an absolute path at the top) refuses it. Each
+    student's files (everything below its top folder, or its archive at the top) are checked and paid
+    by the student's own bounds (:class:`Budget`, :func:`_entry_path`): one that fails them is not
+    unpacked, and ``refused`` receives ``{the student's path: why}`` (an empty folder, or an empty file
+    for an archive, holds its place). No ratio of Moodle's compression is judged: a student's
+    one-colour screenshot or log is no bomb, and the student's bytes are bounded by its budget."""
+    label = os.path.basename(archive)
+    groups = {}
+    for entry in _class_entries(archive, label):
+        parts, rooted = _raw_parts(entry[1])
+        if rooted or (parts and parts[0] == '..'):
+            raise UnpackError('entry %s of the class archive lies outside it' % shown_name(entry[1]))
+        if not parts or parts[0] == '__MACOSX':
+            continue
+        groups.setdefault(parts[0], []).append((entry, parts))
+    base = ''
+    if len(groups) == 1:  # the archive holds the class folder (unless that folder is one package)
+        (top, members), = groups.items()
+        if all(len(parts) > 1 for _, parts in members) and \
+                not any(parts[1:] == ['package.xml'] or parts[2:] == ['package.xml'] for _, parts in members):
+            base = top
+            groups = {}
+            for entry, parts in members:
+                if len(parts) > 1:
+                    groups.setdefault(parts[1], []).append((entry, parts[1:]))
+    os.makedirs(target, exist_ok=True)
+    top = os.path.join(target, base) if base else target
+    plans, total = [], 0
+    for key, members in sorted(groups.items()):
+        place = os.path.join(top, key)
+        try:
+            plan = _Plan(key)
+            for (member, name, kind, size, link), parts in members:
+                if len(parts) == 1 and kind != 'dir':
+                    plan.add(member, parts[0], kind, size, link)
+                else:
+                    plan.add(member, '/'.join(parts[1:]), kind, size, link)
+            single = [p for _, p in members if len(p) == 1]
+            if single and any(len(p) > 1 for _, p in members):
+                raise UnpackError('%s is both a file and a folder' % shown_name(key))
+            Budget(MAX_BYTES, MAX_FILES).take(len(plan.files), sum(size for _, _, size in plan.files),
+                                              'the files of %s' % shown_name(key))
+        except UnpackError as err:
+            refused[place] = str(err)
+            plans.append((key, place, None, members))
+            continue
+        total += sum(size for _, _, size in plan.files)
+        plans.append((key, place, plan, members))
+    if total > CLASS_BYTES:
+        raise UnpackError('the students\' files in %s come to %d bytes (at most %d for a class)'
+                          % (label, total, CLASS_BYTES))
+    kind = archive_kind(archive)
+    with (zipfile.ZipFile(archive) if kind == 'zip' else tarfile.open(archive, 'r:*')) as opened:
+        for key, place, plan, members in plans:
+            archive_at_top = all(len(p) == 1 for _, p in members) and members[0][0][2] != 'dir'
+            if plan is not None:
+                try:
+                    _write_student(opened, kind, place, plan, archive_at_top)
+                    continue
+                except UnpackError as err:
+                    refused[place] = str(err)
+                    shutil.rmtree(place, ignore_errors=True)
+                    if os.path.isfile(place):
+                        os.unlink(place)
+            try:
+                if archive_at_top:
+                    open(place, 'wb').close()
+                else:
+                    os.makedirs(place, exist_ok=True)
+            except OSError as err:
+                raise UnpackError('%s of the class archive cannot be written: %s' % (shown_name(key), err.strerror))
+    return top
+
+
+def _write_student(opened, kind, place, plan, archive_at_top):
+    """Write one student's planned files below ``place`` (its archive at ``place`` itself)."""
+    try:
+        if not archive_at_top:
+            _make_dirs(place, plan)
+        for member, parts, size in plan.files:
+            dest = place if archive_at_top else _dest(place, parts)
+            src = opened.open(member) if kind == 'zip' else opened.extractfile(member)
+            with src:
+                _copy_capped(src, dest, size, '/'.join(parts))
+    except (zipfile.BadZipFile, tarfile.TarError, zlib.error, EOFError, OSError, RuntimeError,
+            NotImplementedError) as err:  # encrypted, corrupt, or compressed as zipfile cannot read
+        raise UnpackError('%s cannot be unpacked: %s' % (shown_name(plan.label), err))
+
+
+#: Endings of the files a class's run writes in OUT beside the students' folders (grades.csv, index.html,
+#: hand.csv, similarity.json, the filled worksheet...): a student's folder never has one.
+OUTPUT_ENDINGS = ('.csv', '.html', '.json', '.jsonl', '.md', '.png', '.txt', '.log', '.zip')
 
 
 def student_name(folder):
     """A name usable as a folder and a CSV cell: Moodle's ``Jane Doe_1234_assignsubmission_file_``
-    becomes ``Jane Doe``; anything but letters, digits, space, ``-._`` becomes ``_``."""
+    becomes ``Jane Doe``; anything but letters, digits, space, ``-._`` becomes ``_``. A name that ends
+    like one of the class's outputs (OUTPUT_ENDINGS: ``grades.csv``, ``index.html``) has its last dot
+    made ``_`` (``grades_csv``): a student's folder and the class's files can never be one path."""
     name = folder.split('_assignsubmission')[0]
     parts = name.rsplit('_', 1)
     if len(parts) == 2 and parts[1].isdigit():
         name = parts[0]
     cleaned = ''.join(c if c.isalnum() or c in ' -._' else '_' for c in name).strip(' .')
+    if cleaned.lower().endswith(OUTPUT_ENDINGS):
+        stem, ending = cleaned.rsplit('.', 1)
+        cleaned = '%s_%s' % (stem, ending)
     return cleaned or 'student'

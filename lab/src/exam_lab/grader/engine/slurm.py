@@ -176,7 +176,8 @@ def run_task(manifest, index, out_dir, sheet=None, unsandboxed=False):
     # scancel and the time limit send SIGTERM: exit through the finally blocks, which end the
     # session's processes and remove the work folder.
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
-    record = runner.grade_student(entry['student'], entry['submission'], out_dir, sheet, unsandboxed=unsandboxed)
+    record = runner.grade_student(entry['student'], entry['submission'], out_dir, sheet, unsandboxed=unsandboxed,
+                                  refused=entry.get('refused'))
     _write_json(os.path.join(os.path.dirname(manifest), 'results', '%d.json' % index), record)
     return record
 
@@ -331,14 +332,16 @@ def grade_class(class_path, out_dir, sheet=None, progress=None, unsandboxed=Fals
     for folder in ('results', 'logs'):
         os.makedirs(os.path.join(base, folder))
     say = progress.say if progress else (lambda line: None)
-    students = runner.class_students(class_path, os.path.join(base, 'class'), out=out_dir)
+    refused = {}  # students whose files the intake refused by their own bounds: their rows say why
+    students = runner.class_students(class_path, [], os.path.join(base, 'class'), refused, out=out_dir)
     records = []
     if students:
         runner.ensure_underlay(runner.default_underlay())  # here, once, rather than by the first tasks at once
         manifest = os.path.join(base, 'manifest.jsonl')
         with open(manifest, 'w') as f:
             for name, folder in students:
-                f.write(json.dumps({'student': name, 'submission': os.path.abspath(folder)}) + '\n')
+                f.write(json.dumps(dict({'student': name, 'submission': os.path.abspath(folder)},
+                                        **({'refused': refused[folder]} if folder in refused else {}))) + '\n')
         script = os.path.join(base, 'task.sh')
         write_task_script(script, manifest, out_dir, sheet, unsandboxed)
         if progress:

@@ -1,6 +1,6 @@
 """The grader's probe: plays the drone for a student's node and measures what the rubric asks.
 
-Run inside its own rospy process, on the master of one submission, by :mod:`exam_lab.grader.judge.session`::
+Run inside its own rospy process, on the master of one submission, by :mod:`exam_lab.grader.host.session`::
 
     python3 -m exam_lab.grader.judge.probe PLAN.json RESULT.json
 
@@ -8,11 +8,11 @@ The drone is the harness's :class:`~exam_lab.harness.fake_drone.Drone`, driven b
 noise-free values from the oracle, so the same package gets the same measurements. The probe only
 measures; the points are given by :mod:`exam_lab.grader.score.rubric` from the JSON it writes.
 
-Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of question 14a), ``sheet``,
-``threshold`` (student units), ``margin`` (how far beyond the threshold to fly), ``delay`` (s), ``start_timeout``
-(s to wait for the node), ``late_warning`` (s a late WARNING is waited for, 0 for none); for
-"threshold" also ``fit`` (the main run's calibration), ``targets`` and ``warn_after`` (s the main
-run's WARNING took).
+Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of question 14a, the same
+scenario around the threshold drawn for it), ``sheet``, ``threshold`` (student units), ``margin`` (how
+far beyond the threshold to fly), ``delay`` (s), ``start_timeout`` (s to wait for the node),
+``late_warning`` (s a late WARNING is waited for, 0 for none); for "threshold" also ``warn_after``
+(s the main run's WARNING took).
 
 Every time is the wall clock's (``time.time()``), never rospy's ROS time: a student's node can set
 ``/use_sim_time`` on the master before the probe's ``init_node`` and publish ``/clock``, and rospy would
@@ -41,6 +41,7 @@ import re
 import sys
 import threading
 import time
+import xmlrpc.client
 
 import rosgraph
 import rospy
@@ -188,6 +189,145 @@ class Graph(object):
         return sorted(n for n in names if n in self.student_nodes())
 
 
+class NodeWatch(object):
+    """The student's nodes as the judge sees them during a run, whatever roslaunch prints: every
+    PERIOD_S, the master's list of nodes (``getSystemState``), each node's XML-RPC URI (``lookupNode``)
+    and its pid (the node's own ``getPid``). A node whose pid or URI changes was started again (roslaunch's
+    ``respawn``); one that leaves the master's list, or whose URI refuses connections, ended. Either is
+    a death, seen here even when roslaunch's words about it are lost (the log's middle is cut for a
+    chatty node). Built right after ``init_node``; :meth:`stop` before the result is written, so the
+    grader's own stopping of the node is never counted.
+
+    :param names: returns the student's node names (:meth:`Graph.student_nodes`).
+    :param lookup: node name -> XML-RPC URI, None when the master does not know it.
+    :param pid_of: URI -> pid; raises ConnectionRefusedError when nothing listens there any more.
+    """
+
+    #: Seconds between two looks; a node that dies and is back within one is still seen (new pid).
+    PERIOD_S = 0.25
+
+    def __init__(self, names, lookup, pid_of, clock=time.time):
+        self._names, self._lookup, self._pid_of, self._clock = names, lookup, pid_of, clock
+        self._lock = threading.Lock()
+        self._seen = {}    # name -> (uri, pid) while running, None once it ended
+        self._deaths = []
+        self._stop = threading.Event()
+        self._thread = None
+
+    def start(self):
+        self._thread = threading.Thread(target=self._loop, name='node-watch', daemon=True)
+        self._thread.start()
+        return self
+
+    def _loop(self):
+        while not self._stop.wait(self.PERIOD_S):
+            try:
+                self.look()
+            except Exception:  # a transient of the master's XML-RPC: the next look sees it again
+                pass
+
+    def look(self):
+        """One look at the master and each node; records the deaths it sees."""
+        now, names = self._clock(), set(self._names())
+        with self._lock:
+            known = dict(self._seen)
+        for name in sorted(names | set(n for n, s in known.items() if s is not None)):
+            uri = self._lookup(name) if name in names else None
+            now_running = None
+            if uri is not None:
+                try:
+                    now_running = (uri, self._pid_of(uri))
+                except ConnectionRefusedError:
+                    now_running = None  # registered, but its process is gone (killed, no unregistering)
+                except Exception:
+                    continue  # slow or odd answer: not a death, looked at again next time
+            before = known.get(name, 'new')
+            if before == 'new':
+                if now_running is not None:
+                    self._record(name, now_running, None)
+            elif before is None:
+                if now_running is not None:  # back after an end already counted: started again
+                    self._record(name, now_running, None, returned=True)
+            elif now_running is None:
+                self._record(name, None, 'ended during the run (pid %s)' % before[1], at=now)
+            elif now_running != before:
+                self._record(name, now_running, 'started again during the run (pid %s, then %s)'
+                             % (before[1], now_running[1]), at=now)
+
+    def _record(self, name, running, death, at=None, returned=False):
+        with self._lock:
+            self._seen[name] = running
+            if death:
+                self._deaths.append({'node': name, 't': at, 'detail': death})
+            elif returned and self._deaths:
+                for entry in reversed(self._deaths):
+                    if entry['node'] == name:
+                        entry['detail'] += ', then started again (pid %s)' % running[1]
+                        break
+
+    def stop(self):
+        """Stop looking (one last look first); return ``{"deaths": [{"node", "t", "detail"}], "nodes"}``."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+        try:
+            self.look()
+        except Exception:
+            pass
+        with self._lock:
+            return {'deaths': [dict(d) for d in self._deaths], 'nodes': sorted(self._seen)}
+
+class _BoundedTransport(xmlrpc.client.Transport):
+    """XML-RPC to a student's node: every call within ``timeout`` s, at most ``max_bytes`` of answer
+    (the node writes its answer)."""
+
+    def __init__(self, timeout, max_bytes):
+        super().__init__()
+        self._timeout, self._max_bytes = timeout, max_bytes
+
+    def make_connection(self, host):
+        connection = super().make_connection(host)
+        connection.timeout = self._timeout
+        return connection
+
+    def parse_response(self, response):
+        parser, unmarshaller = self.getparser()
+        read = 0
+        while True:
+            data = response.read(1024)
+            if not data:
+                break
+            read += len(data)
+            if read > self._max_bytes:
+                raise ValueError('an answer over %d bytes' % self._max_bytes)
+            parser.feed(data)
+        parser.close()
+        return unmarshaller.close()
+
+
+#: A node's getPid: answered within this many s, in at most this many bytes.
+PID_TIMEOUT_S = 2.0
+PID_ANSWER_BYTES = 4096
+
+
+def node_pid(uri):
+    """The pid the node at ``uri`` gives (its XML-RPC ``getPid``); raises ConnectionRefusedError when
+    nothing listens there any more, another error for an answer that is late, long or not a pid."""
+    code, _, pid = xmlrpc.client.ServerProxy(uri, transport=_BoundedTransport(PID_TIMEOUT_S, PID_ANSWER_BYTES)) \
+        .getPid(rospy.get_name())
+    if code != 1 or not isinstance(pid, int):
+        raise ValueError('getPid answered %r' % ([code, pid],))
+    return pid
+
+
+def node_uri(master, name):
+    """The XML-RPC URI the master has for node ``name``, None when it has none."""
+    try:
+        return master.lookupNode(name)
+    except rosgraph.MasterError:
+        return None
+
+
 def _last_value(recorder, since):
     """The last value published at least IGNORE_S after ``since`` and the number of such samples."""
     samples = recorder.samples(since + IGNORE_S)
@@ -238,6 +378,9 @@ class Probe(object):
         self.refusals = RefusedConnections()
         logging.getLogger('rosout').addHandler(self.refusals)
         self.clock = ClockWatch()
+        # Handles of the watch's own: an XML-RPC connection is never shared between two threads.
+        watched, lookups = Graph(), rosgraph.Master(rospy.get_name())
+        self.watch = NodeWatch(watched.student_nodes, lambda name: node_uri(lookups, name), node_pid).start()
         self.drone = Drone(self.sheet, clock=time.time)
         self.recorder = self.drone.output
         self.t0 = time.time()
@@ -470,35 +613,33 @@ class Probe(object):
         return out
 
     def threshold_check(self):
-        """Question 14a: the node restarted with another threshold; from a value below it, a step to a
-        value that was below the launch file's threshold but is above the new one. A node whose WARNING
-        came late in the main run (``warn_after``) is given that long."""
-        schedule = {'start': self.leg(self.x_of(self.plan['targets']['start']), 'below', REST_S)}
-        hold = max(self.plan['delay'], min(self.plan.get('warn_after') or 0.0, LATE_WARNING_S)) + AFTER_S
-        schedule['step'] = self.leg(self.x_of(self.plan['targets']['step']), 'above', hold)
-        schedule['end'] = time.time()
-        self.result['schedule'] = schedule
-        self.result['legs'] = self.legs(schedule, ('start', 'step'))
+        """Question 14a: the node restarted with its launch file's threshold changed to a value drawn at
+        grading time, flown exactly as the main run (issue 36 point 7: a node cannot tell the two runs
+        apart but by the threshold its launch file gave it) around that value, whose long excursion
+        stays below the launch file's threshold. A WARNING that came late in the main run
+        (``warn_after``) is waited for that long, no longer: a node that ignores the new value costs
+        the long excursion, not the late window."""
+        warn_after = self.plan.get('warn_after')
+        if warn_after is not None:
+            self.plan['late_warning'] = min(self.plan.get('late_warning', 0.0),
+                                            max(warn_after, self.plan['delay']) + AFTER_S)
+        self.main_flight()
 
-    def x_of(self, value):
-        """The oracle value at which the node publishes ``value`` (the main run's fit, if any)."""
-        fit = self.plan.get('fit')
-        return value if fit is None else (value - fit[1]) / fit[0]
+    def main_flight(self):
+        # Inputs from the start: a node that waits for data before it subscribes to the rest still runs.
+        self.fly(self.plan['threshold'] - self.plan['margin'])
+        if self.wait_for_node():
+            readable = self.find_output()
+            points = self.formula() if readable else []
+            lo, hi = self.calibrate(points)
+            self.flight(lo, hi)
 
     def run(self):
         if self.plan['kind'] == 'main':
-            # Inputs from the start: a node that waits for data before it subscribes to the rest still runs.
-            self.fly(self.plan['threshold'] - self.plan['margin'])
-            if self.wait_for_node():
-                readable = self.find_output()
-                points = self.formula() if readable else []
-                lo, hi = self.calibrate(points)
-                self.flight(lo, hi)
+            self.main_flight()
         else:
-            self.fly(self.x_of(self.plan['targets']['start']))
-            if self.wait_for_node():
-                self.find_output()  # the node's own values, to check the legs on
-                self.threshold_check()
+            self.threshold_check()
+        self.result['node_watch'] = self.watch.stop()
         self.result['calls'] = [[t, s] for t, s in self.drone.service.calls()]
         self.result['answers'] = [[t, s, ok, message] for t, s, ok, message in self.drone.service.answers()]
         self.result['graph'] = self.graph.summary()

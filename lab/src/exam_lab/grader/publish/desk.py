@@ -2,6 +2,7 @@
 
 After grading, :func:`finish` writes, in ``OUT``: each student's Gradescope ``results.json`` and
 flight plot, the similarity check across the class, the Moodle worksheet filled (when one is given),
+each released student's feedback page in ``moodle-feedback.zip`` (:mod:`exam_lab.grader.publish.feedback`)
 and ``index.html`` (:mod:`exam_lab.grader.publish.page`).
 
 The desk survives any one student: each student's results.json, flight plot and page section are
@@ -13,7 +14,7 @@ import html
 import json
 import os
 
-from exam_lab.grader.publish import flightplot, gradescope, hand, moodle, page
+from exam_lab.grader.publish import feedback, flightplot, gradescope, hand, moodle, page
 from exam_lab.grader.score import safe_text
 
 
@@ -56,7 +57,7 @@ def _student(out, record, single):
     return entry
 
 
-def finish(out, records, single=False, similar=None, worksheet=None, scale=False, title=None):
+def finish(out, records, single=False, similar=None, worksheet=None, scale=False, title=None, show=None):
     """Write the desk's files for ``records`` graded into ``out``; return lines for the terminal.
 
     :param single: one submission (its results are in ``out`` itself, not ``out/<student>``).
@@ -64,7 +65,9 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
     :param worksheet: the Moodle worksheet to fill, or None.
     :param scale: scale the grades to the worksheet's maximum grade (:func:`moodle.fill`).
     :param title: the class's name (:func:`moodle.class_name`); the output folder's name when None.
+    :param show: what the students' feedback pages show (:func:`feedback.write`); None: lab/check_visibility.ini.
     """
+    records = safe_text.cleaned(records)  # as grade_record made them; a record read back is made so again
     lines, notes, entries = [], [], {}
     for record in records:
         entry = entries[record['student']] = _student(out, record, single)
@@ -88,6 +91,10 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
             lines.append('worksheet NOT filled: %s' % err)
         except Exception as err:  # a bug on one record's text: the page must still say so
             lines.append('worksheet NOT filled (a grader bug, please report): %s' % _failure(err))
+    try:
+        lines += feedback.write(out, records, single, show)
+    except Exception as err:  # the grades are written; the page must still say why the zip is not
+        lines.append('moodle feedback NOT written (a grader bug, please report): %s' % _failure(err))
     notes += lines
     pairs = None
     if similar is not None:

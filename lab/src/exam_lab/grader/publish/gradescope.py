@@ -8,6 +8,7 @@ copies this file; a class graded here gets one per student, to upload with Grade
 import json
 import os
 
+from exam_lab.grader.publish import student_view
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 
@@ -24,14 +25,16 @@ def results(record):
                       else entry['id'],
                       'score': entry['points'], 'max_score': entry['max'],
                       'status': 'passed' if entry['points'] >= entry['max'] else 'failed',
-                      'output': entry.get('evidence', '')})
+                      'output': student_view.item_words(entry, record, first_line=False)
+                      if entry.get('evidence') else ''})
     output = 'Graded by running the package (sheet %s): %s / %s. Not scored by the machine: comments, code ' \
              'quality and the report.' % (record.get('sheet') or '-', record['total'], record['max'])
     out = {'score': record['total'], 'output': output, 'tests': tests, 'stdout_visibility': 'hidden',
-           'extra_data': {'status': status, 'status_reason': record.get('status_reason', ''),
+           'extra_data': {'status': status,
+                          'status_reason': student_view.scrub(record.get('status_reason', ''), student_view.hidden(record)),
                           'student': record['student']}}
     if status not in GRADED:
-        out['output'] = 'Needs the teacher (%s): %s' % (status, record.get('status_reason', ''))
+        out['output'] = 'Needs the teacher (%s): %s' % (status, out['extra_data']['status_reason'])
         out['visibility'] = 'hidden'  # a grade only the teacher sees until it is settled by hand
     return safe_text.cleaned(out)  # the student sees it: no control character of anyone's reaches it
 

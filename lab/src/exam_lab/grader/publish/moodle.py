@@ -22,7 +22,7 @@ import collections
 import html
 import re
 
-from exam_lab.grader.publish import cells
+from exam_lab.grader.publish import cells, student_view
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 
@@ -250,7 +250,7 @@ def feedback(record, maximum=None, scaled=None):
         if entry.get('by') == 'hand':
             line += ' (by hand)' if entry['id'] not in record.get('missing', ()) else ': not given yet'
         elif entry['points'] < entry['max'] and entry.get('evidence'):
-            why = safe_text.clean(entry['evidence']).split('\n', 1)[0]
+            why = safe_text.clean(student_view.item_words(entry, record)).split('\n', 1)[0]  # never the threshold run
             line += ': ' + (why if len(why) <= 200 else why[:197] + '...')
         lines.append(line)
     if 'machine_total' in record:  # the whole grade (exam_lab.grader.publish.hand.combine)

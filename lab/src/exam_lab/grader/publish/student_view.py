@@ -1,16 +1,21 @@
-"""What a student's own check (``make check``, lab/scripts/check.py) prints of a grade record: what the
-teacher chose to show, in one setting (lab/check_visibility.ini, ``[check] show``):
+"""What a student's own check (``make check``, lab/scripts/check.py) prints of a grade record, and what
+a student's feedback page shows (:mod:`~exam_lab.grader.publish.feedback`): what the teacher chose to
+show, in one setting (lab/check_visibility.ini, ``[check] show``):
 
 - ``points``: each item and its points, the total and the status;
 - ``evidence``: also each item's evidence (its first line: the measured numbers) and the status's reason.
 
-Never shown, whatever the setting: the threshold run. For question 14a the grader runs the node a
-second time with its launch file's threshold lowered to a value the student is not told; when that run
-took place, Q14a's evidence (which names the value and what was flown) gives way to a sentence that
-names none, the ``runs`` item's words about that run are left out, and so is a status reason about it.
-The teacher's notes (``for_the_teacher``) are the teacher's. No rospy here.
+Never shown, whatever the setting, nor in any other output a student reads (the Moodle feedback, the
+Gradescope results: :func:`item_words`): the threshold run. For question 14a the grader runs the node a
+second time with its launch file's threshold lowered to a value drawn at grading time, which the
+student is not told (the record's ``threshold_run``); when there is one, Q14a's evidence (which names
+the value and what was flown) gives way to a sentence that names none, the ``runs`` item's words about
+that run are left out, and so is a status reason about it; and any number written as that value is
+replaced (:func:`scrub`), whatever item's words it is in. The teacher's notes (``for_the_teacher``)
+are the teacher's. No rospy here.
 """
 import configparser
+import re
 
 from exam_lab.grader.publish.report import NOT_SCORED, _points
 
@@ -26,6 +31,37 @@ Q14A_WORDS = ('the node obeyed its launch file\'s threshold parameter: run again
               '(to a value not shown)')
 #: How the grader's words name the threshold run (rubric: '<tag> run: ...', 'in the <tag> run ...').
 THRESHOLD_RUN = 'threshold run'
+#: What a number that is the hidden value is written as.
+NOT_SHOWN = '(a value not shown)'
+
+
+def hidden(record):
+    """The values a student must never read in ``record``: the threshold run's (``[]`` when none)."""
+    run = record.get('threshold_run') or {}
+    return [run['value']] if run.get('value') is not None else []
+
+
+def scrub(text, values):
+    """``text`` with every way the grader writes one of ``values`` (``%g``, one or two decimals, the
+    integer) replaced by :data:`NOT_SHOWN`."""
+    for value in values:
+        forms = {'%g' % value, '%.1f' % value, '%.2f' % value, '%.3f' % value, repr(float(value))}
+        if float(value).is_integer():
+            forms.add('%d' % value)
+        for form in sorted(forms, key=len, reverse=True):
+            text = re.sub(r'(?<![\d.])%s(?![\d])' % re.escape(form), NOT_SHOWN, text)
+    return text
+
+
+def item_words(entry, record, first_line=True):
+    """An item's evidence as any output a student reads gives it (the check, Moodle's feedback,
+    Gradescope's results): without the threshold run (:func:`student_evidence`) and its value."""
+    threshold_run = bool(hidden(record))
+    if first_line or (threshold_run and entry['id'] in ('Q14a', 'runs')):
+        words = student_evidence(entry, threshold_run)  # a launch's log may print the value: first line only
+    else:
+        words = entry['evidence']
+    return scrub(words, hidden(record))
 
 
 def read_setting(path):
@@ -70,26 +106,37 @@ def student_evidence(entry, threshold_run):
     return first
 
 
-def lines(record, show, threshold_run):
+def student_reason(record, show, threshold_run):
+    """The status's reason as the student may read it: only with ``evidence``, and never one about the
+    threshold run; '' otherwise."""
+    reason = record.get('status_reason') or ''
+    if show != 'evidence' or (threshold_run and THRESHOLD_RUN in reason):
+        return ''
+    return scrub(reason, hidden(record))
+
+
+def lines(record, show, threshold_run=None):
     """The lines to print for ``record`` with the setting ``show``.
 
-    :param threshold_run: True when the grader ran the threshold run (its plan is in the logs).
+    :param threshold_run: True when the grader ran the threshold run; by default, when the record
+        has one (:func:`hidden`).
     """
+    threshold_run = bool(hidden(record)) if threshold_run is None else threshold_run
     if show not in SHOW:
         raise ValueError('show = %r; expected one of %s' % (show, ', '.join(SHOW)))
     rows = [['item', 'points'] + (['evidence'] if show == 'evidence' else [])]
     for entry in record['items']:
         row = [entry['id'], '%s / %s' % (_points(entry['points']), _points(entry['max']))]
         if show == 'evidence':
-            row.append(student_evidence(entry, threshold_run))
+            row.append(scrub(student_evidence(entry, threshold_run), hidden(record)))
         rows.append(row)
     rows.append(['total', '%s / %s' % (_points(record['total']), _points(record['max']))] +
                 ([''] if show == 'evidence' else []))
     widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]) - 1)]
     out = ['  '.join([cell.ljust(w) for cell, w in zip(r, widths)] + [r[-1]]).rstrip() for r in rows]
     status = 'status: %s' % record.get('status', '')
-    reason = record.get('status_reason') or ''
-    if show == 'evidence' and reason and not (threshold_run and THRESHOLD_RUN in reason):
+    reason = student_reason(record, show, threshold_run)
+    if reason:
         status += ' - %s' % reason
     out += ['', status, 'not scored by the machine (the teacher grades them): %s' % NOT_SCORED]
     return out

@@ -104,7 +104,7 @@ def check(value, schema, where='record'):
         if not isinstance(value, list):
             raise RecordError('%s: a list expected, got %s' % (where, type(value).__name__))
         if len(value) > schema.limit:
-            raise RecordError('%s: %d items (at most %d)' % (where, len(value), schema.limit))
+            raise RecordError('%s: %d %s (at most %d)' % (where, len(value), _noun(where), schema.limit))
         return [check(item, schema.schema, '%s[%d]' % (where, index)) for index, item in enumerate(value)]
     if isinstance(schema, dict):
         if not isinstance(value, dict):
@@ -121,6 +121,12 @@ def check(value, schema, where='record'):
             checked[key] = check(value[key], inner, '%s.%s' % (where, key))
         return checked
     raise TypeError('not a schema: %r' % (schema,))
+
+
+def _noun(where):
+    """What a list at ``where`` holds, for its cap's sentence: ``inspect.json.comments.files`` holds files."""
+    key = where.rsplit('.', 1)[-1]
+    return key.replace('_', ' ') if re.match(r'^[a-z_]+s$', key) else 'items'
 
 
 def _shown(value):
@@ -184,9 +190,13 @@ def write(folder, record_type, value):
 #: What the inspection read of the package for the rubric (``static`` of :func:`~exam_lab.grader.score.rubric.score`).
 STATIC = {
     'launch_files': [str], 'package': Text(255), 'python2': [str], 'params_in_code': [str],
+    'args_in_code': Optional([str]),
+    'code': Optional({'service_calls': [str], 'publishes': [str], 'timers': [str],
+                      'private_before_init': Optional([str])}),
     'launch': Maybe({'file': str, 'starts_drone': bool, 'exam_type': str, 'exam_name': str, 'package': Text(255),
                      'comments': Number(0, 1e9, integer=True), 'exam_type_found': bool}),
     'threshold': Maybe({'name': str, 'value': Maybe((str, Number(), bool)), 'where': str,
+                        'how': Optional(OneOf('param', 'args')), 'run_value': Optional(float),
                         'not_rewritable': Optional(str)}),
     'threshold_reason': str,
     'uploads': Optional(Items({'files': [str], 'chosen': str, 'why': str, 'ambiguous': bool}, 20)),
@@ -213,6 +223,7 @@ class InspectRecord(Record):
         'calls_service': bool,
         'namespace': str,
         'main_launch': Maybe(str), 'threshold_launch': Maybe(str),
+        'threshold_run_value': Optional(Maybe(float)),
         'handed_in_launch': Optional(Maybe(str)),
         'comments': Maybe({'comments': Number(0, 1e9, integer=True), 'code': Number(0, 1e9, integer=True),
                            'files': [str]}),
@@ -226,15 +237,19 @@ class InspectRecord(Record):
                 _relative(getattr(self, key), 'inspect.json.%s' % key)
         if self.threshold_launch is not None and self.main_launch is None:
             raise RecordError('inspect.json: a threshold run without a main run')
+        if self.threshold_launch is not None and self.threshold_run_value is None:
+            raise RecordError('inspect.json: a threshold run without its value')
 
 
 class IntakeRecord(Record):
     """A class archive unpacked by :mod:`exam_lab.grader.boxed.intake` (``intake.json``): ``students``,
-    each ``{"name", "path"}`` with ``path`` relative to the intake's output folder."""
+    each ``{"name", "path"}`` with ``path`` relative to the intake's output folder, and ``refused``
+    (why) when that student's files were not unpacked. A class may be larger than any other list's cap."""
     FILE = 'intake.json'
-    MAX_BYTES = 4 << 20
+    MAX_BYTES = 16 << 20
+    MAX_STUDENTS = 10000
     SCHEMA = {'uid': Number(0, 2 ** 32, integer=True),
-              'students': [{'name': Text(255), 'path': Text(4096)}]}
+              'students': Items({'name': Text(255), 'path': Text(4096), 'refused': Optional(Text())}, MAX_STUDENTS)}
 
     def validate(self):
         for index, student in enumerate(self.students):

@@ -1,7 +1,7 @@
 """The rubric: points for each item from what was measured, and why. Pure functions, no rospy.
 
 Input: ``static`` (what the runner read in the package: the launch file, the threshold parameter,
-the parameters the code reads) and ``session`` (what :mod:`exam_lab.grader.judge.session` measured: the
+the parameters the code reads) and ``session`` (what :mod:`exam_lab.grader.host.session` measured: the
 build, the main run and the threshold run, each with the probe's result). Output: one
 ``{"id", "points", "max", "evidence"}`` per item of :data:`exam_lab.grader.score.sheets.ITEMS`.
 
@@ -58,6 +58,15 @@ def threshold_probe(session):
     return runs[0]['probe'] if runs and runs[0].get('probe') else None
 
 
+def threshold_run_value(static, session):
+    """The threshold run's value, which no output a student reads may show: as flown (its probe's
+    plan), else as drawn by the inspection (a run skipped or failed); None when there was none."""
+    probe = threshold_probe(session)
+    if probe and probe.get('threshold') is not None:
+        return probe['threshold']
+    return ((static or {}).get('threshold') or {}).get('run_value')
+
+
 def node_ran(session):
     probe = main_probe(session)
     return bool(probe and probe.get('nodes'))
@@ -86,7 +95,7 @@ def score_runs(session):
     if build is None:
         return item('runs', 0, (session or {}).get('error', 'the submission could not be prepared'))
     if build['status'] is None:
-        return item('runs', 0, 'catkin_make did not finish within %.0f s' % build['timeout'])
+        return item('runs', 0, build.get('stopped') or 'catkin_make did not finish within %.0f s' % build['timeout'])
     if build['status'] != 0:
         return item('runs', 0, 'catkin_make failed (exit %s) in a workspace of its own next to the '
                     'simulators; its last lines:\n%s' % (build['status'], build['tail']))
@@ -402,6 +411,31 @@ def score_q13(sheet, session):
     return item('Q13', points, '%s (%s)' % (evidence, _driven_by(probe)))
 
 
+def _reads(static, threshold):
+    """What of the student's code reads the launch file's threshold: a parameter of that name (the
+    last part of its name, however resolved), or for an ``args=`` word, argparse's option of that name
+    or the index the code takes of ``rospy.myargv()`` / ``sys.argv`` (a positional argparse name too)."""
+    name = threshold['name']
+    if threshold.get('how') == 'args':
+        found = static.get('args_in_code') or []
+        if name.startswith('-'):
+            return [a for a in found if a == name]
+        return [a for a in found if a == name or not a.startswith(('-', 'argv['))]
+    early = _read_too_early(static)
+    return [p for p in static.get('params_in_code', []) if p.strip('~/').split('/')[-1] == name.split('/')[-1]
+            and p not in early]
+
+
+def _read_too_early(static):
+    """{private parameter name: where} the code reads before init_node (then rospy resolves it against
+    ``<ns>/unnamed``, never the node's name: ``rospy/names.py``)."""
+    out = {}
+    for entry in ((static.get('code') or {}).get('private_before_init') or []):
+        where, _, name = entry.rpartition(': ')
+        out.setdefault(name, where)
+    return out
+
+
 def score_q14a(sheet, static, session):
     threshold = static.get('threshold')
     if static.get('launch_files') is None:
@@ -409,38 +443,51 @@ def score_q14a(sheet, static, session):
     if threshold is None:
         return item('Q14a', 0, static.get('threshold_reason', 'no threshold parameter in the launch file'))
     name = threshold['name']
+    what = 'argument %s' % name if threshold.get('how') == 'args' else 'parameter %s' % name
     if not node_ran(session):
-        return item('Q14a', 0, 'parameter %s = %s in the launch file; %s' % (name, threshold['value'], _not_run(session)))
-    read = [p for p in static.get('params_in_code', []) if p.strip('~/').split('/')[-1] == name.split('/')[-1]]
+        return item('Q14a', 0, '%s = %s in the launch file; %s' % (what, threshold['value'], _not_run(session)))
+    read = _reads(static, threshold)
     # Judged from the code only for a node that runs: one that dies has not shown it uses anything.
     static_points = 0.5 if read and stayed_up(session) else 0.0
-    static_note = ('the code reads %s' % ', '.join(read)) if read else 'the code reads no parameter of that name'
+    static_note = ('the code reads %s' % ', '.join(read)) if read else 'the code reads no %s of that name' % (
+        'argument' if threshold.get('how') == 'args' else 'parameter')
     if read and not stayed_up(session):
         static_note += ', but the node died (see runs)'
+    early = [(n, w) for n, w in sorted(_read_too_early(static).items())
+             if n.strip('~/').split('/')[-1] == name.split('/')[-1]]
+    if early:
+        static_note += '; it reads %s before init_node (%s), where rospy resolves it as .../unnamed/%s (its name ' \
+                       'until then), not as the node\'s parameter' % (early[0][0], early[0][1], early[0][0].lstrip('~'))
     probe2 = threshold_probe(session)
     skipped = session.get('threshold_skipped')
     if probe2 is None:
         why = skipped or threshold.get('not_rewritable') or 'the threshold run failed'
-        return item('Q14a', static_points, 'parameter %s = %s in the launch file; its effect could not be '
-                    'observed (%s); judged from the code: %s' % (name, threshold['value'], why, static_note))
+        return item('Q14a', static_points, '%s = %s in the launch file; its effect could not be observed (%s); '
+                    'judged from the code: %s' % (what, threshold['value'], why, static_note))
     schedule = probe2.get('schedule') or {}
-    if 'step' not in schedule:
+    # The threshold run flies the main run's legs (its long excursion above the new value, below the
+    # launch file's); measurements kept from before flew a single step.
+    leg = 'long_up' if 'long_up' in schedule else 'step' if 'step' in schedule else None
+    if leg is None:
         return item('Q14a', 0, 'with %s = %g the node did not run' % (name, probe2['threshold']))
-    if unreached_legs(probe2, ['step']):
-        return item('Q14a', static_points, 'parameter %s = %s; set to %g: %s; judged from the code: %s' % (
-            name, threshold['value'], probe2['threshold'], _leg_words(probe2, 'step'), static_note))
-    warned = _calls_between(probe2, schedule['step'], schedule['end'], 'WARNING')
-    main = main_probe(session)
-    lo = (main.get('calibration') or {}).get('lo', {})
+    if unreached_legs(probe2, [leg]):
+        return item('Q14a', static_points, '%s = %s; set to %g: %s; judged from the code: %s' % (
+            what, threshold['value'], probe2['threshold'], _leg_words(probe2, leg), static_note))
+    end = schedule['long_down'] if leg == 'long_up' else schedule['end']
+    warned = _calls_between(probe2, schedule[leg], end, 'WARNING')
+    if leg == 'long_up':
+        flown = ((probe2.get('calibration') or {}).get('hi') or {}).get('target', float('nan'))
+    else:
+        flown = ((main_probe(session).get('calibration') or {}).get('lo') or {}).get('target', float('nan'))
     if warned:
-        return item('Q14a', 1, 'launch file %s = %s; set to %g, the node warned %.2f s after reaching %.1f, a value '
-                    'it kept NORMAL with %s' % (name, threshold['value'], probe2['threshold'],
-                                                warned[0][0] - schedule['step'], lo.get('target', float('nan')),
-                                                threshold['value']))
+        return item('Q14a', 1, 'launch file %s = %s; set to %g, the node warned %.2f s after its own value went '
+                    'above it, flown at %.1f, a value it kept NORMAL with %s' % (
+                        what, threshold['value'], probe2['threshold'], warned[0][0] - _reached(probe2, leg), flown,
+                        threshold['value']))
     return item('Q14a', 0, 'launch file %s = %s; set to %g, the node stayed NORMAL for %.1f s at %.1f, above the new '
-                'threshold: it does not obey the parameter (%s)' % (
-                    name, threshold['value'], probe2['threshold'], schedule['end'] - schedule['step'],
-                    lo.get('target', float('nan')), static_note))
+                'threshold: it does not obey the %s (%s)' % (
+                    what, threshold['value'], probe2['threshold'], end - _reached(probe2, leg), flown,
+                    'argument' if threshold.get('how') == 'args' else 'parameter', static_note))
 
 
 def score_q14b(sheet, session):
@@ -514,14 +561,42 @@ def crash_summary(text):
     return '%s%s' % (error[:200], where)
 
 
+def missing_evidence(static, session):
+    """Rules the runs could not observe while the code holds what they need: one line each, naming
+    the code's ``file:line`` (issue 35 point 5: a doubt, never a silent zero). A node that never
+    published its value while its code publishes; a node that never called the warning service in a
+    whole flight, its own value above the threshold for longer than the delay, while its code calls it."""
+    static, session = static or {}, session or {}
+    code = static.get('code') or {}
+    probe = main_probe(session)
+    schedule = _flight(probe)
+    if not node_ran(session) or not stayed_up(session) or schedule is None:
+        return []
+    out = []
+    sheet = SHEETS.get(probe.get('sheet')) or SHEETS['altitude']
+    rate = probe.get('rate')
+    if rate is not None and not rate.get('samples') and code.get('publishes'):
+        out.append('the node never published its value while flown, yet its code publishes at %s: nothing '
+                   'measured for Q11, Q13, Q14; read its code' % ', '.join(code['publishes'][:3]))
+    elif not calls(probe) and code.get('service_calls') and not unreached_legs(probe, ['long_up']):
+        out.append('the node never called %s in the whole flight (its own value above the threshold for %.1f s), '
+                   'yet its code calls it at %s: no call to judge Q13, Q14a, Q14b on; read its code to see why '
+                   'the call is never reached' % ('/' + sheet.service.lstrip('/'), schedule['long_down'] - _reached(probe, 'long_up'),
+                                                  ', '.join(code['service_calls'][:3])))
+    return out
+
+
 def status(static, session, fixes=()):
     """``(status, reason)``: what the teacher must do with this grade (one of STATUSES; the reason is
     one line, '' when graded).
 
     Not graded: the upload was refused or unreadable, or the grader could not run it. Needs a hand
-    grade: the package has no node, does not build, its node does not start or dies (the traceback's
+    grade: its grading used up its budget (a step stopped or left out), the package has no node, does
+    not build, its node does not start or dies (the traceback's
     last line and file:line; Python 2 named), a run's measurement was refused (the node set the time,
-    its master went over its memory bound), or a leg of a flight was not reached (nothing judged there). Graded with fixes: the grader made a teacher's fix (each in for_the_teacher).
+    its master went over its memory bound), a leg of a flight was not reached (nothing judged there), or a
+    rule could not be observed while the code holds it (:func:`missing_evidence`: the code's file:line).
+    Graded with fixes: the grader made a teacher's fix (each in for_the_teacher).
     """
     static, session = static or {}, session or {}
     build = session.get('build')
@@ -529,6 +604,8 @@ def status(static, session, fixes=()):
         return NOT_GRADED, _one_line(session.get('error', 'the upload was refused'))
     if build is None and not session.get('no_node'):
         return NOT_GRADED, _one_line(session.get('error', 'the submission could not be graded'))
+    if session.get('budget_used'):  # a step stopped or left out: what it would have measured is missing
+        return HAND_GRADE, _one_line(session['budget_used'])
     python2 = static.get('python2') or []
     python2_words = 'Python 2 code (%s): it cannot start under ROS Noetic\'s Python 3; read its algorithm by hand' \
         % ', '.join(python2[:3])
@@ -548,6 +625,9 @@ def status(static, session, fixes=()):
         crash = crash_summary(tails)
         return HAND_GRADE, _one_line('the node %s%s' % ('does not start' if not node_ran(session) else 'died',
                                                           ': %s' % crash if crash else ' (see runs)'))
+    missing = missing_evidence(static, session)
+    if missing:
+        return HAND_GRADE, _one_line(missing[0])
     for run in runs:
         missed = unreached_legs(run.get('probe'))
         if missed:
@@ -579,9 +659,9 @@ def status(static, session, fixes=()):
 def doubts(static, session):
     """What makes a grade doubtful, one line each, for the "needs the teacher" box whatever the status:
     refused service calls, roslaunch refusing (or warning about) the launch file as handed in, several
-    uploads, a run whose measurement was refused."""
+    uploads, a run whose measurement was refused, a rule not observed while the code holds it."""
     static, session = static or {}, session or {}
-    out = []
+    out = list(missing_evidence(static, session))
     refused = refused_calls(main_probe(session))
     if refused:
         out.append('the drone refused %s' % _refused_words(refused))

@@ -11,6 +11,10 @@ screen or sets the title, so a traceback could rewrite the class summary ("17/17
 - the bidirectional overrides, embeddings and isolates (U+202A-U+202E, U+2066-U+2069): they reorder
   what the teacher reads ("Trojan Source") without being seen.
 
+A name in bytes that are not UTF-8 (a file name in a student's tar) reaches the records as Python's
+surrogate escapes, kept exactly; shown, each such byte reads ``\\xNN`` (a lone surrogate of any other
+kind ``\\udNNN``): no UTF-8 file, page or terminal can refuse it.
+
 A carriage return that is not part of a CRLF becomes a newline: what it would have overwritten on a
 terminal stays readable, on a line of its own. :func:`one_line` is for a cell (a name, a table cell):
 line breaks and tabs become spaces too.
@@ -27,6 +31,7 @@ _SEQUENCE = re.compile(
 #: Control characters left once the sequences are gone (newline and tab are kept), and bidi controls.
 _CONTROL = re.compile('[\x00-\x08\x0b-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]')
 _LONE_CR = re.compile('\r\n?')
+_SURROGATE = re.compile('[\ud800-\udfff]')
 _BREAKS = re.compile('[\n\t]+')
 
 
@@ -34,7 +39,13 @@ def clean(text):
     """``text`` without escape sequences and control characters but newline and tab (see above)."""
     if not isinstance(text, str):
         text = str(text)
-    return _CONTROL.sub('', _SEQUENCE.sub('', _LONE_CR.sub('\n', text)))
+    return _CONTROL.sub('', _SEQUENCE.sub('', _LONE_CR.sub('\n', _SURROGATE.sub(_escaped, text))))
+
+
+def _escaped(match):
+    """A lone surrogate as text: the byte surrogateescape kept (``\\xff``), else its code point."""
+    code = ord(match.group())
+    return '\\x%02x' % (code - 0xdc00) if 0xdc80 <= code <= 0xdcff else '\\u%04x' % code
 
 
 def one_line(text):

@@ -2,7 +2,7 @@
 
 The runner starts this module as root, alone in a network namespace that has only loopback::
 
-    python3 -m exam_lab.grader.judge.session JOB.json
+    python3 -m exam_lab.grader.host.session JOB.json
 
 This orchestrator stays root (it starts the boxes, which drop root themselves) but parses no byte of the
 student's: it reads roslaunch's output and the probe's JSON, both capped. The judge (a master per run,
@@ -13,17 +13,21 @@ the judge's own folder (``judge_home``: ROS logs, plans, the probe's results) is
 Every step that runs the student's code (``catkin_make``, ``roslaunch`` and the nodes) runs in the
 submission's :class:`~exam_lab.grader.host.sandbox.Box`, another user in namespaces of its own that shares
 only this network namespace. The box's environment starts empty: the underlay's, ROS's, a fresh HOME;
-the student's own ``devel/setup.bash`` is sourced inside the box, never here. After each step, the box's
+the student's own ``devel/setup.bash`` is sourced inside the box, never here, and only for the build's
+products to run: roslaunch's verdict on the file as handed in comes first, before anything of the
+student's has run (:func:`launch_verdict`). After each step, the box's
 uid must have no process left (they die with its PID namespace); any found is killed and reported.
 
 Job (JSON, written by :mod:`exam_lab.grader.runner`): ``workspace`` (the student's catkin workspace as
 the box sees it), ``box`` (:meth:`~exam_lab.grader.host.sandbox.Box.describe`), ``underlay`` (setup.bash of
 the simulators' workspace), ``log_dir``, ``namespace`` (the drone's), ``build_timeout`` /
-``run_timeout`` (s), ``judge_home`` (the judge's folder), ``runs``: the main run and, when the launch
+``run_timeout`` (s), ``budget`` (s the session may take, what is left of ``student_budget``, the
+student's whole grading: :class:`Budget`), ``judge_home`` (the judge's folder), ``runs``: the main run and, when the launch
 file has a threshold the grader can change, the threshold run: each ``{"tag", "launch" (derived launch
 file, as the box sees it), "plan" (for the probe)}``. Writes ``<log_dir>/session.json``: ``{"build":
 {...}, "runs": [{"tag", "probe" (the probe's result or None), "probe_refused" (why a result was
-refused), "master" (its memory, its uid), "probe_uid", "launch": {...}}], "survivors": n}``, and each
+refused), "master" (its memory, its uid), "probe_uid", "launch": {...}}], "survivors": n, "launch_check",
+"budget_used" (the sentence when the budget stopped a step, else None)}``, and each
 probe's result as ``<log_dir>/probe-<tag>.json``.
 """
 import json
@@ -82,6 +86,21 @@ def launch_outcome(output, workspace=None):
             ended.append({'node': match.group(1) or required or '?', 'how': match.group(2),
                           'detail': match.group(3) or ''})
     return {'ended': ended, 'not_started': _NOT_STARTED.findall(text), 'tail': tail(clean(output))}
+
+
+#: The most deaths of one run the judge's watch reports.
+WATCHED_DEATHS = 20
+
+
+def watched_deaths(probe):
+    """The deaths the probe's :class:`~exam_lab.grader.judge.probe.NodeWatch` saw (a node started again
+    or gone during the run), as entries of :func:`launch_outcome`'s ``ended``: they cost what a death
+    in roslaunch's words costs, and they are the judge's own, whatever roslaunch's log kept."""
+    watch = (probe or {}).get('node_watch')
+    deaths = watch.get('deaths') if isinstance(watch, dict) else None
+    return [{'node': clean_text(str(d.get('node', '?')))[:100], 'how': 'died',
+             'detail': 'seen by the judge: %s' % clean_text(str(d.get('detail', '')))[:200]}
+            for d in (deaths if isinstance(deaths, list) else [])[:WATCHED_DEATHS] if isinstance(d, dict)]
 
 
 def warned_in_long_excursion(probe):
@@ -163,26 +182,30 @@ for node in config.nodes:
 '''
 
 
-def launch_verdict(sup, job, base_env, box):
+def launch_verdict(sup, job, base_env, box, timeout=LAUNCH_CHECK_TIMEOUT):
     """roslaunch's verdict on the student's launch file as handed in (``job["handed_in_launch"]``, in
-    the workspace's src/), read by roslaunch's own loader in the box with the student's workspace
-    sourced (:data:`_LAUNCH_CHECK`). ``{"file" (in the package), "status" (exit code, None when it did
-    not finish), "refused" (roslaunch's words, '' when accepted), "warnings" [lines], "nodes" [names]}``;
+    the workspace's src/), read by roslaunch's own loader (:data:`_LAUNCH_CHECK`) in the box before
+    anything of the student's has run: the session asks for it before the build, with the underlay's
+    environment and the package's folder on ROS_PACKAGE_PATH (all ``$(find exam)`` needs), never the
+    student's devel/setup.bash (its environment hooks would run first and could answer for roslaunch),
+    from the box's fresh HOME (a ``python3 -c`` imports first from its working folder, and the build
+    can write the workspace's). ``{"file" (in the package), "status" (exit code, None when it did not
+    finish), "refused" (roslaunch's words, '' when accepted), "warnings" [lines], "nodes" [names]}``;
     None without a launch file. The output comes from the box: capped, read as text."""
     relative = job.get('handed_in_launch')
     if not relative:
         return None
     path = os.path.join(job['workspace'], 'src', relative)
-    status, output, _ = sup.run('launch-check', box.argv(
-        ['bash', '-c', 'source "$1/devel/setup.bash" && exec /usr/bin/python3 -c "$2" "$3"', 'bash',
-         job['workspace'], _LAUNCH_CHECK, path], dict(base_env, ROS_HOME=os.path.join(box.home, 'ros-check'))),
-        timeout=LAUNCH_CHECK_TIMEOUT)
+    packages = ':'.join(p for p in (os.path.join(job['workspace'], 'src'), base_env.get('ROS_PACKAGE_PATH')) if p)
+    env = dict(base_env, ROS_PACKAGE_PATH=packages, ROS_HOME=os.path.join(box.home, 'ros-check'))
+    status, output, _ = sup.run('launch-check', box.argv(['/usr/bin/python3', '-c', _LAUNCH_CHECK, path], env,
+                                                         cwd=box.home), timeout=timeout)
     lines = [l.strip()[:300] for l in clean_text(output).replace(job['workspace'].rstrip('/') + '/src/', '')
              .splitlines() if l.strip()]
     words = [l for l in lines if not l.startswith('/')]
     return {'file': relative.split('/', 1)[-1], 'status': status,
             'refused': '' if status == 0 else ' '.join(words[-LAUNCH_CHECK_LINES:]) or
-            ('roslaunch did not finish within %.0f s' % LAUNCH_CHECK_TIMEOUT if status is None
+            ('roslaunch did not finish within %.0f s' % timeout if status is None
              else 'roslaunch exit %s' % status),
             'warnings': [l[len('WARNING: '):] for l in words if l.startswith('WARNING: ')][:LAUNCH_CHECK_LINES]
             if status == 0 else [],
@@ -204,6 +227,47 @@ def uid_of(pid):
         return None
 
 
+#: Seconds of the budget a run keeps for its end (roslaunch's, the probe's and the master's grace
+#: periods), a build or a check for its own (the kill at its limit, the box's end).
+RUN_STOP_S = 30.0
+STEP_STOP_S = 5.0
+#: The least seconds a run is started with (the master's start, the node's registration).
+MIN_RUN_S = 30.0
+
+
+def budget_sentence(total, what):
+    """The teacher's sentence for a grading that used up its budget of ``total`` s in ``what``."""
+    return ('its grading used up its budget of %.0f s (the most one student\'s grading may take, inspection, '
+            'build and runs together): %s' % (total, what))
+
+
+class Budget(object):
+    """What is left of the student's grading budget: ``seconds`` from the session's start (the runner's
+    share of ``total``, the student's whole budget). Each step's limit is its own or what is left,
+    whichever is less (:meth:`limit`); the first step the budget stopped or left out is :attr:`used`,
+    the sentence the teacher reads."""
+
+    def __init__(self, seconds, total, clock=time.monotonic):
+        self.clock, self.total = clock, total
+        self.deadline = clock() + seconds
+        self.used = None
+
+    def left(self, keep=0.0):
+        """Seconds left once ``keep`` s are kept back for stopping the step."""
+        return max(0.0, self.deadline - keep - self.clock())
+
+    def limit(self, cap, keep):
+        """``(limit, by_budget)``: the time limit of a step whose own limit is ``cap`` s."""
+        left = self.left(keep)
+        return (left, True) if left < cap else (cap, False)
+
+    def spend(self, what):
+        """Note that the budget ended ``what`` (the first such step is kept); returns the sentence."""
+        sentence = budget_sentence(self.total, what)
+        self.used = self.used or sentence
+        return sentence
+
+
 def master_problem(master, died):
     """Why a run whose master ended early (``died``) or hit its memory bound (``master``: the cgroup's
     :func:`~exam_lab.grader.host.sandbox.memory_use`) is not one to score, or None."""
@@ -216,13 +280,15 @@ def master_problem(master, died):
     return None
 
 
-def run_one(sup, job, run, base_env, box):
-    """Start a master, the student's launch (in the box) and the probe; return the run's record."""
+def run_one(sup, job, run, base_env, box, budget):
+    """Start a master, the student's launch (in the box) and the probe; return the run's record. The
+    probe is waited for at most the run's limit or what is left of the ``budget``."""
     tag = run['tag']
     log_dir, judge_dir = sup.log_dir, job['judge_home']
     reset_memory_peak(box.judge_cgroups.get('master', []))
     killed_before = (memory_use(box.judge_cgroups.get('master', [])) or {}).get('oom_kills', 0)
-    master = sup.start_master(name='master-%s' % tag, wrap=box.judge_argv([], 'master'))
+    master = sup.start_master(name='master-%s' % tag, wrap=box.judge_argv([], 'master'),
+                              timeout=max(1.0, min(30.0, budget.left(RUN_STOP_S))))
     record = {'tag': tag, 'probe': None, 'master': {'uid': uid_of(master.proc.pid)}}
     launch_env = ros_env(base_env, master.uri, os.path.join(box.home, 'ros-%s' % tag), ip='127.0.0.1')
     launch = sup.start('launch-%s' % tag, box.argv(
@@ -240,9 +306,12 @@ def run_one(sup, job, run, base_env, box):
         [sys.executable, '-m', 'exam_lab.grader.judge.probe', plan_path, result_path], 'probe'), probe_env)
     # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
     # nothing it does when its drone goes away (a failed service call, a crash) is counted.
+    limit, by_budget = budget.limit(job['run_timeout'], RUN_STOP_S)
     wait_until(lambda: os.path.isfile(result_path) or probe.poll() is not None or master.proc.poll() is not None,
-               job['run_timeout'], period=0.1)
+               limit, period=0.1)
     record['seconds'] = time.monotonic() - started
+    if by_budget and not os.path.isfile(result_path) and probe.poll() is None:
+        record['budget'] = budget.spend('the %s run was stopped after %.0f s' % (tag, record['seconds']))
     record['probe_uid'] = uid_of(probe.pid)  # lingering: its uid is the one it measured as
     record['launch_running'] = launch.poll() is None
     master_died = master.proc.poll() is not None
@@ -259,6 +328,7 @@ def run_one(sup, job, run, base_env, box):
         if not isinstance(record['probe'], dict):
             record['probe'] = None
             record.setdefault('probe_error', 'result unreadable: not an object')
+        record['launch']['ended'].extend(watched_deaths(record['probe']))  # whether or not the run is refused
     if record['probe'] is not None:
         with open(os.path.join(log_dir, 'probe-%s.json' % tag), 'w') as f:
             json.dump(record['probe'], f, indent=1, sort_keys=True)
@@ -266,8 +336,11 @@ def run_one(sup, job, run, base_env, box):
         if problem:
             record['probe'], record['probe_error'] = None, 'result refused: %s' % problem
             record['probe_refused'] = problem
+    elif 'probe_error' not in record and record.get('budget'):
+        record['probe_error'] = record['budget']
     elif 'probe_error' not in record:
-        record['probe_error'] = ('no result within %.0f s; ' % job['run_timeout'] if probe.poll() is None else
+        record['probe_error'] = ('no result within the run\'s time limit (%.0f s); ' % job['run_timeout']
+                                 if probe.poll() is None else
                                  'exit %s; ' % probe.poll()) + tail(sup.output('probe-%s' % tag), 15)
     record['probe_status'] = sup.stop(probe, grace=5.0)
     sup.stop(master.proc)
@@ -292,21 +365,33 @@ def session(job):
     os.chmod(judge_dir, 0o700)
     judge_env = dict(os.environ, ROS_IP='127.0.0.1', HOME=judge_dir, PYTHONNOUSERSITE='1',
                      ROS_LOG_DIR=os.path.join(judge_dir, 'ros_log'), ROS_HOME=os.path.join(judge_dir, 'ros_home'))
+    budget = Budget(job['budget'], job['student_budget'])
     with Supervisor(job['log_dir'], env=judge_env) as sup:
         base_env = workspace_env(job['underlay'], {'PATH': os.environ.get('PATH', '/usr/bin:/bin'),
                                                    'LANG': 'C.UTF-8'})
+        # roslaunch's verdict first: nothing of the student's has run yet (no build, no environment hook).
+        limit, by_budget = budget.limit(LAUNCH_CHECK_TIMEOUT, STEP_STOP_S)
+        result['launch_check'] = launch_verdict(sup, job, base_env, box, timeout=limit)
+        result['survivors'] += box.end()
+        if by_budget and (result['launch_check'] or {}).get('status', 0) is None:
+            result['budget_used'] = result['error'] = budget.spend(
+                'roslaunch\'s check of the launch file was stopped after %.0f s' % limit)
+            return result
+        limit, by_budget = budget.limit(job['build_timeout'], STEP_STOP_S)
         status, _, seconds = sup.run(
             'build', box.argv(['catkin_make', '--directory', job['workspace'],
                                '-DPYTHON_EXECUTABLE=/usr/bin/python3', '-DCATKIN_ENABLE_TESTING=OFF'],
                               dict(base_env, ROS_HOME=os.path.join(box.home, 'ros'))),
-            timeout=job['build_timeout'])
+            timeout=limit)
         result['survivors'] += box.end()
         result['build'] = {'status': status, 'seconds': seconds, 'tail': tail(capped_log(sup, 'build')),
-                           'timeout': job['build_timeout']}
+                           'timeout': limit}
+        if status is None:
+            result['build']['stopped'] = budget.spend('catkin_make was stopped after %.0f s, nothing was run' % seconds) \
+                if by_budget else 'catkin_make did not finish within the build\'s time limit (%.0f s)' % limit
         if status != 0:
+            result['budget_used'] = budget.used
             return result
-        result['launch_check'] = launch_verdict(sup, job, base_env, box)
-        result['survivors'] += box.end()
         for run in job['runs']:
             if run['tag'] == 'threshold':
                 main = result['runs'][0]['probe'] if result['runs'] else None
@@ -315,14 +400,18 @@ def session(job):
                     break
                 run = dict(run, plan=dict(run['plan'], fit=main['calibration'].get('fit'),
                                           warn_after=warning_latency(main)))
-            result['runs'].append(run_one(sup, job, run, base_env, box))
+            if budget.left(RUN_STOP_S) < MIN_RUN_S:
+                budget.spend('the %s run was not started (%.0f s left)' % (run['tag'], budget.left()))
+                break
+            result['runs'].append(run_one(sup, job, run, base_env, box, budget))
             result['survivors'] += result['runs'][-1]['survivors']
+        result['budget_used'] = budget.used
     return result
 
 
 def main(argv):
     if len(argv) != 1:
-        sys.stderr.write('usage: python3 -m exam_lab.grader.judge.session JOB.json\n')
+        sys.stderr.write('usage: python3 -m exam_lab.grader.host.session JOB.json\n')
         return 2
     with open(argv[0]) as f:
         job = json.load(f)
