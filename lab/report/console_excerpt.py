@@ -47,9 +47,9 @@ def block(first, last, lines, date, commit):
                       '', '```'] + lines + ['```', END])
 
 
-def splice(text, new_block):
-    """``text`` with the block between BEGIN and END (markers included) replaced by ``new_block``."""
-    start, end = text.index(BEGIN), text.index(END) + len(END)
+def splice(text, new_block, begin=BEGIN, end=END):
+    """``text`` with the block between ``begin`` and ``end`` (markers included) replaced by ``new_block``."""
+    start, end = text.index(begin), text.index(end) + len(end)
     return text[:start] + new_block + text[end:]
 
 

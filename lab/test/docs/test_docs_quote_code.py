@@ -10,6 +10,7 @@ moved out of reach of its check is not a guarded one). Each check is held to a w
 import glob
 import os
 import re
+import sys
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -18,6 +19,10 @@ from exam_lab.grader import runner
 from exam_lab.grader.publish import provenance
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
+sys.path.insert(0, os.path.join(REPO, 'lab', 'report'))
+
+import calibration  # noqa: E402  (lab/report is a script folder, not a package)
+
 GRADER = os.path.join(REPO, 'lab', 'src', 'exam_lab', 'grader')
 GRADING = os.path.join(REPO, 'docs', 'grading.md')
 ARCHITECTURE = os.path.join(REPO, 'docs', 'architecture.md')
@@ -319,3 +324,484 @@ def test_the_report_prints_the_whole_simple_answer():
                  'launch/exam.launch', 'launch/exam_submarine.launch'):
         body = read(os.path.join(REPO, 'docs', 'simple_answer', 'exam', path)).rstrip()
         assert body in appendix, path
+
+
+# --- the benchmarks' hand-written analysis ---------------------------------------------------------
+
+BENCH = os.path.join(REPO, 'lab', 'bench')
+
+
+def bench_results():
+    import json
+    with open(os.path.join(BENCH, 'results.json')) as f:
+        return json.load(f)
+
+
+def per_node_cpu_quoted(text):
+    """(low, high, cpu of 20, each of 20, cpu of 100, each of 100) of "CPU at L to H % of a core per exam
+    node (A % for 20: a % each; B % for 100: b % each)"."""
+    found = re.search(r'CPU at ([\d.]+) to ([\d.]+) % of a core per exam node \(([\d.]+) % for 20: ([\d.]+) % '
+                      r'each; ([\d.]+) % for 100: ([\d.]+) % each\)', text)
+    return found.groups() if found else None
+
+
+def per_node_cpu_expected(results):
+    fleet = results['ours']['fleet']
+    twenty, hundred = fleet['20']['cpu_percent']['exam'], fleet['100']['cpu_percent']['exam']
+    each = sorted([twenty / 20, hundred / 100])
+    return ('%.2f' % each[0], '%.2f' % each[1], '%.1f' % twenty, '%.2f' % (twenty / 20), '%.1f' % hundred,
+            '%.2f' % (hundred / 100))
+
+
+def test_the_analysis_per_node_cpu_is_the_fleet_tables_divided():
+    quoted = per_node_cpu_quoted(prose(read(os.path.join(BENCH, 'analysis.md'))))
+    assert quoted is not None, 'lab/bench/analysis.md no longer says "CPU at L to H % of a core per exam node (...)"'
+    assert quoted == per_node_cpu_expected(bench_results())
+
+
+def test_the_per_node_cpu_check_catches_a_rounded_range():
+    stale = 'CPU at 0.5 to 0.6 % of a core per exam node (11.7 % for 20: 0.6 % each; 48.1 % for 100: 0.5 % each)'
+    assert per_node_cpu_quoted(stale) != per_node_cpu_expected(bench_results())
+
+
+def history_figures_quoted(text):
+    """[(file, [figures])] of every "a / b / c / d (`fleet-master-*.json`)" of a text."""
+    return [(name, figures.split(' / ')) for figures, name in
+            re.findall(r'((?:[\d.]+ / )+[\d.]+)\*{0,2} \(`(fleet-master-[\w-]+\.json)`\)', text)]
+
+
+def history_master_cpu(name):
+    import json
+    with open(os.path.join(BENCH, 'history', name)) as f:
+        fleet = json.load(f)['ours']['fleet']
+    return ['%.1f' % fleet[n]['master_cpu_percent'] for n in sorted(fleet, key=int)]
+
+
+def test_the_masters_cpu_figures_are_their_history_files():
+    quoted = history_figures_quoted(prose(read(os.path.join(BENCH, 'analysis.md'))))
+    assert len(quoted) >= 4, quoted
+    for name, figures in quoted:
+        assert figures == history_master_cpu(name), name
+
+
+def test_the_history_check_catches_a_figure_of_another_file():
+    swapped = '0.4 / 1.0 / 1.5 / 3.2 (`fleet-master-0551.json`)'
+    (name, figures), = history_figures_quoted(swapped)
+    assert figures != history_master_cpu(name)
+
+
+def test_the_analysis_explains_the_delay_the_latency_stage_used():
+    delay = bench_results()['config']['delay']
+    text = prose(read(os.path.join(BENCH, 'analysis.md')))
+    quoted = re.findall(r"with the stage's `~delay` of ([\d.]+) s it counts `delay_ticks` = (\d+) ticks", text)
+    assert quoted == [('%g' % delay, '%d' % round(delay * 10))], quoted
+
+
+# --- the grader's speed, quoted from the benchmark's grader section --------------------------------
+
+def grader_bench_quoted(section):
+    """What lab/bench/grader.md measured: {'date', 'commit', 'alone': (n, wall, low, high, cpu),
+    'classes': {jobs: (students, wall)}, 'packages': {name: seconds}}."""
+    head = re.search(r'on (\d{4}-\d\d-\d\d \d\d:\d\d) \(UTC\).*? at commit ([0-9a-f]+)', section)
+    alone = re.search(r'\| each of (\d+) packages alone \(JOBS=1\) \| (\d+) s \| (\d+)-(\d+) s \| (\d+) s \|', section)
+    return {'date': head.group(1), 'commit': head.group(2), 'alone': alone.groups(),
+            'classes': {jobs: (n, wall) for n, jobs, wall in
+                        re.findall(r'^\| class of (\d+), JOBS=(\d+) \| (\d+) s \|', section, re.M)},
+            'packages': dict(re.findall(r'^\| (\w+) \| [\d.]+ \| (\d+) s \|$', section, re.M))}
+
+
+def speed_problems(speed, measured):
+    """What the Speed paragraph of docs/grading.md says that the grader section did not measure."""
+    problems = []
+    for name, seconds in re.findall(r'`(\w+)`: (\d+) s', speed):
+        if measured['packages'].get(name) != seconds:
+            problems.append('%s: %s s quoted, %s s measured' % (name, seconds, measured['packages'].get(name)))
+    run = re.search(r'on (\d{4}-\d\d-\d\d \d\d:\d\d) UTC \(commit ([0-9a-f]+)\)', speed)
+    if run is None or run.groups() != (measured['date'], measured['commit']):
+        problems.append('the run quoted is not the grader section\'s (%s at %s)' % (measured['date'], measured['commit']))
+    alone = re.search(r'the (\d+) packages of that day .*? took (\d+) to (\d+) s each \((\d+) s in all; (\d+) s of CPU', speed)
+    n, wall, low, high, cpu = measured['alone']
+    if alone is None or alone.groups() != (n, low, high, wall, cpu):
+        problems.append('the packages graded alone: %s' % (alone.groups() if alone else 'not quoted'))
+    classes = re.findall(r'(\d+) s (?:\([\d.]+ minutes\) )?with `JOBS=(\d+)`', speed)
+    if not classes or any(measured['classes'].get(jobs, (None, None))[1] != wall for wall, jobs in classes):
+        problems.append('the classes: %s quoted, %s measured' % (classes, measured['classes']))
+    for wall, minutes, jobs in re.findall(r'(\d+) s \(([\d.]+) minutes\) with `JOBS=(\d+)`', speed):
+        if '%.1f' % (int(wall) / 60.0) != minutes:
+            problems.append('%s s is not %s minutes' % (wall, minutes))
+    return problems
+
+
+def speed_paragraph():
+    text = prose(read(GRADING))
+    return text[text.index('## Speed'):text.index('The sandbox costs nothing')]
+
+
+def test_the_speed_paragraph_quotes_the_benchmarks_grader_section():
+    measured = grader_bench_quoted(read(os.path.join(BENCH, 'grader.md')))
+    assert len(measured['packages']) == int(measured['alone'][0])
+    speed = speed_paragraph()
+    assert len(re.findall(r'`(\w+)`: (\d+) s', speed)) >= 5
+    assert speed_problems(speed, measured) == []
+
+
+def test_the_speed_check_catches_a_typed_time():
+    measured = grader_bench_quoted(read(os.path.join(BENCH, 'grader.md')))
+    speed = speed_paragraph()
+    assert speed_problems(speed.replace('`late_warning`: 132 s', '`late_warning`: 134 s'), measured) == [
+        'late_warning: 134 s quoted, 132 s measured']
+    assert len(speed_problems(speed.replace('826 s (13.8', '826 s (13.9'), measured)) == 1
+    assert len(speed_problems(speed.replace('585 s with', '590 s with'), measured)) == 1
+
+
+# --- the test packages' table ----------------------------------------------------------------------
+
+SUBMISSIONS = os.path.join(REPO, 'lab', 'test', 'grader', 'submissions')
+
+
+def package_table_rows(text):
+    """The packages named by the first cell of the rows of the test-package tables of docs/grading.md's
+    Tests section ("| `no_kelvin` | ..." or "| `wrong_topic` (depth) | ..."); rows made by the test from
+    another package ("made from") are not folders and are left out."""
+    tests = text[text.index('\n## Tests'):]
+    tests = tests[:tests.index('\n## ', 1)]
+    names = []
+    for line in tests.splitlines():
+        cell = re.match(r'^\| `(\w+)`([^|]*)\|', line)
+        if cell and 'made from' not in cell.group(2):
+            names.append(cell.group(1))
+    return names
+
+
+def test_every_test_package_has_a_row_and_every_row_a_package():
+    folders = sorted(d for d in os.listdir(SUBMISSIONS) if os.path.isdir(os.path.join(SUBMISSIONS, d)))
+    rows = package_table_rows(read(GRADING))
+    assert len(rows) == len(set(rows)), 'a package has two rows'
+    assert sorted(rows) == folders, ('no row for %s; a row without a folder: %s'
+                                     % (sorted(set(folders) - set(rows)), sorted(set(rows) - set(folders))))
+
+
+def test_the_package_table_check_catches_a_missing_row():
+    text = ('\n## Tests\n\n| package | flaw |\n|---|---|\n| `no_kelvin` | degC |\n| `wrong_topic` (depth) | x |\n'
+            '| `windows_zip` (made from `good_student`) | CRLF |\n\n## Determinism\n| `not_here` | x |\n')
+    assert package_table_rows(text) == ['no_kelvin', 'wrong_topic']
+
+
+def grade_test_expectations():
+    """{package: its total} of lab/test/grader/test_grade.py's EXPECTED and FAIR_EXPECTED (the tested
+    truth): full marks less what each package loses."""
+    module = calibration.load_expectations()
+    totals = {}
+    for expected in (module.EXPECTED, module.FAIR_EXPECTED):
+        for name, points in expected.items():
+            totals[name] = sum(dict(module.FULL, **points).values())
+    return totals
+
+
+def package_table_points(text):
+    """{package: points} of the test-package tables' rows."""
+    tests = text[text.index('\n## Tests'):]
+    tests = tests[:tests.index('\n## ', 1)]
+    return {name: float(points) for name, points in
+            re.findall(r'^\| `(\w+)`[^|]*\|[^|]*\| ([\d.]+) \|', tests, re.M)}
+
+
+def test_the_package_tables_points_are_the_grader_tests_expectations():
+    totals = grade_test_expectations()
+    quoted = package_table_points(read(GRADING))
+    assert set(quoted) <= set(totals), set(quoted) - set(totals)
+    assert {name: totals[name] for name in quoted} == quoted
+
+
+def test_the_points_check_catches_a_typed_total():
+    totals = grade_test_expectations()
+    assert package_table_points('\n## Tests\n| `no_kelvin` | degC | 15 | Q11 |\n\n## Next\n') == {'no_kelvin': 15.0}
+    assert totals['no_kelvin'] == 15.5
+
+
+# --- outputs the docs quote, made again by the code that prints them --------------------------------
+
+def quoted_output(pattern, text=None):
+    """The one output of docs/grading.md that ``pattern`` finds (its first group), line breaks folded."""
+    found = re.findall(pattern, prose(read(GRADING)) if text is None else text)
+    assert len(found) == 1, 'docs/grading.md no longer quotes %r once: %s' % (pattern, found)
+    return found[0]
+
+
+def not_scaled_problems(text=None):
+    from exam_lab.grader.publish import moodle
+    quote = quoted_output(r'`(NOT SCALED: [^`]+)`', text)
+    maximum, machine = re.match(r"NOT SCALED: the worksheet's maximum grade is ([\d.]+), .* out of ([\d.]+)$", quote).groups()
+    lines = moodle.summary_lines({'graded': [], 'machine_max': [float(machine)], 'maxima': [float(maximum)],
+                                  'scaled': False, 'kept': [], 'unmatched': [], 'no_submission': []}, 'w.csv')
+    return [] if any(quote in line for line in lines) else ['not printed: %s' % quote]
+
+
+def test_the_not_scaled_line_is_the_worksheets():
+    assert not_scaled_problems() == []
+
+
+def test_the_not_scaled_check_catches_a_reworded_line():
+    text = prose(read(GRADING)).replace('the grades written are', 'the grades are')
+    assert len(not_scaled_problems(text)) == 1
+
+
+def synthetic_grade(total_before=None):
+    from exam_lab.grader.publish import report
+    from exam_lab.grader.score.sheets import ITEMS
+    record = report.grade_record('late', 'altitude', [{'id': i, 'points': p, 'max': p, 'evidence': 'ok'}
+                                                      for i, (p, _) in ITEMS.items()], [])
+    if total_before is not None:
+        record['provenance'] = {'how': 'rescore', 'grader': 'abc', 'rubric': 'def', 'machine': 'vm', 'date': 'd'}
+        record['previous'] = {'total': total_before, 'status': 'graded'}
+    return record
+
+
+def feedback_problems(text=None):
+    import html
+    from exam_lab.grader.publish import moodle
+    quote = quoted_output(r'\("(The grade is out of [^"]+)"\)', text)
+    maximum = float(re.search(r'the maximum grade ([\d.]+)', quote).group(1))
+    return [] if quote in html.unescape(moodle.feedback(synthetic_grade(), maximum=maximum)) else [
+        'not in the feedback comment: %s' % quote]
+
+
+def test_the_feedback_comment_quoted_is_moodles():
+    assert feedback_problems() == []
+
+
+def test_the_feedback_check_catches_a_reworded_comment():
+    text = prose(read(GRADING)).replace("(the machine's items), not out of", "(the machine's items), not of")
+    assert len(feedback_problems(text)) == 1
+
+
+def rescored_problems(text=None):
+    from exam_lab.grader.publish import report
+    quote = quoted_output(r'\("Rescored \.\.\. (Before: [^"]+)"\)', text)
+    before = float(re.match(r'Before: ([\d.]+)', quote).group(1))
+    line = [l for l in report.markdown(synthetic_grade(before)).splitlines() if l.startswith('Rescored')]
+    return [] if line and quote in line[0] else ['grade.md does not say %r: %s' % (quote, line)]
+
+
+def test_the_rescored_line_is_grade_mds():
+    assert rescored_problems() == []
+
+
+def test_the_rescored_check_catches_a_typed_line():
+    assert len(rescored_problems(prose(read(GRADING)).replace('Before: 15.5 / 17', 'Before: 15.5 of 17'))) == 1
+
+
+def format_literal(path, literal):
+    """``literal`` (a format string) as the code has it, or a failure naming where it was looked for."""
+    assert literal in read(os.path.join(REPO, path)), '%s no longer formats its line with %s' % (path, literal)
+    return literal
+
+
+def rescore_change_problems(text=None):
+    """The rescore's line quoted (``late: 17 -> 15.5 (Q14b 3 -> 1.5)``) against runner.rescore_class's
+    two formats, and its arithmetic: the total moves by what the items moved."""
+    quote = quoted_output(r'`(\w+: [\d.]+ -> [\d.]+ \([^`]*\))`', text)
+    line = format_literal('lab/src/exam_lab/grader/runner.py', "'%s: %s -> %s (%s)'").strip("'")
+    item = format_literal('lab/src/exam_lab/grader/runner.py', "'%s %s -> %s'").strip("'")
+    student, old, new, moved = re.match(r'(\w+): ([\d.]+) -> ([\d.]+) \((.*)\)$', quote).groups()
+    items = [re.match(r'(\w+) ([\d.]+) -> ([\d.]+)$', m).groups() for m in moved.split('; ')]
+    problems = []
+    if line % (student, old, new, '; '.join(item % i for i in items)) != quote:
+        problems.append('not the runner\'s form: %s' % quote)
+    if abs((float(new) - float(old)) - sum(float(b) - float(a) for _, a, b in items)) > 1e-9:
+        problems.append('the total moves by %s, its items by another amount' % quote)
+    return problems
+
+
+def test_the_rescore_change_line_is_the_runners():
+    assert rescore_change_problems() == []
+
+
+def test_the_rescore_change_check_catches_wrong_arithmetic():
+    text = prose(read(GRADING)).replace('Q14b 3 -> 1.5', 'Q14b 3 -> 2')
+    assert rescore_change_problems(text) == ['the total moves by late: 17 -> 15.5 (Q14b 3 -> 2), its items by another amount']
+
+
+def missing_hand_points_problems(text=None):
+    """The worksheet's line for a student without all hand points (``Paul Martin: Q5, Q6, ...``):
+    worksheet.py's format, hand items of score/sheets.py in their order."""
+    from exam_lab.grader.score.sheets import HAND_ITEMS
+    format_literal('lab/scripts/worksheet.py',
+                   "'  %s: %s' % (safe_text.one_line(record['student']), ', '.join(record['missing']))")
+    quote = quoted_output(r'\(`([A-Z][\w ]+: (?:\w+, )+\.\.\.)`\)', text)
+    named = quote.split(': ', 1)[1].split(', ')[:-1]
+    if not named or not set(named) <= set(HAND_ITEMS):
+        return ['not hand items: %s' % named]
+    return [] if named == [i for i in HAND_ITEMS if i in named] else ['not in the order worksheet.py lists them']
+
+
+def test_the_worksheets_missing_hand_points_line_is_the_scripts():
+    assert missing_hand_points_problems() == []
+
+
+def test_the_missing_hand_points_check_catches_a_wrong_item():
+    assert missing_hand_points_problems(prose(read(GRADING)).replace('Q5, Q6, ...', 'Q11, Q6, ...')) == [
+        "not hand items: ['Q11', 'Q6']"]
+    assert missing_hand_points_problems(prose(read(GRADING)).replace('Q5, Q6, ...', 'Q6, Q5, ...')) == [
+        'not in the order worksheet.py lists them']
+
+
+def slurm_problems(text=None):
+    from exam_lab.grader import runner
+    from exam_lab.grader.engine import slurm
+    problems = []
+    state = quoted_output(r'`(slurm job [^`]+)`', text)
+    counts = re.match(r'slurm job (\d+): (\d+) pending, (\d+) running, (\d+) done of (\d+)$', state)
+    if counts is None:
+        return ['not the engine\'s state line: %s' % state]
+    job, pending, running, done, total = counts.groups()
+    tasks = dict(enumerate([('PENDING', 0)] * int(pending) + [('RUNNING', 0)] * int(running)))
+    if slurm.state_line([job], tasks, int(done), 0, int(total)) != state:
+        problems.append('not the engine\'s state line: %s' % state)
+    said = quoted_output(r'`(could not grade: Slurm said: [^`]+)`', text)
+    fields = dict(zip(('JobState', 'ExitCode'), re.match(r'could not grade: Slurm said: (\w+), exit code ([\d:]+)$',
+                                                         said).groups()))
+    reason = runner.could_not_grade('x', 'altitude', 'Slurm said: %s' % slurm.slurm_said(fields))['status_reason']
+    if reason != said:
+        problems.append('not the engine\'s reason: %s (it says %s)' % (said, reason))
+    return problems
+
+
+def test_the_slurm_lines_quoted_are_the_engines():
+    assert slurm_problems() == []
+
+
+def test_the_slurm_check_catches_a_typed_line():
+    text = prose(read(GRADING)).replace('0 done of 3', '0 of 3 done')
+    assert len(slurm_problems(text)) == 1
+
+
+# --- the teacher's quick start and its calibration table -------------------------------------------
+
+def calibration_block(text):
+    begin, end = text.find(calibration.BEGIN), text.find(calibration.END)
+    assert 0 <= begin < end, 'docs/grading.md has no calibration block between its markers'
+    return text[begin:end + len(calibration.END)]
+
+
+def test_the_calibration_table_is_the_grader_tests_truth():
+    assert calibration_block(read(GRADING)) == calibration.block(), 'run python3 lab/report/calibration.py'
+
+
+def test_the_calibration_check_catches_a_typed_point_and_a_package_left_out():
+    block = calibration.block()
+    assert calibration_block(block.replace('15.5 / 17 (Q11 1.5)', '16 / 17 (Q11 1)')) != block
+    tested = calibration.load_expectations()
+    tested.EXPECTED = dict(tested.EXPECTED, new_mistake={'Q10': 1.0})
+    with pytest.raises(ValueError, match='new_mistake'):
+        calibration.rows(tested)
+
+
+def class_of_60_problems(quick):
+    """What the quick start's "a class of 60 took N s (M minutes) at the default JOBS=J ... run of DATE"
+    says that the benchmark's grader section did not measure."""
+    measured = grader_bench_quoted(read(os.path.join(BENCH, 'grader.md')))
+    default = str(runner.default_jobs(cores=2, memory=24 << 30))
+    wall = measured['classes'][default][1]
+    quoted = re.search(r'a class of 60 took (\d+) s \(([\d.]+) minutes\) at the default JOBS=(\d+) .*?run of '
+                       r'(\d{4}-\d\d-\d\d \d\d:\d\d) UTC', quick)
+    if quoted is None:
+        return ['the quick start no longer quotes the class of 60']
+    expected = (wall, '%.1f' % (int(wall) / 60.0), default, measured['date'])
+    return [] if quoted.groups() == expected else ['%s quoted, %s measured' % (quoted.groups(), expected)]
+
+
+def quick_start():
+    text = read(GRADING)
+    first = re.findall(r'^## .*$', text, re.M)[0]
+    assert first == "## A teacher's quick start", 'the quick start does not open docs/grading.md'
+    return prose(text[text.index(first):text.index(calibration.BEGIN)])
+
+
+def test_the_quick_start_opens_the_page_and_quotes_the_class_of_60():
+    quick = quick_start()
+    assert class_of_60_problems(quick) == []
+    for status in ('graded', 'graded with fixes', 'needs a hand grade', 'not graded'):
+        assert '| `%s` |' % status in quick
+
+
+def test_the_class_of_60_check_catches_a_rounded_time():
+    assert len(class_of_60_problems(quick_start().replace('826 s (13.8 minutes)', '826 s (14 minutes)'))) == 1
+    assert len(class_of_60_problems(quick_start().replace('2026-11-25 18:54', '2026-11-24 18:54'))) == 1
+
+
+# --- README's make run timings ---------------------------------------------------------------------
+
+def run_timing_problems(readme, banner_script):
+    """What is wrong with README's block of lab/report/run_timing.py: [] when it is there, dated, at a
+    commit of this repository, and its times keep the banner's promises (tools/run_launch.sh: "RED
+    about N s from now, GREEN again about M s later") within 5 s."""
+    import subprocess
+    import run_timing
+    begin, end = readme.find(run_timing.BEGIN), readme.find(run_timing.END)
+    if not 0 <= begin < end:
+        return ['no run timing block between its markers']
+    found = re.search(r'on (\d{4}-\d\d-\d\d \d\d:\d\d) UTC at commit ([0-9a-f]{7,40})(\+changes)?: `data: "RED"` '
+                      r'([\d.]+) s after that banner, `data: "GREEN"` ([\d.]+) s after it\..*?RED ([\d.]+) s, GREEN '
+                      r'([\d.]+) s after the banner', prose(readme[begin:end]))
+    if found is None:
+        return ['the block does not say which run, which commit and both launches\' times']
+    problems = []
+    if subprocess.run(['git', '-C', REPO, 'cat-file', '-e', found.group(2) + '^{commit}'],
+                      stderr=subprocess.DEVNULL).returncode != 0:
+        problems.append('commit %s is not in this repository' % found.group(2))
+    red_in, green_after = (float(x) for x in re.search(r'RED about (\d+) s from now, GREEN again about (\d+) s later',
+                                                       banner_script).groups())
+    for red, green in ((found.group(4), found.group(5)), (found.group(6), found.group(7))):
+        if abs(float(red) - red_in) > 5 or abs(float(green) - float(red) - green_after) > 5:
+            problems.append('the banner promises RED about %g s, GREEN %g s later; measured %s and %s'
+                            % (red_in, green_after, red, green))
+    return problems
+
+
+def test_readmes_run_timings_are_a_dated_run_keeping_the_banners_promises():
+    banner = read(os.path.join(REPO, 'tools', 'run_launch.sh'))
+    assert run_timing_problems(read(README), banner) == []
+
+
+def test_the_run_timing_check_catches_a_broken_promise():
+    readme, banner = read(README), read(os.path.join(REPO, 'tools', 'run_launch.sh'))
+    assert len(run_timing_problems(readme, banner.replace('RED about 50 s', 'RED about 40 s'))) == 2
+    assert run_timing_problems(readme.replace('at commit ', 'at commit 0000000'), banner) != []
+
+
+def rendered_benchmarks(analysis=None):
+    """docs/benchmarks.md as `BENCH_RENDER_ONLY=1 make bench` renders it from lab/bench/results.json,
+    lab/bench/analysis.md and lab/bench/grader.md (lab/bench/report.py; nothing measured)."""
+    sys.path.insert(0, BENCH)
+    import report
+    results = bench_results()
+    results['analysis'] = read(os.path.join(BENCH, 'analysis.md')) if analysis is None else analysis
+    return report.render(results, os.path.join('figures', 'bench_fleet.png'))
+
+
+def test_benchmarks_md_is_the_render_of_its_results_never_edited_by_hand():
+    assert read(os.path.join(REPO, 'docs', 'benchmarks.md')) == rendered_benchmarks(), (
+        'docs/benchmarks.md differs from its sources: edit lab/bench/analysis.md or report.py, then '
+        'BENCH_RENDER_ONLY=1 make bench')
+
+
+def test_the_render_check_catches_an_edit():
+    analysis = read(os.path.join(BENCH, 'analysis.md'))
+    assert rendered_benchmarks(analysis.replace('0.48 to 0.59', '0.5-0.6')) != read(
+        os.path.join(REPO, 'docs', 'benchmarks.md'))
+
+
+def scripts_not_named(text, folder):
+    """The Python files of ``folder`` that ``text`` does not name (as `name.py`)."""
+    return sorted(os.path.basename(p) for p in glob.glob(os.path.join(folder, '*.py'))
+                  if '`%s`' % os.path.basename(p) not in text)
+
+
+def test_architecture_names_every_script_of_lab_report():
+    assert scripts_not_named(read(ARCHITECTURE), os.path.join(REPO, 'lab', 'report')) == []
+
+
+def test_the_script_list_check_catches_a_script_left_out():
+    text = read(ARCHITECTURE).replace('`run_timing.py`', 'run_timing')
+    assert scripts_not_named(text, os.path.join(REPO, 'lab', 'report')) == ['run_timing.py']
