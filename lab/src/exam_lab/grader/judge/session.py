@@ -32,7 +32,9 @@ import re
 import sys
 import time
 
-from exam_lab.grader.host.sandbox import FILE_CAP, Box, memory_use, read_capped, reset_memory_peak
+from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
+from exam_lab.grader.host.egress import FILE_CAP, read_capped
+from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
