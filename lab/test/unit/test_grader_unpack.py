@@ -1,5 +1,6 @@
 """Unpacking what students upload: unsafe archives refused as a whole, the package found."""
 import os
+import re
 import stat
 import zipfile
 
@@ -54,6 +55,36 @@ def test_not_a_zip(tmp_path):
     path.write_text('not a zip')
     with pytest.raises(archives.UnpackError, match='not a readable zip'):
         archives.safe_extract(str(path), str(tmp_path / 'out'))
+
+
+def unreadable_zip(path, how):
+    """A zip whose listing reads but whose bytes cannot be had: ``crc`` (one byte of its data changed, as
+    a cut or damaged download), ``encrypted`` (its entry flagged password-protected in both headers, as
+    a zip a student made with a password: APPNOTE.TXT 4.4.4, general purpose bit 0)."""
+    make_zip(path, [('exam/package.xml', PACKAGE_XML)])
+    data = bytearray(path.read_bytes())
+    if how == 'crc':
+        with zipfile.ZipFile(str(path)) as zf:
+            info = zf.infolist()[0]
+        data[info.header_offset + 30 + len(info.filename) + 1] ^= 0xff  # a byte of the compressed data
+    else:
+        for signature, offset in ((b'PK\x03\x04', 6), (b'PK\x01\x02', 8)):  # local, central header
+            data[data.index(signature) + offset] |= 0x1
+    path.write_bytes(bytes(data))
+    return str(path)
+
+
+@pytest.mark.parametrize('how', ['crc', 'encrypted'])
+def test_a_zip_whose_bytes_cannot_be_read_is_refused_with_why(tmp_path, how):
+    """A damaged or password-protected upload is refused with the reason for the teacher, as a class
+    archive's student is (classlist), never a crash of the inspection."""
+    (tmp_path / 'upload').mkdir()
+    archive = unreadable_zip(tmp_path / 'upload' / 'exam.zip', how)
+    why = {'crc': "Bad CRC-32 for file 'exam/package.xml'", 'encrypted': 'it is encrypted (made with a password)'}[how]
+    with pytest.raises(archives.UnpackError, match=re.escape('exam.zip cannot be unpacked: %s' % why)):
+        archives.safe_extract(archive, str(tmp_path / 'out'))
+    with pytest.raises(archives.UnpackError, match=re.escape('exam.zip (refused: exam.zip cannot be unpacked: %s' % why)):
+        package.open_submission(str(tmp_path / 'upload'), str(tmp_path / 'scratch'), [])
 
 
 @pytest.mark.parametrize('prefix', ['', 'exam_jdupont/', 'catkin_ws/src/'])

@@ -17,6 +17,7 @@ import re
 import stat
 import tarfile
 import zipfile
+import zlib
 
 #: Most files one submission may unpack, all its archives together (a package has tens).
 MAX_FILES = 5000
@@ -45,6 +46,9 @@ _UNSUPPORTED = ((b'Rar!\x1a\x07', 'a RAR archive'), (b'7z\xbc\xaf\x27\x1c', 'a 7
                 (b'\x1f\x8b', 'a gzip file that holds no tar'), (b'BZh', 'a bzip2 file that holds no tar'),
                 (b'\xfd7zXZ\x00', 'an xz file that holds no tar'), (b'%PDF', 'a PDF document'))
 _KIND_WORDS = {'zip': 'zip', 'tar': 'tar archive'}
+#: What reading an entry's bytes raises when the archive cannot give them: encrypted (a password-protected
+#: zip), corrupt (a bad CRC, a cut file), or compressed as zipfile cannot read.
+UNREADABLE = (zipfile.BadZipFile, tarfile.TarError, zlib.error, EOFError, OSError, RuntimeError, NotImplementedError)
 #: A byte that is not UTF-8 as repr() shows its surrogate escape (``\\udcff``).
 _ESCAPED_BYTE = re.compile(r'(?<!\\)((?:\\\\)*)\\udc([89a-f][0-9a-f])')  # not after an escaped backslash
 #: At most this many notes of one kind (links dropped, duplicates) are listed; the rest are counted.
@@ -292,11 +296,18 @@ def safe_extract(archive, target, max_files=MAX_FILES, max_bytes=MAX_BYTES, max_
                 write_plan(plan, target, opened.open, _zip_mode)
             else:
                 write_plan(plan, target, opened.extractfile, lambda member: member.mode & 0o777)
-        except (zipfile.BadZipFile, tarfile.TarError, EOFError) as err:
-            raise UnpackError('%s is not a readable %s: %s' % (label, _KIND_WORDS[kind], err))
+        except UNREADABLE as err:
+            raise UnpackError('%s cannot be unpacked: %s' % (label, unreadable_why(err)))
     notes.extend(plan.notes())
     fixes.extend(plan.link_notes())
     return len(plan.files)
+
+
+def unreadable_why(err):
+    """Words for the teacher on an error of :data:`UNREADABLE`."""
+    if isinstance(err, RuntimeError) and 'encrypted' in str(err):  # zipfile: "File ... is encrypted, ..."
+        return 'it is encrypted (made with a password): ask for it without one'
+    return str(err)
 
 
 def _plan_zip(zf, label, max_ratio):

@@ -9,12 +9,11 @@ student only. Names are cleaned by :func:`~exam_lab.grader.score.identity.studen
 import os
 import shutil
 import tarfile
-import zipfile
-import zlib
 
 from exam_lab.grader.boxed import archives
-from exam_lab.grader.boxed.archives import (ARCHIVE_ENDINGS, SKIPPED_DIRS, Plan, UnpackError, open_archive, shown_name,
-                                            tar_entries, without_ending, write_plan, zip_entries)
+from exam_lab.grader.boxed.archives import (ARCHIVE_ENDINGS, SKIPPED_DIRS, UNREADABLE, Plan, UnpackError, open_archive,
+                                            shown_name, tar_entries, unreadable_why, without_ending, write_plan,
+                                            zip_entries)
 from exam_lab.grader.score.identity import student_name
 
 #: A class archive ("download all submissions") holds every student's uploads: its bounds as a whole
@@ -172,6 +171,5 @@ def _write_student(opened, kind, target, plan):
     the plan's one file is the student's key)."""
     try:
         write_plan(plan, target, opened.open if kind == 'zip' else opened.extractfile)
-    except (zipfile.BadZipFile, tarfile.TarError, zlib.error, EOFError, OSError, RuntimeError,
-            NotImplementedError) as err:  # encrypted, corrupt, or compressed as zipfile cannot read
-        raise UnpackError('%s cannot be unpacked: %s' % (shown_name(plan.label), err))
+    except UNREADABLE as err:
+        raise UnpackError('%s cannot be unpacked: %s' % (shown_name(plan.label), unreadable_why(err)))
