@@ -57,19 +57,22 @@ def test_not_a_zip(tmp_path):
         archives.safe_extract(str(path), str(tmp_path / 'out'))
 
 
-def unreadable_zip(path, how):
-    """A zip whose listing reads but whose bytes cannot be had: ``crc`` (one byte of its data changed, as
-    a cut or damaged download), ``encrypted`` (its entry flagged password-protected in both headers, as
-    a zip a student made with a password: APPNOTE.TXT 4.4.4, general purpose bit 0)."""
-    make_zip(path, [('exam/package.xml', PACKAGE_XML)])
+def unreadable_zip(path, how, links=()):
+    """A zip whose listing reads but whose bytes cannot be had: ``crc`` (a byte of its package.xml's data
+    changed, as a cut or damaged download), ``encrypted`` (every entry flagged password-protected in
+    both its headers, as a zip a student made with a password: APPNOTE.TXT 4.4.4, general purpose bit 0)."""
+    make_zip(path, [('exam/package.xml', PACKAGE_XML)], links)
     data = bytearray(path.read_bytes())
+    with zipfile.ZipFile(str(path)) as zf:
+        infos = zf.infolist()
     if how == 'crc':
-        with zipfile.ZipFile(str(path)) as zf:
-            info = zf.infolist()[0]
-        data[info.header_offset + 30 + len(info.filename) + 1] ^= 0xff  # a byte of the compressed data
+        data[infos[0].header_offset + 30 + len(infos[0].filename) + 1] ^= 0xff  # a byte of the compressed data
     else:
-        for signature, offset in ((b'PK\x03\x04', 6), (b'PK\x01\x02', 8)):  # local, central header
-            data[data.index(signature) + offset] |= 0x1
+        central = data.index(b'PK\x01\x02')
+        for info in infos:
+            data[info.header_offset + 6] |= 0x1  # the local header's flags
+            data[data.index(b'PK\x01\x02', central) + 8] |= 0x1  # the central header's
+            central = data.index(b'PK\x01\x02', central) + 4
     path.write_bytes(bytes(data))
     return str(path)
 
@@ -77,9 +80,10 @@ def unreadable_zip(path, how):
 @pytest.mark.parametrize('how', ['crc', 'encrypted'])
 def test_a_zip_whose_bytes_cannot_be_read_is_refused_with_why(tmp_path, how):
     """A damaged or password-protected upload is refused with the reason for the teacher, as a class
-    archive's student is (classlist), never a crash of the inspection."""
+    archive's student is (classlist), never a crash of the inspection; a link among its entries (whose
+    target is read for the teacher's note) changes nothing."""
     (tmp_path / 'upload').mkdir()
-    archive = unreadable_zip(tmp_path / 'upload' / 'exam.zip', how)
+    archive = unreadable_zip(tmp_path / 'upload' / 'exam.zip', how, links=[('exam/l', '/etc/passwd')])
     why = {'crc': "Bad CRC-32 for file 'exam/package.xml'", 'encrypted': 'it is encrypted (made with a password)'}[how]
     with pytest.raises(archives.UnpackError, match=re.escape('exam.zip cannot be unpacked: %s' % why)):
         archives.safe_extract(archive, str(tmp_path / 'out'))

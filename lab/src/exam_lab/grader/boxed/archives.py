@@ -268,9 +268,13 @@ def _zip_mode(info, mask=0o777):
 
 
 def _zip_link_target(zf, info):
+    """What a zip's link points to, for the teacher's note; '?' when it is long or cannot be read."""
     if info.file_size > 4096:
         return '?'
-    return zf.read(info).decode('utf-8', 'replace')
+    try:
+        return zf.read(info).decode('utf-8', 'replace')
+    except UNREADABLE:
+        return '?'
 
 
 def safe_extract(archive, target, max_files=MAX_FILES, max_bytes=MAX_BYTES, max_ratio=MAX_RATIO,
@@ -279,7 +283,9 @@ def safe_extract(archive, target, max_files=MAX_FILES, max_bytes=MAX_BYTES, max_
     of files written.
 
     The whole archive is refused (UnpackError) before anything is written if any entry is unsafe or the
-    ``budget`` (a new one of ``max_files`` / ``max_bytes`` when None) cannot pay for it. ``notes``
+    ``budget`` (a new one of ``max_files`` / ``max_bytes`` when None) cannot pay for it; an entry whose
+    bytes cannot be read (:data:`UNREADABLE`: a password, a bad CRC) refuses it while it is written,
+    what was written left in ``target`` (a scratch folder no caller searches once refused). ``notes``
     receives what was dropped (build products, special files) and duplicates; ``fixes`` the dropped
     links (``notes`` when None).
     """
