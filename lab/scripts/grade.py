@@ -21,7 +21,7 @@ import sys
 
 from exam_lab.grader import runner
 
-from exam_lab.grader.boxed import unpack
+from exam_lab.grader.boxed import archives
 from exam_lab.grader.engine import slurm
 
 from exam_lab.grader.publish import desk, moodle, progress, report
@@ -109,7 +109,7 @@ def main(argv=None):
     except RuntimeError as err:
         say('grade: %s' % err, sys.stderr)
         return 1
-    except unpack.UnpackError as err:  # the class archive itself (one student's upload never gets here)
+    except archives.UnpackError as err:  # the class archive itself (one student's upload never gets here)
         say('grade: the class archive cannot be opened safely: %s' % err, sys.stderr)
         return 1
     return 0

@@ -21,8 +21,7 @@ import time
 import pytest
 
 from exam_lab.grader import runner
-from exam_lab.grader.host import sandbox
-from exam_lab.grader.host import session
+from exam_lab.grader.host import limits, session, uids
 from exam_lab.grader.score import rubric
 from exam_lab.grader.score.sheets import ITEMS
 
@@ -96,8 +95,8 @@ def test_a_parameter_flood_stays_within_the_masters_bound(judged_class):
     record = judged_class['records']['d_param_flood']
     assert record['status'] == rubric.HAND_GRADE and 'memory bound' in record['status_reason'], evidence(record)
     master = session_of(judged_class, 'd_param_flood')['runs'][0]['master']
-    assert master['memory']['limit'] == sandbox.MASTER_MEMORY_BYTES, master
-    assert master['memory']['peak'] <= sandbox.MASTER_MEMORY_BYTES and master['memory']['oom_kills'] >= 1, master
+    assert master['memory']['limit'] == limits.MASTER_MEMORY_BYTES, master
+    assert master['memory']['peak'] <= limits.MASTER_MEMORY_BYTES and master['memory']['oom_kills'] >= 1, master
 
 
 def test_the_judge_is_neither_root_nor_the_box(judged_class):
@@ -106,17 +105,17 @@ def test_the_judge_is_neither_root_nor_the_box(judged_class):
         assert runs, student
         for run in runs:
             judge = run['master']['uid']
-            assert sandbox.JUDGE_UID_BASE <= judge < sandbox.JUDGE_UID_BASE + sandbox.SLOTS, (student, run['master'])
+            assert uids.JUDGE_UID_BASE <= judge < uids.JUDGE_UID_BASE + uids.SLOTS, (student, run['master'])
             assert run['probe_uid'] == judge, (student, run['probe_uid'], judge)
     probe = json.loads(logs_of(judged_class, 'b_good', 'probe-main.json'))
-    assert probe['judge_uid'] >= sandbox.JUDGE_UID_BASE and probe['clock']['ros_time_is_wall'] is True
+    assert probe['judge_uid'] >= uids.JUDGE_UID_BASE and probe['clock']['ros_time_is_wall'] is True
 
 
 def test_no_judge_process_is_left(judged_class):
     """Of the judge's uids (only this grader uses them; a box's uid may already be another grading's,
     test_sandbox checks those), no process is left once the class is graded."""
-    assert [uid for uid in range(sandbox.JUDGE_UID_BASE, sandbox.JUDGE_UID_BASE + sandbox.SLOTS)
-            if sandbox.pids_of_uid(uid)] == []
+    assert [uid for uid in range(uids.JUDGE_UID_BASE, uids.JUDGE_UID_BASE + uids.SLOTS)
+            if uids.pids_of_uid(uid)] == []
 
 
 def points_of(record):

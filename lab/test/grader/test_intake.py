@@ -32,8 +32,8 @@ import zipfile
 import pytest
 
 from exam_lab.grader import runner
-from exam_lab.grader.boxed import similarity, unpack
-from exam_lab.grader.host import sandbox
+from exam_lab.grader.boxed import archives, classlist, similarity
+from exam_lab.grader.host import sandbox, staging
 from exam_lab.grader.publish import desk
 from exam_lab.grader.score import rubric
 
@@ -92,8 +92,8 @@ def moodle_zip(path):
         (MOODLE % ('Eve Original', 106) + 'exam.zip', package(('src/exam/logic.py', SHARED))),
         (MOODLE % ('Fay Many', 107) + 'exam.zip', package(*[('src/exam/m%03d.py' % i, b'x = 1\n') for i in range(501)])),
         (MOODLE % ('Gus Deep', 108) + 'exam.zip', package()),
-        (MOODLE % ('Gus Deep', 108) + 'deep/' * (sandbox.UPLOAD_DEPTH + 1) + 'notes.txt', b'deep'),
-    ] + [(MOODLE % ('Bob Crowd', 102) + 'photos/p%04d.jpg' % i, b'j') for i in range(unpack.MAX_FILES)]
+        (MOODLE % ('Gus Deep', 108) + 'deep/' * (staging.UPLOAD_DEPTH + 1) + 'notes.txt', b'deep'),
+    ] + [(MOODLE % ('Bob Crowd', 102) + 'photos/p%04d.jpg' % i, b'j') for i in range(archives.MAX_FILES)]
     with zipfile.ZipFile(path, 'w', zipfile.ZIP_DEFLATED) as zf:
         for name, content in entries:
             zf.writestr(name, content)
@@ -108,13 +108,13 @@ def graded(tmp_path_factory):
     root = tmp_path_factory.mktemp('intake')
     klass = moodle_zip(str(root / 'class.zip'))
     out = str(root / 'out')
-    staged, stage_upload = [], sandbox.stage_upload
+    staged, stage_upload = [], staging.stage_upload
 
     def spy(source, target, *bounds):
         staged.append((source, bounds))
         return stage_upload(source, target, *bounds)
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(sandbox, 'stage_upload', spy)
+        patch.setattr(staging, 'stage_upload', spy)
         records = runner.grade_class(klass, out, jobs=2)
         similar = runner.class_similarity(klass, out, records)
     lines = desk.finish(out, records, similar=similar, title='Intake class')
@@ -200,7 +200,7 @@ def test_a_cap_hit_reads_as_a_sentence(graded):
 def test_a_student_over_an_upload_s_bounds_is_left_out_alone(graded):
     gus = graded['records']['Gus Deep']
     assert gus['status'] == rubric.NOT_GRADED, gus['status_reason']
-    assert 'folders more than %d deep' % sandbox.UPLOAD_DEPTH in gus['status_reason'], gus['status_reason']
+    assert 'folders more than %d deep' % staging.UPLOAD_DEPTH in gus['status_reason'], gus['status_reason']
     assert [line for line in graded['similar']['notes'] if line.startswith('Gus Deep: not compared')]
 
 
@@ -208,4 +208,4 @@ def test_the_class_zip_is_staged_by_a_class_s_bounds(graded):
     """A class of 60 with its PDFs is larger than one upload may be (256 MB): its zip is staged for
     the intake by the class's bounds."""
     assert [bounds for source, bounds in graded['staged'] if source == graded['class']] == \
-        [(unpack.CLASS_BYTES, 1)] * 2  # the grading's intake and the similarity check's
+        [(classlist.CLASS_BYTES, 1)] * 2  # the grading's intake and the similarity check's

@@ -29,7 +29,7 @@ import tempfile
 
 import pytest
 
-from exam_lab.grader.host import sandbox
+from exam_lab.grader.host import sandbox, uids
 from exam_lab.grader.publish import student_view
 from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
@@ -49,7 +49,7 @@ def unused_uid():
         try:
             pwd.getpwuid(uid)
         except KeyError:
-            if not sandbox.pids_of_uid(uid):
+            if not uids.pids_of_uid(uid):
                 return uid
     pytest.skip('no unused uid in %d-%d' % (UIDS[0], UIDS[-1]))
 
@@ -74,8 +74,8 @@ class User(object):
         done = subprocess.run(drop + list(argv), cwd=cwd or self.repo, env=self.env, stdout=subprocess.PIPE,
                               stderr=subprocess.STDOUT, timeout=timeout)
         if os.geteuid() == 0:
-            assert wait_until(lambda: not sandbox.pids_of_uid(self.uid), 30.0, period=0.2), \
-                'processes of uid %d left: %s' % (self.uid, sandbox.pids_of_uid(self.uid))
+            assert wait_until(lambda: not uids.pids_of_uid(self.uid), 30.0, period=0.2), \
+                'processes of uid %d left: %s' % (self.uid, uids.pids_of_uid(self.uid))
         return done.returncode, done.stdout.decode('utf-8', 'replace')
 
     def sourced(self, command, timeout):
@@ -116,7 +116,7 @@ def user():
         yield someone
     finally:
         if os.geteuid() == 0:
-            for pid in sandbox.pids_of_uid(uid):
+            for pid in uids.pids_of_uid(uid):
                 try:
                     os.kill(pid, signal.SIGKILL)
                 except OSError:

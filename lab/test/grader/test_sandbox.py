@@ -21,7 +21,7 @@ import pytest
 
 from exam_lab.grader import runner
 
-from exam_lab.grader.host import sandbox
+from exam_lab.grader.host import egress, limits, sandbox, staging, uids
 from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
 
@@ -127,7 +127,7 @@ def test_every_student_runs_in_a_box_of_its_own(hostile_class):
         assert len(ran) == 1 and ran[0].startswith('ran in a bubblewrap sandbox as uid '), (name, ran)
         boxes.append(int(ran[0].split('as uid ')[1].split(':')[0]))
     assert boxes[0] != boxes[1], 'the saboteur and its classmate, graded side by side, share a uid'
-    assert all(uid >= sandbox.BOX_UID_BASE for uid in boxes)
+    assert all(uid >= uids.BOX_UID_BASE for uid in boxes)
 
 
 def test_the_classmate_of_a_saboteur_keeps_its_points(hostile_class):
@@ -154,8 +154,8 @@ def test_a_forged_probe_file_changes_nothing(hostile_class):
 
 def test_no_detached_child_survives(hostile_class):
     assert hostile_class['survivors'] == []
-    assert [uid for uid in range(sandbox.BOX_UID_BASE, sandbox.BOX_UID_BASE + sandbox.SLOTS)
-            if sandbox.pids_of_uid(uid)] == []
+    assert [uid for uid in range(uids.BOX_UID_BASE, uids.BOX_UID_BASE + uids.SLOTS)
+            if uids.pids_of_uid(uid)] == []
 
 
 def test_secrets_never_reach_the_results(hostile_class):
@@ -176,7 +176,7 @@ def test_a_snoop_reads_nothing_root_can(hostile_class):
     """Its include of a root-only launch file is not there for the box that reads it: no node, no
     parameter, nothing to run; the class went on around it."""
     record = hostile_class['records']['e_snoop']
-    assert [uid for uid in read_as(record) if uid >= sandbox.BOX_UID_BASE] == read_as(record) != []
+    assert [uid for uid in read_as(record) if uid >= uids.BOX_UID_BASE] == read_as(record) != []
     # Two walls, either enough: the analysis reads no file outside the package, and the box sees none.
     assert [h for h in record['for_the_teacher'] if 'include' in h and ('not found' in h or 'outside the package'
                                                                        in h)], record['for_the_teacher']
@@ -198,7 +198,7 @@ def test_the_upload_is_read_as_the_box_uid(tmp_path):
     assert token not in json.dumps(record)
     for path, text in files_under(str(tmp_path / 'out')):
         assert token not in text, path
-    assert read_as(record) and all(uid >= sandbox.BOX_UID_BASE for uid in read_as(record)), record['for_the_teacher']
+    assert read_as(record) and all(uid >= uids.BOX_UID_BASE for uid in read_as(record)), record['for_the_teacher']
 
 
 def test_reading_student_bytes_is_bounded(tmp_path):
@@ -237,7 +237,7 @@ def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
     if os.geteuid() != 0 or sandbox.check() is not None:
         pytest.skip('boxes need root and bubblewrap: %s' % sandbox.check())
     import zipfile
-    from exam_lab.grader.boxed import unpack
+    from exam_lab.grader.boxed import archives
     archive = str(tmp_path / 'class.zip')
     with zipfile.ZipFile(archive, 'w') as zf:
         for folder in ('Jane Doe_12_assignsubmission_file_', 'Bob_13_assignsubmission_file_'):
@@ -247,11 +247,11 @@ def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
         students = runner.class_students(archive, work_dirs)
         assert [name for name, _ in students] == ['Bob', 'Jane Doe']
         for _, folder in students:
-            assert folder.startswith(work_dirs[0] + '/') and os.stat(folder).st_uid >= sandbox.BOX_UID_BASE
+            assert folder.startswith(work_dirs[0] + '/') and os.stat(folder).st_uid >= uids.BOX_UID_BASE
             assert os.path.isfile(os.path.join(folder, 'exam', 'package.xml'))
         with zipfile.ZipFile(archive, 'a') as zf:
             zf.writestr('../outside.txt', 'x')
-        with pytest.raises(unpack.UnpackError, match='unpacking it in its box failed'):
+        with pytest.raises(archives.UnpackError, match='unpacking it in its box failed'):
             runner.class_students(archive, work_dirs)
     finally:
         for work in work_dirs:
@@ -271,14 +271,14 @@ def test_an_upload_is_staged_as_bytes_never_followed(tmp_path):
     secret.chmod(0o600)
     os.symlink(str(secret), str(upload / 'exam' / 'leak.txt'))
     os.mkfifo(str(upload / 'exam' / 'fifo'))
-    sandbox.stage_upload(str(upload), str(staged))
+    staging.stage_upload(str(upload), str(staged))
     assert sorted(os.listdir(str(staged / 'exam'))) == ['launch', 'leak.txt', 'node.py']
     assert oct(os.stat(str(staged / 'exam' / 'node.py')).st_mode & 0o777) == '0o755', 'a script stays executable'
     assert os.readlink(str(staged / 'exam' / 'leak.txt')) == str(secret)
     assert (staged / 'exam' / 'launch' / 'exam.launch').read_text() == '<launch/>'
     assert oct(os.stat(str(staged / 'exam' / 'launch' / 'exam.launch')).st_mode & 0o777) == '0o644'
-    with pytest.raises(sandbox.UploadRefused, match='larger than the grader takes'):
-        sandbox.stage_upload(str(upload), str(tmp_path / 'capped'), max_bytes=4)
+    with pytest.raises(staging.UploadRefused, match='larger than the grader takes'):
+        staging.stage_upload(str(upload), str(tmp_path / 'capped'), max_bytes=4)
 
 
 def test_the_results_take_only_regular_files_capped(tmp_path):
@@ -292,14 +292,14 @@ def test_the_results_take_only_regular_files_capped(tmp_path):
     os.symlink(str(secret), str(source / 'leak.log'))
     os.symlink('/nonexistent', str(source / 'dangling.log'))
     os.mkfifo(str(source / 'fifo.log'))
-    (source / 'long.log').write_text('first\n' + 'x' * (3 * sandbox.LOG_PART) + '\nlast\n')
+    (source / 'long.log').write_text('first\n' + 'x' * (3 * egress.LOG_PART) + '\nlast\n')
     (source / 'probe-main.json').write_text(json.dumps({'ok': True}))
-    skipped = sandbox.copy_results(str(source), str(target))
+    skipped = egress.copy_results(str(source), str(target))
     assert sorted(skipped) == ['dangling.log', 'fifo.log', 'leak.log']
     assert sorted(os.listdir(str(target))) == ['long.log', 'probe-main.json']
     text = (target / 'long.log').read_text()
     assert text.startswith('first\n') and text.endswith('\nlast\n')
-    assert 'bytes cut by the grader' in text and len(text) < 2 * sandbox.LOG_PART + 200
+    assert 'bytes cut by the grader' in text and len(text) < 2 * egress.LOG_PART + 200
 
 
 def test_no_sandbox_no_grading_unless_the_risk_is_named(monkeypatch, tmp_path):
@@ -344,7 +344,7 @@ def test_a_box_is_another_user_and_sees_only_its_own():
               'touch /box/ws/src/exam/x 2>/dev/null && echo PACKAGE_WRITABLE; touch /box/ws/devel/x && echo OK; '
               'env; tr "\\0" "\\n" < /proc/1/environ; (setsid sh -c "sleep 77; true" &) ; '
               'test -d %s && echo BOUND; cat /proc/self/limits; head -c %d /dev/zero > /box/ws/devel/big; echo "BIG $(wc -c < /box/ws/devel/big)"'
-              % (host_file, shown, sandbox.FILE_BYTES + 4096))
+              % (host_file, shown, limits.FILE_BYTES + 4096))
     try:
         with sandbox.Box(work, [shown]) as box:
             grader_env = dict(os.environ, GRADER_SECRET='leak')
@@ -357,10 +357,10 @@ def test_a_box_is_another_user_and_sees_only_its_own():
     lines = output.splitlines()
     assert lines[0] == str(uid) and uid != 0
     assert 'OK' in lines and 'BOUND' in lines
-    assert 'BIG %d' % sandbox.FILE_BYTES in lines, 'a file stops growing at the limit'
-    limits = dict((line[:26].strip(), line[26:].split()) for line in lines if line.startswith('Max '))
-    assert limits['Max processes'][0] == str(sandbox.PROCESSES)
-    assert limits['Max cpu time'][0] == str(sandbox.CPU_SECONDS)
-    assert limits['Max address space'][0] == str(sandbox.ADDRESS_SPACE_BYTES)
+    assert 'BIG %d' % limits.FILE_BYTES in lines, 'a file stops growing at the limit'
+    seen = dict((line[:26].strip(), line[26:].split()) for line in lines if line.startswith('Max '))
+    assert seen['Max processes'][0] == str(limits.PROCESSES)
+    assert seen['Max cpu time'][0] == str(limits.CPU_SECONDS)
+    assert seen['Max address space'][0] == str(limits.ADDRESS_SPACE_BYTES)
     for bad in ('ROOT_VISIBLE', 'HOST_TMP_VISIBLE', 'PACKAGE_WRITABLE', 'GRADER_SECRET', 'EXAM_LAB'):
         assert bad not in output

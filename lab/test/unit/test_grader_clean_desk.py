@@ -348,15 +348,15 @@ def test_a_name_in_any_bytes_is_kept_exactly_by_a_rescore(tmp_path):
 
 
 def test_the_class_outputs_never_name_a_student(tmp_path):
-    """Every file a class's desk writes in OUT ends like an output (unpack.OUTPUT_ENDINGS), which no
-    student's folder does (:func:`unpack.student_name`): a student named ``grades.csv`` cannot take
+    """Every file a class's desk writes in OUT ends like an output (identity.OUTPUT_ENDINGS), which no
+    student's folder does (:func:`identity.student_name`): a student named ``grades.csv`` cannot take
     the table's place."""
-    from exam_lab.grader.boxed import unpack
+    from exam_lab.grader.score import identity
     out, records, worksheet = class_desk(tmp_path)
     report.write_csv(str(out / 'grades.csv'), records)
     desk.finish(str(out), records, similar={'pairs': [], 'students': 3}, worksheet=worksheet, title='Class')
     written = [n for n in os.listdir(str(out)) if not os.path.isdir(str(out / n))]
-    assert written and [n for n in written if not n.lower().endswith(unpack.OUTPUT_ENDINGS)] == []
+    assert written and [n for n in written if not n.lower().endswith(identity.OUTPUT_ENDINGS)] == []
     for name in written + ['hand.csv.zip', 'Index.HTML', 'grades.csv_12_assignsubmission_file_']:
-        shown = unpack.student_name(name)
-        assert shown not in written and not shown.lower().endswith(unpack.OUTPUT_ENDINGS), (name, shown)
+        shown = identity.student_name(name)
+        assert shown not in written and not shown.lower().endswith(identity.OUTPUT_ENDINGS), (name, shown)

@@ -12,7 +12,8 @@ from html.parser import HTMLParser
 
 import pytest
 
-from exam_lab.grader.publish import feedback, hand, moodle, report, student_view
+from exam_lab.grader.publish import feedback, hand, report, student_view
+from exam_lab.grader.score import identity
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 from test_grader_desk import probe_result as desk_probe_result
 
@@ -77,18 +78,18 @@ def test_moodle_naming_rule_gives_the_download_names(folder, fullname, number):
 def test_the_class_zips_names_reach_the_feedback_folders(tmp_path):
     """A class zip as Moodle's downloader streams it (ZipStream flags a non-ASCII name as UTF-8, as Python
     does): unpacked, each folder's name is Moodle's, and so is its feedback folder's."""
-    from exam_lab.grader.boxed import unpack
+    from exam_lab.grader.boxed import classlist
     from test_grader_unpack import PACKAGE_XML, make_zip
     archive = make_zip(tmp_path / 'ROS-Exam-12.zip', [('%s/exam/package.xml' % folder, PACKAGE_XML)
                                                       for folder, _, _ in DOWNLOADS])
     scratch = tmp_path / 'scratch'
     scratch.mkdir()
-    found = unpack.list_students(archive, str(scratch))
+    found = classlist.list_students(archive, str(scratch))
     assert sorted(os.path.basename(path) for _, path in found) == sorted(folder for folder, _, _ in DOWNLOADS)
     for _, path in found:
         folder = os.path.basename(path)
         r = {'folder': folder, 'student': 'x', 'participant': None}
-        number = moodle.identity(r).participant
+        number = identity.identity(r).participant
         assert feedback.folder_name(feedback.moodle_name(r, number), number) == \
             folder.rstrip('_').replace('_assignsubmission_file', '_assignfeedback_file') + '_'
 

@@ -8,7 +8,7 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader.boxed import source, unpack
+from exam_lab.grader.boxed import archives, classlist, package, source
 
 PACKAGE_XML = '<package format="2"><name>%s</name></package>'
 
@@ -44,7 +44,7 @@ def test_a_windows_zip_with_crlf_is_read_as_meant(tmp_path):
     script = '#!/usr/bin/env python3\r\nprint(1)\r\n'
     archive = windows_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML % 'exam'),
                                                   ('exam/scripts/exam_node.py', script)])
-    found = unpack.open_submission(archive, str(tmp_path / 'scratch'), [])
+    found = package.open_submission(archive, str(tmp_path / 'scratch'), [])
     node = os.path.join(found, 'scripts', 'exam_node.py')
     assert os.path.isfile(node), 'backslashes are folders, not parts of a file name'
     fixes = source.fix_text(found)
@@ -70,15 +70,15 @@ def test_a_utf8_bom_hiding_the_shebang_is_removed(tmp_path):
 def test_tar_archives(tmp_path, name, mode):
     archive = make_tar(tmp_path / name, [('exam/package.xml', PACKAGE_XML % 'exam'),
                                          ('exam/scripts/exam_node.py', 'print(1)\n')], mode=mode)
-    found = unpack.open_submission(archive, str(tmp_path / 'scratch'), [])
+    found = package.open_submission(archive, str(tmp_path / 'scratch'), [])
     assert os.access(os.path.join(found, 'scripts', 'exam_node.py'), os.X_OK), 'tar keeps the modes'
 
 
 @pytest.mark.parametrize('name', ['../evil', '/etc/evil', 'exam/../../evil'])
 def test_tar_entries_escaping_are_refused(tmp_path, name):
     archive = make_tar(tmp_path / 'exam.tar.gz', [('exam/package.xml', PACKAGE_XML % 'exam'), (name, 'x')])
-    with pytest.raises(unpack.UnpackError):
-        unpack.safe_extract(archive, str(tmp_path / 'out'))
+    with pytest.raises(archives.UnpackError):
+        archives.safe_extract(archive, str(tmp_path / 'out'))
     assert not (tmp_path / 'out').exists()
 
 
@@ -92,7 +92,7 @@ def test_a_whole_workspace_gives_its_package(tmp_path):
                        links=[('catkin_ws/src/CMakeLists.txt', '/opt/ros/noetic/share/catkin/cmake/toplevel.cmake'),
                               ('catkin_ws/devel/lib/x', '/x')])
     notes, fixes = [], []
-    found = unpack.open_submission(archive, str(tmp_path / 'scratch'), notes, fixes)
+    found = package.open_submission(archive, str(tmp_path / 'scratch'), notes, fixes)
     assert found.endswith(os.path.join('catkin_ws', 'src', 'exam'))
     assert not os.path.exists(os.path.join(os.path.dirname(os.path.dirname(found)), 'build'))
     assert any("build products of a workspace not unpacked: catkin_ws/build/ (1 entries), "
@@ -112,7 +112,7 @@ def test_a_whole_workspace_zipped_on_linux_keeps_its_package(tmp_path):
         info.external_attr = (stat.S_IFLNK | 0o777) << 16
         zf.writestr(info, '/opt/ros/noetic/share/catkin/cmake/toplevel.cmake')
     notes, fixes = [], []
-    found = unpack.open_submission(str(tmp_path / 'ws.zip'), str(tmp_path / 'scratch'), notes, fixes)
+    found = package.open_submission(str(tmp_path / 'ws.zip'), str(tmp_path / 'scratch'), notes, fixes)
     assert found.endswith(os.path.join('catkin_ws', 'src', 'exam'))
     assert not os.path.lexists(os.path.join(os.path.dirname(found), 'CMakeLists.txt'))
     assert len(fixes) == 1 and "catkin's link 'catkin_ws/src/CMakeLists.txt' dropped" in fixes[0]
@@ -123,7 +123,7 @@ def test_a_package_however_named(tmp_path):
     archive = windows_zip(tmp_path / 'a.zip', [('catkin_ws/src/mydrone/package.xml', PACKAGE_XML % 'mydrone'),
                                                ('catkin_ws/src/exam_pkg/package.xml', PACKAGE_XML % 'exam_pkg')])
     fixes = []
-    found = unpack.open_submission(archive, str(tmp_path / 'scratch'), [], fixes)
+    found = package.open_submission(archive, str(tmp_path / 'scratch'), [], fixes)
     assert os.path.basename(found) == 'exam_pkg', 'never a simulator'
     assert fixes == ["the package is named 'exam_pkg', not exam (question 9 asks for exam): graded as it is"]
 
@@ -138,9 +138,9 @@ def test_nested_archives_share_one_budget(tmp_path):
         for i in range(20):
             zf.writestr('part%d.zip' % i, inner.getvalue())
     notes = []
-    with pytest.raises(unpack.UnpackError, match='more bytes, beyond the'):
-        unpack.open_submission(str(outer), str(tmp_path / 'scratch'), notes,
-                               budget=unpack.Budget(max_bytes=len(inner.getvalue()) * 20 + 1000))
+    with pytest.raises(archives.UnpackError, match='more bytes, beyond the'):
+        package.open_submission(str(outer), str(tmp_path / 'scratch'), notes,
+                               budget=archives.Budget(max_bytes=len(inner.getvalue()) * 20 + 1000))
     refused = [n for n in notes if 'beyond the' in n]
     assert refused and len(refused) < 20, notes
     written = sum(len(f) for _, _, f in os.walk(str(tmp_path / 'scratch')))
@@ -155,8 +155,8 @@ def test_names_beyond_the_limits_are_refused_with_a_reason(tmp_path, name, reaso
         zf.writestr('exam/package.xml', PACKAGE_XML % 'exam')
         zf.writestr(name, 'x')
     notes = []
-    with pytest.raises(unpack.UnpackError, match=reason) as err:
-        unpack.open_submission(str(tmp_path / 'a.zip'), str(tmp_path / 'scratch'), notes)
+    with pytest.raises(archives.UnpackError, match=reason) as err:
+        package.open_submission(str(tmp_path / 'a.zip'), str(tmp_path / 'scratch'), notes)
     assert '\n' not in str(err.value) and '\x1b' not in str(err.value) and len(str(err.value)) < 200
 
 
@@ -170,7 +170,7 @@ def test_duplicates_and_case_collisions_are_noted(tmp_path):
             zf.writestr('exam/scripts/node.py', 'new')
         zf.writestr('exam/Scripts/node.py', 'other')
     notes = []
-    found = unpack.open_submission(str(tmp_path / 'a.zip'), str(tmp_path / 'scratch'), notes)
+    found = package.open_submission(str(tmp_path / 'a.zip'), str(tmp_path / 'scratch'), notes)
     assert open(os.path.join(found, 'scripts', 'node.py')).read() == 'new'
     assert any("'exam/scripts/node.py'" in n and 'more than once' in n for n in notes), notes
     assert any('differ only by case' in n and 'exam/Scripts/node.py / exam/scripts/node.py' in n for n in notes)
@@ -181,13 +181,13 @@ def test_formats_that_cannot_be_opened_say_so_by_name(tmp_path):
     folder.mkdir()
     (folder / 'exam.rar').write_bytes(b'Rar!\x1a\x07\x01\x00' + b'\0' * 20)
     (folder / 'report.pdf').write_bytes(b'%PDF-1.4')
-    with pytest.raises(unpack.UnpackError, match='RAR archive'):
-        unpack.open_submission(str(folder), str(tmp_path / 'scratch'), [])
-    with pytest.raises(unpack.UnpackError, match='exam.rar is a RAR archive: the grader opens zip and tar'):
-        unpack.open_submission(str(folder / 'exam.rar'), str(tmp_path / 'scratch'), [])
+    with pytest.raises(archives.UnpackError, match='RAR archive'):
+        package.open_submission(str(folder), str(tmp_path / 'scratch'), [])
+    with pytest.raises(archives.UnpackError, match='exam.rar is a RAR archive: the grader opens zip and tar'):
+        package.open_submission(str(folder / 'exam.rar'), str(tmp_path / 'scratch'), [])
 
 
 def test_a_class_of_tar_uploads(tmp_path):
     make_tar(tmp_path / 'Bob_2.tar.gz', [('exam/package.xml', PACKAGE_XML % 'exam')])
-    students = unpack.list_students(str(tmp_path), str(tmp_path / 'scratch'))
+    students = classlist.list_students(str(tmp_path), str(tmp_path / 'scratch'))
     assert [name for name, _ in students] == ['Bob']

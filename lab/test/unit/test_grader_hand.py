@@ -178,9 +178,8 @@ def test_a_badly_filled_hand_csv_stops_the_worksheet_with_every_problem(tmp_path
 def moodle_record(folder, total):
     """A class student's record as a run makes it: the name cleaned from Moodle's folder name (the
     intake's own rule), the participant number read from it."""
-    from exam_lab.grader.boxed import unpack
-    from exam_lab.grader.publish import moodle
-    return dict(record(unpack.student_name(folder), total, moodle.participant_number(folder)), folder=folder)
+    from exam_lab.grader.score import identity
+    return dict(record(identity.student_name(folder), total, identity.participant_number(folder)), folder=folder)
 
 
 def named_as_a_run_names_them(records):

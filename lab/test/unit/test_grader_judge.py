@@ -10,26 +10,26 @@ import tempfile
 
 import pytest
 
-from exam_lab.grader.host import sandbox
+from exam_lab.grader.host import cgroups, limits, sandbox, uids
 from exam_lab.grader.host.session import uid_of
 from exam_lab.harness.supervisor import Supervisor, descendants
 from exam_lab.harness.wait import wait_until
 
 
 def test_a_box_gets_its_part_of_the_cores_and_the_judge_the_weight():
-    assert sandbox.box_cpus(2, cores=2) == 1.0
-    assert sandbox.box_cpus(1, cores=8) == 8.0
-    assert sandbox.box_cpus(8, cores=2) == sandbox.MIN_BOX_CPUS
-    v1 = sandbox.cgroup_limits(1 << 30, sandbox.BOX_SHARES, pids=512, cpus=1.0)
-    assert ('cpu', 'cpu.cfs_quota_us', sandbox.CPU_PERIOD_US) in v1
-    assert ('cpu', 'cpu.cfs_period_us', sandbox.CPU_PERIOD_US) in v1
+    assert limits.box_cpus(2, cores=2) == 1.0
+    assert limits.box_cpus(1, cores=8) == 8.0
+    assert limits.box_cpus(8, cores=2) == limits.MIN_BOX_CPUS
+    v1 = cgroups.cgroup_limits(1 << 30, limits.BOX_SHARES, pids=512, cpus=1.0)
+    assert ('cpu', 'cpu.cfs_quota_us', cgroups.CPU_PERIOD_US) in v1
+    assert ('cpu', 'cpu.cfs_period_us', cgroups.CPU_PERIOD_US) in v1
     assert ('cpu', 'cpu.shares', 1024) in v1 and ('pids', 'pids.max', 512) in v1
     assert ('memory', 'memory.limit_in_bytes', 1 << 30) in v1
-    judge = sandbox.cgroup_limits(sandbox.MASTER_MEMORY_BYTES, sandbox.JUDGE_SHARES)
-    assert sorted(judge) == [('cpu', 'cpu.shares', sandbox.JUDGE_SHARES),
-                             ('memory', 'memory.limit_in_bytes', sandbox.MASTER_MEMORY_BYTES)]
-    assert sandbox.JUDGE_SHARES > sandbox.BOX_SHARES
-    v2 = dict((name, value) for _, name, value in sandbox.cgroup_limits(1 << 30, 4096, pids=512, cpus=0.5, v2=True))
+    judge = cgroups.cgroup_limits(limits.MASTER_MEMORY_BYTES, limits.JUDGE_SHARES)
+    assert sorted(judge) == [('cpu', 'cpu.shares', limits.JUDGE_SHARES),
+                             ('memory', 'memory.limit_in_bytes', limits.MASTER_MEMORY_BYTES)]
+    assert limits.JUDGE_SHARES > limits.BOX_SHARES
+    v2 = dict((name, value) for _, name, value in cgroups.cgroup_limits(1 << 30, 4096, pids=512, cpus=0.5, v2=True))
     assert v2 == {'memory.max': 1 << 30, 'cpu.weight': 400, 'cpu.max': '50000 100000', 'pids.max': 512}
 
 
@@ -50,7 +50,7 @@ def box():
 def test_the_judge_is_a_user_of_its_own_in_its_cgroups(box):
     """The judge's commands drop root for the slot's judge uid (not the box's) and join the judge's
     cgroups; the box's cgroup has its CPU quota."""
-    assert box.judge_uid == sandbox.JUDGE_UID_BASE + box.slot
+    assert box.judge_uid == uids.JUDGE_UID_BASE + box.slot
     done = subprocess.run(box.judge_argv(['sh', '-c', 'id -u; id -G; cat /proc/self/cgroup'], 'master'),
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=30)
     lines = done.stdout.decode().splitlines()
@@ -60,10 +60,10 @@ def test_the_judge_is_a_user_of_its_own_in_its_cgroups(box):
     cpu = [f for f in box.cgroups if '/cpu/' in f]
     assert cpu, box.cgroups
     with open(os.path.join(cpu[0], 'cpu.cfs_quota_us')) as f:
-        assert int(f.read()) == sandbox.CPU_PERIOD_US
+        assert int(f.read()) == cgroups.CPU_PERIOD_US
     master_memory = [f for f in box.judge_cgroups['master'] if '/memory/' in f]
     with open(os.path.join(master_memory[0], 'memory.limit_in_bytes')) as f:
-        assert int(f.read()) == sandbox.MASTER_MEMORY_BYTES
+        assert int(f.read()) == limits.MASTER_MEMORY_BYTES
 
 
 def test_the_master_runs_as_the_judge_not_root(box, tmp_path):
@@ -83,7 +83,7 @@ def test_the_master_runs_as_the_judge_not_root(box, tmp_path):
         assert wait_until(lambda: len(descendants(master.proc.pid)) >= 2, 30.0, period=0.1), \
             descendants(master.proc.pid)
         family = [master.proc.pid] + descendants(master.proc.pid)
-        uids = {pid: uid_of(pid) for pid in family}
-        assert set(uids.values()) == {box.judge_uid}, uids
-        use = sandbox.memory_use(box.judge_cgroups['master'])
-        assert use['limit'] == sandbox.MASTER_MEMORY_BYTES and 0 < use['peak'] < use['limit'], use
+        owners = {pid: uid_of(pid) for pid in family}
+        assert set(owners.values()) == {box.judge_uid}, owners
+        use = cgroups.memory_use(box.judge_cgroups['master'])
+        assert use['limit'] == limits.MASTER_MEMORY_BYTES and 0 < use['peak'] < use['limit'], use

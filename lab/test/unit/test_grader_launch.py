@@ -151,7 +151,7 @@ def test_value_alone_identifies_a_threshold(tmp_path):
 # --- what the analysis reads: the student's package and the box's environment only (issue 26) ------
 
 def test_env_substitutions_see_the_box_never_the_grader(tmp_path, monkeypatch):
-    from exam_lab.grader.host import sandbox
+    from exam_lab.grader.score import boxenv
     monkeypatch.setenv('EXAM_TEACHER_SECRET', 'hunter2-teacher-only')
     pkg = package(tmp_path, {'launch/exam.launch': '''<launch>
   <node pkg="exam" type="exam_node.py" name="exam">
@@ -161,12 +161,12 @@ def test_env_substitutions_see_the_box_never_the_grader(tmp_path, monkeypatch):
   </node>
 </launch>'''})
     path = os.path.join(pkg, 'launch', 'exam.launch')
-    for env in (None, sandbox.box_env({'PATH': '/usr/bin'})):
+    for env in (None, boxenv.box_env({'PATH': '/usr/bin'})):
         analysis = launch.analyse(path, pkg) if env is None else launch.analyse(path, pkg, 'exam', env)
         seen = repr([(p.name, p.value) for p in analysis.params]) + repr(analysis.problems)
         assert 'hunter2' not in seen
         assert launch.threshold_param(analysis, 'altitude')[0].value == 1300, 'the default: unset in the box'
-    assert {p.name: p.value for p in analysis.params}['/exam/home'] == sandbox.BOX_HOME
+    assert {p.name: p.value for p in analysis.params}['/exam/home'] == boxenv.BOX_HOME
 
 
 def test_files_outside_the_package_are_never_read(tmp_path):

@@ -7,6 +7,7 @@ import io
 import pytest
 
 from exam_lab.grader.publish import cells, moodle
+from exam_lab.grader.score import identity
 from exam_lab.grader.score.sheets import ITEMS
 
 #: The header line of a real worksheet, exactly as Moodle wrote it in English (quoting included):
@@ -62,11 +63,11 @@ def moodle_read(text):
 
 
 def test_participant_number_from_moodle_names():
-    assert moodle.participant_number('Jane Doe_1234567_assignsubmission_file_') == 1234567
-    assert moodle.participant_number('Jane_Doe_12_assignsubmission_file_exam.zip') == 12
-    assert moodle.participant_number('Participant_88_assignsubmission_file') == 88
-    assert moodle.participant_number('jdupont') is None
-    assert moodle.participant_number('Jane Doe_12') is None
+    assert identity.participant_number('Jane Doe_1234567_assignsubmission_file_') == 1234567
+    assert identity.participant_number('Jane_Doe_12_assignsubmission_file_exam.zip') == 12
+    assert identity.participant_number('Participant_88_assignsubmission_file') == 88
+    assert identity.participant_number('jdupont') is None
+    assert identity.participant_number('Jane Doe_12') is None
 
 
 def test_parse_gives_the_text_back_exactly():
@@ -250,10 +251,10 @@ def test_a_participant_two_records_claim_is_written_for_neither():
 
 def test_identity_gives_the_participant_and_moodles_folder():
     jane = dict(record('Jane Doe', 1234567, 17.0), folder='Jane Doe_1234567_assignsubmission_file_')
-    assert moodle.identity(jane) == (1234567, 'Jane Doe_1234567_assignsubmission_file_', ('participant', 1234567))
+    assert identity.identity(jane) == (1234567, 'Jane Doe_1234567_assignsubmission_file_', ('participant', 1234567))
     flat = dict(jane, folder='Jane Doe_1234567_assignsubmission_file_exam.zip')
-    assert moodle.identity(flat).folder == 'Jane Doe_1234567_assignsubmission_file_'
+    assert identity.identity(flat).folder == 'Jane Doe_1234567_assignsubmission_file_'
     plain = dict(record('jdupont', None, 17.0), folder='jdupont')
-    assert moodle.identity(plain) == (None, None, ('name', 'jdupont'))
+    assert identity.identity(plain) == (None, None, ('name', 'jdupont'))
     from_folder = dict(record('Jane Doe', None, 17.0), folder='Jane Doe._88_assignsubmission_file_')
-    assert moodle.identity(from_folder) == (88, 'Jane Doe._88_assignsubmission_file_', ('participant', 88))
+    assert identity.identity(from_folder) == (88, 'Jane Doe._88_assignsubmission_file_', ('participant', 88))

@@ -4,7 +4,7 @@ worksheet's scale, the page's title and its "needs the teacher" box."""
 import os
 import zipfile
 
-from exam_lab.grader.boxed import unpack
+from exam_lab.grader.boxed import package, uploads
 from exam_lab.grader.publish import flightplot, moodle, page, report
 from exam_lab.grader.score import rubric, sheets
 from exam_lab.harness import oracle
@@ -139,15 +139,15 @@ def dated_zip(path, when, content=b'<package><name>exam</name></package>'):
 def test_choose_upload_by_dates_then_version():
     from datetime import datetime
     early, late = datetime(2026, 6, 12, 14, 52), datetime(2026, 6, 12, 16, 58)
-    index, why, ambiguous = unpack.choose_upload([('exam.zip', early, None), ('exam_v2.zip', late, 2)])
+    index, why, ambiguous = uploads.choose_upload([('exam.zip', early, None), ('exam_v2.zip', late, 2)])
     assert (index, ambiguous) == (1, False) and 'exam.zip (files dated 2026-06-12 14:52)' in why
-    assert unpack.choose_upload([('b.zip', late, None), ('a.zip', early, None)])[:1] == (0,)
-    index, why, ambiguous = unpack.choose_upload([('exam_v3.zip', None, 3), ('exam_v2.zip', None, 2)])
+    assert uploads.choose_upload([('b.zip', late, None), ('a.zip', early, None)])[:1] == (0,)
+    index, why, ambiguous = uploads.choose_upload([('exam_v3.zip', None, 3), ('exam_v2.zip', None, 2)])
     assert (index, ambiguous) == (0, False) and 'highest version number' in why
-    assert unpack.choose_upload([('exam.zip', early, None), ('exam_v2.zip', early, 2)])[:1] == (1,)
-    assert unpack.choose_upload([('exam_v2.zip', late, 2), ('exam_v3.zip', early, 3)])[2] is True
-    assert unpack.choose_upload([('a.zip', None, None), ('b.zip', None, None)])[2] is True
-    assert [unpack.version_number(n) for n in ('exam.zip', 'exam_v2.zip', 'exam (3).zip', 'examV4.tar.gz',
+    assert uploads.choose_upload([('exam.zip', early, None), ('exam_v2.zip', early, 2)])[:1] == (1,)
+    assert uploads.choose_upload([('exam_v2.zip', late, 2), ('exam_v3.zip', early, 3)])[2] is True
+    assert uploads.choose_upload([('a.zip', None, None), ('b.zip', None, None)])[2] is True
+    assert [uploads.version_number(n) for n in ('exam.zip', 'exam_v2.zip', 'exam (3).zip', 'examV4.tar.gz',
                                                 'exam-2.zip', 'exam_2026.zip')] == [None, 2, 3, 4, 2, None]
 
 
@@ -158,7 +158,7 @@ def test_several_uploads_in_one_folder(tmp_path):
               b'<package><name>exam</name><version>2.0.0</version></package>')
     dated_zip(str(folder / 'exam.zip'), (2026, 6, 12, 14, 52, 0))
     notes, uploads = [], []
-    chosen = unpack.open_submission(str(folder), str(tmp_path / 'scratch'), notes, uploads=uploads)
+    chosen = package.open_submission(str(folder), str(tmp_path / 'scratch'), notes, uploads=uploads)
     with open(os.path.join(chosen, 'package.xml')) as f:
         assert '2.0.0' in f.read()
     assert len(uploads) == 1 and uploads[0]['files'] == ['exam.zip', 'exam_v2.zip'], uploads

@@ -1,11 +1,12 @@
 """Unpacking what students upload: unsafe archives refused as a whole, the package found."""
 import os
+import re
 import stat
 import zipfile
 
 import pytest
 
-from exam_lab.grader.boxed import unpack
+from exam_lab.grader.boxed import archives, classlist, package
 
 PACKAGE_XML = '<package format="2"><name>exam</name></package>'
 
@@ -24,36 +25,70 @@ def make_zip(path, entries, links=()):
 @pytest.mark.parametrize('name', ['../evil.py', 'exam/../../evil.py', '/etc/evil', 'C:/evil', '..\\evil'])
 def test_escaping_paths_are_refused(tmp_path, name):
     archive = make_zip(tmp_path / 'a.zip', [('exam/package.xml', PACKAGE_XML), (name, 'x')])
-    with pytest.raises(unpack.UnpackError):
-        unpack.safe_extract(archive, str(tmp_path / 'out'))
+    with pytest.raises(archives.UnpackError):
+        archives.safe_extract(archive, str(tmp_path / 'out'))
     assert not (tmp_path / 'out').exists(), 'nothing is written from a refused archive'
 
 
 def test_links_are_dropped_and_noted_never_followed(tmp_path):
     archive = make_zip(tmp_path / 'a.zip', [('exam/package.xml', PACKAGE_XML)], links=[('exam/l', '/etc/passwd')])
     notes, fixes = [], []
-    assert unpack.safe_extract(archive, str(tmp_path / 'out'), notes=notes, fixes=fixes) == 1
+    assert archives.safe_extract(archive, str(tmp_path / 'out'), notes=notes, fixes=fixes) == 1
     assert not os.path.lexists(str(tmp_path / 'out' / 'exam' / 'l'))
     assert fixes and "'exam/l' -> '/etc/passwd'" in fixes[0] and not notes
 
 
 def test_bombs_and_crowds_are_refused(tmp_path):
-    bomb = make_zip(tmp_path / 'bomb.zip', [('exam/big', b'\0' * (unpack.RATIO_FROM_BYTES + 1))])
-    with pytest.raises(unpack.UnpackError, match='bomb'):
-        unpack.safe_extract(bomb, str(tmp_path / 'out'))
+    bomb = make_zip(tmp_path / 'bomb.zip', [('exam/big', b'\0' * (archives.RATIO_FROM_BYTES + 1))])
+    with pytest.raises(archives.UnpackError, match='bomb'):
+        archives.safe_extract(bomb, str(tmp_path / 'out'))
     crowd = make_zip(tmp_path / 'crowd.zip', [('f%d' % i, 'x') for i in range(20)])
-    with pytest.raises(unpack.UnpackError, match='20 more files, beyond the 10'):
-        unpack.safe_extract(crowd, str(tmp_path / 'out2'), max_files=10)
+    with pytest.raises(archives.UnpackError, match='20 more files, beyond the 10'):
+        archives.safe_extract(crowd, str(tmp_path / 'out2'), max_files=10)
     big = make_zip(tmp_path / 'big.zip', [('f', 'y' * 5000)])
-    with pytest.raises(unpack.UnpackError, match='5000 more bytes, beyond the 1000'):
-        unpack.safe_extract(big, str(tmp_path / 'out3'), max_bytes=1000)
+    with pytest.raises(archives.UnpackError, match='5000 more bytes, beyond the 1000'):
+        archives.safe_extract(big, str(tmp_path / 'out3'), max_bytes=1000)
 
 
 def test_not_a_zip(tmp_path):
     path = tmp_path / 'report.zip'
     path.write_text('not a zip')
-    with pytest.raises(unpack.UnpackError, match='not a readable zip'):
-        unpack.safe_extract(str(path), str(tmp_path / 'out'))
+    with pytest.raises(archives.UnpackError, match='not a readable zip'):
+        archives.safe_extract(str(path), str(tmp_path / 'out'))
+
+
+def unreadable_zip(path, how, links=()):
+    """A zip whose listing reads but whose bytes cannot be had: ``crc`` (a byte of its package.xml's data
+    changed, as a cut or damaged download), ``encrypted`` (every entry flagged password-protected in
+    both its headers, as a zip a student made with a password: APPNOTE.TXT 4.4.4, general purpose bit 0)."""
+    make_zip(path, [('exam/package.xml', PACKAGE_XML)], links)
+    data = bytearray(path.read_bytes())
+    with zipfile.ZipFile(str(path)) as zf:
+        infos = zf.infolist()
+    if how == 'crc':
+        data[infos[0].header_offset + 30 + len(infos[0].filename) + 1] ^= 0xff  # a byte of the compressed data
+    else:
+        central = data.index(b'PK\x01\x02')
+        for info in infos:
+            data[info.header_offset + 6] |= 0x1  # the local header's flags
+            data[data.index(b'PK\x01\x02', central) + 8] |= 0x1  # the central header's
+            central = data.index(b'PK\x01\x02', central) + 4
+    path.write_bytes(bytes(data))
+    return str(path)
+
+
+@pytest.mark.parametrize('how', ['crc', 'encrypted'])
+def test_a_zip_whose_bytes_cannot_be_read_is_refused_with_why(tmp_path, how):
+    """A damaged or password-protected upload is refused with the reason for the teacher, as a class
+    archive's student is (classlist), never a crash of the inspection; a link among its entries (whose
+    target is read for the teacher's note) changes nothing."""
+    (tmp_path / 'upload').mkdir()
+    archive = unreadable_zip(tmp_path / 'upload' / 'exam.zip', how, links=[('exam/l', '/etc/passwd')])
+    why = {'crc': "Bad CRC-32 for file 'exam/package.xml'", 'encrypted': 'it is encrypted (made with a password)'}[how]
+    with pytest.raises(archives.UnpackError, match=re.escape('exam.zip cannot be unpacked: %s' % why)):
+        archives.safe_extract(archive, str(tmp_path / 'out'))
+    with pytest.raises(archives.UnpackError, match=re.escape('exam.zip (refused: exam.zip cannot be unpacked: %s' % why)):
+        package.open_submission(str(tmp_path / 'upload'), str(tmp_path / 'scratch'), [])
 
 
 @pytest.mark.parametrize('prefix', ['', 'exam_jdupont/', 'catkin_ws/src/'])
@@ -62,7 +97,7 @@ def test_package_found_at_the_top_or_below(tmp_path, prefix):
                                             (prefix + 'exam/scripts/exam_node.py', 'print(1)'),
                                             ('__MACOSX/._exam', 'junk')])
     notes = []
-    found = unpack.open_submission(archive, str(tmp_path / 'scratch'), notes)
+    found = package.open_submission(archive, str(tmp_path / 'scratch'), notes)
     assert found.endswith(os.path.join(prefix.rstrip('/'), 'exam').lstrip('/'))
     assert os.path.isfile(os.path.join(found, 'scripts', 'exam_node.py'))
 
@@ -72,24 +107,24 @@ def test_student_folder_with_report_and_zip(tmp_path):
     folder.mkdir()
     (folder / 'report.pdf').write_bytes(b'%PDF-1.4')
     make_zip(folder / 'exam.zip', [('exam/package.xml', PACKAGE_XML)])
-    students = unpack.list_students(str(tmp_path), str(tmp_path / 'scratch'))
+    students = classlist.list_students(str(tmp_path), str(tmp_path / 'scratch'))
     assert [name for name, _ in students] == ['Jane Doe']
-    found = unpack.open_submission(students[0][1], str(tmp_path / 'scratch'), [])
-    assert unpack.package_name(os.path.join(found, 'package.xml')) == 'exam'
+    found = package.open_submission(students[0][1], str(tmp_path / 'scratch'), [])
+    assert package.package_name(os.path.join(found, 'package.xml')) == 'exam'
 
 
 def test_refused_zip_is_reported(tmp_path):
     folder = tmp_path / 'student'
     folder.mkdir()
     make_zip(folder / 'exam.zip', [('../x', 'x')])
-    with pytest.raises(unpack.UnpackError, match='climbs out'):
-        unpack.open_submission(str(folder), str(tmp_path / 'scratch'), [])
+    with pytest.raises(archives.UnpackError, match='climbs out'):
+        package.open_submission(str(folder), str(tmp_path / 'scratch'), [])
 
 
 def test_class_zip(tmp_path):
     archive = make_zip(tmp_path / 'class.zip', [('all/Ann_1_assignsubmission_file_/exam/package.xml', PACKAGE_XML),
                                                 ('all/Bob_2_assignsubmission_file_/exam/package.xml', PACKAGE_XML)])
-    students = unpack.list_students(archive, str(tmp_path / 'scratch'))
+    students = classlist.list_students(archive, str(tmp_path / 'scratch'))
     assert [name for name, _ in students] == ['Ann', 'Bob']
 
 
@@ -100,7 +135,7 @@ def test_copy_skips_build_products_and_links(tmp_path):
     (src / 'scripts' / 'exam_node.py').write_text('x')
     os.symlink('/etc/passwd', str(src / 'scripts' / 'link'))
     notes = []
-    unpack.copy_package(str(src), str(tmp_path / 'copy'), notes)
+    package.copy_package(str(src), str(tmp_path / 'copy'), notes)
     assert sorted(os.listdir(str(tmp_path / 'copy'))) == ['scripts']
     assert os.listdir(str(tmp_path / 'copy' / 'scripts')) == ['exam_node.py']
     assert any('link' in n for n in notes)
@@ -110,7 +145,7 @@ def test_a_compressible_file_in_an_upload_is_no_bomb(tmp_path):
     """A few MB of log or a one-colour screenshot compress 1000x: the budget bounds them, not the ratio."""
     upload = make_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML),
                                               ('exam/run.log', b'[INFO] altitude 1300.0\n' * 100000)])
-    assert unpack.safe_extract(upload, str(tmp_path / 'out')) == 2
+    assert archives.safe_extract(upload, str(tmp_path / 'out')) == 2
 
 
 def moodle_class(path, students):
@@ -124,14 +159,14 @@ def test_a_class_zip_judges_each_student_by_its_own_bounds(tmp_path, monkeypatch
     """Issue 36 point 3: a one-colour screenshot (5 MB of one byte) is no reason to refuse anyone; a
     student over its own bounds is refused alone, on its own row, with the reason; the others are
     unpacked."""
-    monkeypatch.setattr(unpack, 'MAX_FILES', 3)
-    package = [('exam.zip', open(make_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML)]), 'rb').read())]
+    monkeypatch.setattr(archives, 'MAX_FILES', 3)
+    upload = [('exam.zip', open(make_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML)]), 'rb').read())]
     archive = moodle_class(tmp_path / 'class.zip', {
-        'Ann Lee_11_assignsubmission_file_': package + [('screenshot.bmp', b'\xff' * (5 << 20))],
-        'Bob Crowd_12_assignsubmission_file_': package + [('f%d.txt' % i, 'x') for i in range(4)],
-        'Cy Fine_13_assignsubmission_file_': package})
+        'Ann Lee_11_assignsubmission_file_': upload + [('screenshot.bmp', b'\xff' * (5 << 20))],
+        'Bob Crowd_12_assignsubmission_file_': upload + [('f%d.txt' % i, 'x') for i in range(4)],
+        'Cy Fine_13_assignsubmission_file_': upload})
     refused = {}
-    students = unpack.list_students(archive, str(tmp_path / 'scratch'), refused)
+    students = classlist.list_students(archive, str(tmp_path / 'scratch'), refused)
     assert [name for name, _ in students] == ['Ann Lee', 'Bob Crowd', 'Cy Fine']
     paths = dict(students)
     assert list(refused) == [paths['Bob Crowd']] and os.listdir(paths['Bob Crowd']) == []
@@ -146,17 +181,17 @@ def test_a_class_zip_is_bounded_as_a_whole(tmp_path, monkeypatch):
     entry outside every student's folder."""
     students = {'S%d_%d_assignsubmission_file_' % (i, i): [('a.txt', 'x' * 100)] for i in range(3)}
     archive = moodle_class(tmp_path / 'class.zip', students)
-    monkeypatch.setattr(unpack, 'CLASS_BYTES', 250)
-    with pytest.raises(unpack.UnpackError, match=r'come to 300 bytes \(at most 250 for a class\)'):
-        unpack.list_students(archive, str(tmp_path / 'a'))
-    monkeypatch.setattr(unpack, 'CLASS_FILES', 2)
-    with pytest.raises(unpack.UnpackError, match=r'holds 3 entries \(at most 2 for a class\)'):
-        unpack.list_students(archive, str(tmp_path / 'b'))
-    monkeypatch.setattr(unpack, 'CLASS_FILES', 100)
+    monkeypatch.setattr(classlist, 'CLASS_BYTES', 250)
+    with pytest.raises(archives.UnpackError, match=r'come to 300 bytes \(at most 250 for a class\)'):
+        classlist.list_students(archive, str(tmp_path / 'a'))
+    monkeypatch.setattr(classlist, 'CLASS_FILES', 2)
+    with pytest.raises(archives.UnpackError, match=r'holds 3 entries \(at most 2 for a class\)'):
+        classlist.list_students(archive, str(tmp_path / 'b'))
+    monkeypatch.setattr(classlist, 'CLASS_FILES', 100)
     with zipfile.ZipFile(archive, 'a') as zf:
         zf.writestr('../outside.txt', 'x')
-    with pytest.raises(unpack.UnpackError, match='outside'):
-        unpack.list_students(archive, str(tmp_path / 'c'))
+    with pytest.raises(archives.UnpackError, match='outside'):
+        classlist.list_students(archive, str(tmp_path / 'c'))
 
 
 def test_a_student_named_like_an_output_gets_a_folder_of_its_own(tmp_path):
@@ -164,13 +199,13 @@ def test_a_student_named_like_an_output_gets_a_folder_of_its_own(tmp_path):
     none is named like the class's files."""
     archive = make_zip(tmp_path / 'class.zip', [
         ('grades.csv.zip', 'z'), ('index.html.zip', 'z'), ('hand.csv_7_assignsubmission_file_/exam.zip', 'z')])
-    names = [name for name, _ in unpack.list_students(archive, str(tmp_path / 'scratch'))]
+    names = [name for name, _ in classlist.list_students(archive, str(tmp_path / 'scratch'))]
     assert names == ['grades_csv', 'hand_csv', 'index_html']
 
 
 def test_a_name_in_any_bytes_is_shown_as_its_bytes():
     """A byte that is not UTF-8 (surrogateescape) reads ``\\xNN`` in a note, as on the page; a name
     that merely holds a backslash is not taken for one."""
-    assert unpack.shown_name(b'exam/lien\xfe'.decode('utf-8', 'surrogateescape')) == "'exam/lien\\xfe'"
-    assert unpack.shown_name('a\\udcff') == "'a\\\\udcff'"
-    assert unpack.shown_name('Größe\n') == "'Größe\\n'"
+    assert archives.shown_name(b'exam/lien\xfe'.decode('utf-8', 'surrogateescape')) == "'exam/lien\\xfe'"
+    assert archives.shown_name('a\\udcff') == "'a\\\\udcff'"
+    assert archives.shown_name('Größe\n') == "'Größe\\n'"

@@ -5,22 +5,29 @@
 The folder a module lives in says who runs it, on whose bytes (docs/grading.md, "Isolation"):
 
 - ``boxed/`` -- as a box's uid, never root, on the student's bytes: :mod:`~.boxed.inspect` (reads one
-  upload and writes its record), :mod:`~.boxed.intake` (a class archive), :mod:`~.boxed.unpack` (safe
-  unzipping, finding the package, a class's students), :mod:`~.boxed.source` (what the sources say;
+  upload and writes its record), :mod:`~.boxed.intake` (a class archive), :mod:`~.boxed.archives` (one
+  archive unpacked after checking every entry), :mod:`~.boxed.package` (the package found in an upload,
+  copied), :mod:`~.boxed.uploads` (which of several uploads is the last), :mod:`~.boxed.classlist` (a
+  class's students, from a folder or an archive), :mod:`~.boxed.source` (what the sources say;
   the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it,
   the derived launch files the grader runs), :mod:`~.boxed.documents` (participant number, PDF
   reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own).
 - ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`
   (rospy: plays the drone with the harness's fake drone, measures, watches the node's pid).
 - ``host/`` -- root: :mod:`~.host.session` (builds and runs one submission: the student's steps in its
-  box, the master and the probe as the slot's judge uid), :mod:`~.host.sandbox` (the box: bubblewrap, a
-  uid of its own, limits; the capped, regular-file-only copy of what a box leaves) and
-  :mod:`~.host.egress` (the only reader of a box's record: capped, never a link, checked against its
-  schema).
-- ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima) and
+  box, the master and the probe as the slot's judge uid), :mod:`~.host.sandbox` (the box: opened, its command lines, run, closed),
+  :mod:`~.host.uids` (a slot's box and judge uids, under a lock; what runs as them ended),
+  :mod:`~.host.cgroups` (the box's and the judge's cgroups), :mod:`~.host.limits` (their bounds;
+  prlimit), :mod:`~.host.bwrap` (bubblewrap's command line; the session's network namespace),
+  :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder) and
+  :mod:`~.host.egress` (the only reader of what a box leaves: its record, capped, never a link, checked
+  against its schema; its logs, capped).
+- ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima),
   :mod:`~.score.rubric` (points, evidence and status from the measurements), :mod:`~.score.safe_text`
   (student-derived text without control characters, for every record and output), :mod:`~.score.records`
-  (the typed records that cross the boundary, with their schemas).
+  (the typed records that cross the boundary, with their schemas), :mod:`~.score.identity` (who a
+  submission is: Moodle's participant number and folder, the student's name) and :mod:`~.score.boxenv`
+  (the paths and the environment a box's processes see).
 - ``publish/`` -- what the teacher reads, from records only: :mod:`~.publish.report` (grade.json,
   grade.md, grades.csv, the terminal table), :mod:`~.publish.desk` (writes the rest into OUT),
   :mod:`~.publish.page` (index.html), :mod:`~.publish.flightplot`, :mod:`~.publish.moodle` (the

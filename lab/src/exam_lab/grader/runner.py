@@ -1,7 +1,7 @@
 """Grading a submission or a class: inspect (boxed), run the session (sandboxed), score, write.
 
 Root never parses a student's bytes. It stages the upload byte for byte (regular files, folders, links
-as links: :func:`~exam_lab.grader.host.sandbox.stage_upload`), opens the submission's
+as links: :func:`~exam_lab.grader.host.staging.stage_upload`), opens the submission's
 :class:`~exam_lab.grader.host.sandbox.Box`, and runs :mod:`~exam_lab.grader.boxed.inspect` in it, as the
 box's uid, without network, within INSPECT_BOUNDS: unpacking, the package copied into the workspace,
 the teacher's fixes, launch and YAML analysis, the derived launch files (at the paths the run box sees),
@@ -10,12 +10,12 @@ the source scan, PDF facts and comment statistics. Root reads back one capped, s
 the workspace stays the box uid's, read-only in the build and run box. A class archive is unpacked by
 :mod:`~exam_lab.grader.boxed.intake`, the similarity check runs in a box too. Then
 :mod:`exam_lab.grader.host.session` runs in a network namespace with only loopback
-(:func:`~exam_lab.grader.host.sandbox.network_namespace`: ``unshare --net`` as root, a user namespace of
+(:func:`~exam_lab.grader.host.bwrap.network_namespace`: ``unshare --net`` as root, a user namespace of
 its own too otherwise), under a :class:`~exam_lab.harness.supervisor.Supervisor` with an overall time
 limit;
 :mod:`~exam_lab.grader.score.rubric` scores and :mod:`~exam_lab.grader.publish.report` writes; what reaches
 the results from the session's folder is copied as data (regular files only, each capped:
-:func:`~exam_lab.grader.host.sandbox.copy_results`).
+:func:`~exam_lab.grader.host.egress.copy_results`).
 
 The simulators (``node_kit``, ``drone_sim``, ``mydrone``, ``submarinedrone``) are built once as an underlay
 workspace (cached under ``$EXAM_WS/grader/underlay``, rebuilt when their sources change); each student's
@@ -38,15 +38,15 @@ import time
 import traceback
 
 from exam_lab.grader import workspace
-from exam_lab.grader.boxed import similarity, unpack
+from exam_lab.grader.boxed import archives, classlist, similarity
 
-from exam_lab.grader.host import egress, sandbox
-from exam_lab.grader.host.sandbox import BOX_WS
+from exam_lab.grader.host import bwrap, egress, limits, sandbox, staging
 from exam_lab.grader.host.session import budget_sentence
+from exam_lab.grader.score.boxenv import BOX_WS
 
-from exam_lab.grader.score import records, rubric
+from exam_lab.grader.score import identity, records, rubric
 
-from exam_lab.grader.publish import moodle, progress, provenance, report
+from exam_lab.grader.publish import progress, provenance, report
 from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, SHEETS, margin_of
 from exam_lab.harness.supervisor import WORKSPACE_VARS, Supervisor, end_pids, marked
 
@@ -90,7 +90,7 @@ def can_isolate():
 def _can_isolate():
     if 'ok' not in _isolation:
         try:
-            _isolation['ok'] = subprocess.run(sandbox.network_namespace(['true']), stdout=subprocess.DEVNULL,
+            _isolation['ok'] = subprocess.run(bwrap.network_namespace(['true']), stdout=subprocess.DEVNULL,
                                               stderr=subprocess.DEVNULL, timeout=10).returncode == 0
         except (OSError, subprocess.SubprocessError):
             _isolation['ok'] = False
@@ -166,7 +166,7 @@ def _grader_source():
 
 class Boxed(object):
     """One of the grader's own modules run on student bytes in ``box``, as its uid, without network:
-    ``<work>/upload`` (staged by root, :func:`~exam_lab.grader.host.sandbox.stage_upload`) read-only at
+    ``<work>/upload`` (staged by root, :func:`~exam_lab.grader.host.staging.stage_upload`) read-only at
     ``/box/upload``, ``<work>/out`` writable at ``/box/out``, the grader's source read-only; its one
     record is read back through :func:`~exam_lab.grader.host.egress.read_record`. Unsandboxed, the same
     folders are used at their host paths.
@@ -202,7 +202,7 @@ class Boxed(object):
         """
         timeout, cpu, memory = bounds
         # Only lowered: a box's process cannot raise its hard limits (sandbox.Box.argv's prlimit).
-        cpu, memory = min(cpu, sandbox.CPU_SECONDS), min(memory, sandbox.ADDRESS_SPACE_BYTES)
+        cpu, memory = min(cpu, limits.CPU_SECONDS), min(memory, limits.ADDRESS_SPACE_BYTES)
         command = ['prlimit', '--as=%d' % memory, '--cpu=%d' % cpu, '--', python, '-m', module] + list(args)
         env = {'PATH': '/usr/bin:/bin', 'PYTHONPATH': self.source, 'PYTHONDONTWRITEBYTECODE': '1'}
         log = os.path.join(self.work, '%s.log' % module.rsplit('.', 1)[-1])
@@ -217,7 +217,7 @@ class Boxed(object):
             signum = -status if status < 0 else status - 128 if status > 128 else None
             why = 'it failed (exit %d)' % status if signum is None else \
                 'it was killed by signal %d (its bounds: %d s of CPU, %d MB of address space)' % (signum, cpu, memory >> 20)
-        tail = session_tail(sandbox.read_capped(log, 4096) or '')
+        tail = session_tail(egress.read_capped(log, 4096) or '')
         raise InspectionFailed('%s%s' % (why, ': %s' % tail if tail else ''))
 
 
@@ -281,7 +281,7 @@ def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BU
         and killed SESSION_KILL_S after.
 
     :param isolate: in a network namespace of its own with only loopback
-        (:func:`~exam_lab.grader.host.sandbox.network_namespace`).
+        (:func:`~exam_lab.grader.host.bwrap.network_namespace`).
     :param on_step: called with each step's name as the session starts it (:mod:`~exam_lab.grader.publish.progress`).
     """
     log_dir = os.path.join(work, 'logs')
@@ -296,7 +296,7 @@ def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BU
         json.dump(job, f, indent=1, sort_keys=True)
     argv = [sys.executable, '-m', 'exam_lab.grader.host.session', job_path]
     if isolate:
-        argv = sandbox.network_namespace(argv)
+        argv = bwrap.network_namespace(argv)
     with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
         status, output, _ = sup.run('session', argv, timeout=left + SESSION_KILL_S, env=dict(os.environ, HOME=judge_home))
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
@@ -481,7 +481,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     :param jobs: how many submissions are graded side by side: the box's part of the CPU.
     """
     start = time.monotonic()
-    student = student or unpack.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
+    student = student or identity.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
     refusal = sandbox_refusal(unsandboxed)
     if refusal:
         raise sandbox.SandboxUnavailable(refusal)
@@ -495,17 +495,17 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     os.chmod(work, 0o711)
     folder = os.path.basename(os.path.abspath(submission).rstrip('/'))
     notes, fixes, static, session, chosen_sheet, comments, how_run = [], [], {}, None, sheet, None, None
-    facts = {'participant': moodle.participant_number(folder), 'folder': folder, 'documents': []}
+    facts = {'participant': identity.participant_number(folder), 'folder': folder, 'documents': []}
     try:
         try:
             progress.report(on_step, 'unpack')
             upload = os.path.join(work, 'upload', folder if folder not in ('', '.', '..') else 'upload')
             os.mkdir(os.path.dirname(upload), 0o755)
-            sandbox.stage_upload(os.path.realpath(submission), upload)  # the teacher's path: followed
+            staging.stage_upload(os.path.realpath(submission), upload)  # the teacher's path: followed
             for sub in ('ws', 'ws/src'):
                 os.mkdir(os.path.join(work, sub), 0o755)
             with sandbox.Box(work, _box_binds(underlay), bwrap=sandbox.check() is None,
-                             cpus=sandbox.box_cpus(jobs)) as box:
+                             cpus=limits.box_cpus(jobs)) as box:
                 notes.extend(box.notes)
                 found = inspect(box, work, upload, sheet, timeout=deadline - time.monotonic())
                 notes.append(_how_read(box, found.uid))
@@ -513,7 +513,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                 fixes.extend(found.fixes)
                 facts, comments = found.facts, found.comments
                 if found.refused is not None:
-                    raise unpack.UnpackError(found.refused)
+                    raise archives.UnpackError(found.refused)
                 chosen_sheet, static = found.sheet, found.static
                 job = plan_job(found)
                 if job is None:
@@ -527,7 +527,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                     how_run = _how_run(box)
                     session = run_session(job, work, underlay, isolate, box, on_step,
                                           left=deadline - time.monotonic())
-        except (unpack.UnpackError, sandbox.UploadRefused) as err:
+        except (archives.UnpackError, staging.UploadRefused) as err:
             session = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % err}
         except InspectionFailed as err:
             session = {'build': None, 'runs': [], 'error': 'the inspection of the upload failed: %s' % err}
@@ -537,7 +537,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
         logs = os.path.join(out_dir, 'logs')
         shutil.rmtree(logs, ignore_errors=True)
         if os.path.isdir(os.path.join(work, 'logs')):
-            skipped = sandbox.copy_results(os.path.join(work, 'logs'), logs)
+            skipped = egress.copy_results(os.path.join(work, 'logs'), logs)
             if skipped:
                 notes.append('not copied to logs/ (not a regular file): %s' % ', '.join(skipped))
         measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session,
@@ -559,7 +559,7 @@ def _staged_work(prefix, sources, parent=None, bounds=None, refused=None):
     ``<work>/upload/<index>/<name>``, within ``bounds`` (``(bytes, files)``; one upload's when None);
     returns ``(work, [staged paths])``. With ``refused`` (a dict), a source over its bounds is not
     staged (None in its place) and ``refused`` receives ``{its path: why}``; otherwise it raises
-    :class:`~exam_lab.grader.host.sandbox.UploadRefused`."""
+    :class:`~exam_lab.grader.host.staging.UploadRefused`."""
     work = tempfile.mkdtemp(prefix=prefix, dir=parent)
     os.chmod(work, 0o711)
     staged = []
@@ -569,8 +569,8 @@ def _staged_work(prefix, sources, parent=None, bounds=None, refused=None):
         os.mkdir(os.path.join(work, 'upload', str(index)), 0o755)
         staged.append(os.path.join(work, 'upload', str(index), name if name not in ('', '.', '..') else 'upload'))
         try:
-            sandbox.stage_upload(path, staged[-1], *(bounds or ()))
-        except sandbox.UploadRefused as err:
+            staging.stage_upload(path, staged[-1], *(bounds or ()))
+        except staging.UploadRefused as err:
             if refused is None:
                 raise
             refused[path] = str(err)
@@ -584,23 +584,23 @@ def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
     the students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`); with
     ``out``, the folder of an earlier run of the class, each student keeps the name (the folder in OUT)
     that run gave its participant number (:func:`kept_folders`). A
-    folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.boxed.unpack.list_students`
+    folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.boxed.classlist.list_students`
     opens no file of a folder); an archive is unpacked by :mod:`exam_lab.grader.boxed.intake` in a box of
     its own (INTAKE_BOUNDS), in a work folder made in ``scratch`` (default: the system's temp folder) and
     appended to ``work_dirs`` (the caller removes it once the students are graded). ``refused`` (a
     dict) receives ``{folder: why}`` of the students whose files the intake refused by their own
     bounds (:func:`grade_student`'s ``refused``).
 
-    :raises unpack.UnpackError: the archive could not be unpacked (why, and the end of the box's log).
+    :raises archives.UnpackError: the archive could not be unpacked (why, and the end of the box's log).
     """
     class_path = os.path.abspath(class_path)
     if not os.path.isfile(class_path):
-        return _unique(unpack.list_students(class_path, None), kept_folders(out))
+        return _unique(classlist.list_students(class_path, None), kept_folders(out))
     if scratch:
         os.makedirs(scratch, mode=0o711, exist_ok=True)
     # One file, bounded as a class (a class of 60 with its PDFs is more than one upload may be).
     work, (staged,) = _staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch,
-                                   (unpack.CLASS_BYTES, 1))
+                                   (classlist.CLASS_BYTES, 1))
     work_dirs.append(work)
     with sandbox.Box(work, bwrap=sandbox.check() is None) as box:
         boxed = Boxed(box, work)
@@ -609,12 +609,12 @@ def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
                                                                  boxed.path(boxed.out)], records.IntakeRecord,
                               INTAKE_BOUNDS)
         except InspectionFailed as err:
-            raise unpack.UnpackError('unpacking it in its box failed: %s' % err)
+            raise archives.UnpackError('unpacking it in its box failed: %s' % err)
     students = []
     for student in found.students:
         path = os.path.join(boxed.out, student['path'])
         if os.path.realpath(path) != os.path.normpath(path) or not os.path.lexists(path):
-            raise unpack.UnpackError('the intake named %s, which is a link or missing' % student['path'])
+            raise archives.UnpackError('the intake named %s, which is a link or missing' % student['path'])
         if student.get('refused') is not None and refused is not None:
             refused[path] = student['refused']
         students.append((student['name'], path))
@@ -640,7 +640,7 @@ def kept_folders(out):
             facts = facts.get('extra', {}) if kept_file == MEASUREMENTS else facts
             number = facts.get('participant')
             if number is None:
-                number = moodle.participant_number(str(facts.get('folder') or ''))
+                number = identity.participant_number(str(facts.get('folder') or ''))
             if isinstance(number, int):
                 kept.setdefault(number, name)
             break
@@ -649,7 +649,7 @@ def kept_folders(out):
 
 def _unique(students, kept=None):
     """Each student's name made unique (``Jane Doe``, ``Jane Doe_2``): it is the student's folder in
-    OUT, which never ends like one of the class's files (:func:`~exam_lab.grader.boxed.unpack.student_name`).
+    OUT, which never ends like one of the class's files (:func:`~exam_lab.grader.score.identity.student_name`).
     A participant that ``kept`` (:func:`kept_folders`) gives a folder keeps it, and no other
     student takes a folder of OUT that is a participant's: a classmate whose name cleans to the same
     (``Jane Doe.``) submitting late never takes the first one's folder, its kept measurements or its
@@ -658,7 +658,7 @@ def _unique(students, kept=None):
     held = set(kept.values())
     named, seen = [None] * len(students), set()
     for index, (name, folder) in enumerate(students):
-        previous = kept.get(moodle.participant_number(os.path.basename(folder.rstrip('/'))))
+        previous = kept.get(identity.participant_number(os.path.basename(folder.rstrip('/'))))
         if previous is not None and previous not in seen and \
                 (previous == name or re.match(r'^%s_\d+$' % re.escape(name), previous)):
             named[index] = previous
@@ -691,7 +691,7 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
         record = could_not_grade(name, sheet, '%r' % err,
                                  ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
         moodle_name = os.path.basename(os.path.abspath(folder).rstrip('/'))
-        record.update(participant=moodle.participant_number(moodle_name), folder=moodle_name)  # who, even so
+        record.update(participant=identity.participant_number(moodle_name), folder=moodle_name)  # who, even so
         try:
             report.write_grade(os.path.join(out_dir, name), record)
         except OSError:
@@ -705,7 +705,7 @@ def _refused_at_intake(name, folder, out_dir, sheet, why):
     measured = {'student': name, 'sheet': sheet or 'altitude', 'static': {}, 'notes': [], 'fixes': [],
                 'comments': None, 'isolate': None, 'how_run': None,
                 'session': {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % why},
-                'extra': {'participant': moodle.participant_number(folder_name), 'folder': folder_name,
+                'extra': {'participant': identity.participant_number(folder_name), 'folder': folder_name,
                           'documents': [], 'seconds': 0.0}}
     os.makedirs(out_dir, exist_ok=True)
     with open(os.path.join(out_dir, MEASUREMENTS), 'w') as f:
@@ -748,7 +748,7 @@ def class_similarity(klass, out, records_):
         result['notes'] = ['%s: not compared (its files were refused: %s)' % (name, refused[folder])
                            for name, folder in listed if folder in refused] + result.get('notes', [])
     except Exception as err:  # a bug of the check, or its box failing, must not cost the class its page
-        result = {'error': str(err) if isinstance(err, (InspectionFailed, unpack.UnpackError)) else repr(err)}
+        result = {'error': str(err) if isinstance(err, (InspectionFailed, archives.UnpackError)) else repr(err)}
     finally:
         for work in work_dirs:
             shutil.rmtree(work, ignore_errors=True)

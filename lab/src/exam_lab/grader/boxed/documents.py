@@ -6,7 +6,7 @@ import os
 import re
 import zlib
 
-from exam_lab.grader.publish import moodle
+from exam_lab.grader.score.identity import participant_number
 
 #: Bytes of a PDF read to count its pages, and the work spent on its streams, all together: bytes
 #: fed to zlib plus bytes inflated (a stream that fails still costs what was fed). Most bytes one
@@ -112,4 +112,4 @@ def submission_facts(path):
     """What a grade record takes from the submission itself: ``participant`` (Moodle's number in the
     folder's name, or None), ``folder`` (that name), ``documents`` (the PDFs handed in)."""
     name = os.path.basename(os.path.abspath(path).rstrip('/'))
-    return {'participant': moodle.participant_number(name), 'folder': name, 'documents': documents(path)}
+    return {'participant': participant_number(name), 'folder': name, 'documents': documents(path)}

@@ -5,7 +5,7 @@ network, with a wall-clock, CPU and memory bound::
 
     python3 -m exam_lab.grader.boxed.inspect --upload U --ws /box/ws --out /box/out [--sheet S] [--toplevel T]
 
-It unpacks the upload (:mod:`~exam_lab.grader.boxed.unpack`, scratch under ``OUT``), copies the package
+It unpacks the upload (:mod:`~exam_lab.grader.boxed.package`, scratch under ``OUT``), copies the package
 into ``WS/src/<name>``, makes the teacher's fixes (:mod:`~exam_lab.grader.boxed.source`), analyses the
 launch files and writes the derived ones (:mod:`~exam_lab.grader.boxed.launch`), reads the PDF facts
 (:mod:`~exam_lab.grader.boxed.documents`) and the comment statistics, and writes ``OUT/inspect.json``:
@@ -22,9 +22,8 @@ import random
 import re
 import sys
 
-from exam_lab.grader.boxed import documents, launch, source, unpack
-from exam_lab.grader.host import sandbox
-from exam_lab.grader.score import records
+from exam_lab.grader.boxed import archives, documents, launch, package, source
+from exam_lab.grader.score import boxenv, records
 from exam_lab.grader.score.sheets import PACKAGE, SHEETS, threshold_run_value
 
 
@@ -70,15 +69,15 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
               'comments': None, 'facts': documents.submission_facts(upload)}
     uploads = []
     try:
-        pkg_source = unpack.open_submission(upload, os.path.join(out, 'unpacked'), notes, fixes, uploads=uploads)
-    except unpack.UnpackError as err:
+        pkg_source = package.open_submission(upload, os.path.join(out, 'unpacked'), notes, fixes, uploads=uploads)
+    except archives.UnpackError as err:
         record['refused'] = str(err)
         return record
-    name = unpack.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
+    name = package.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
     pkg = os.path.join(ws, 'src', name if re.match(r'^[A-Za-z][\w-]*$', name) else PACKAGE)
-    unpack.copy_package(pkg_source, pkg, fixes)
+    package.copy_package(pkg_source, pkg, fixes)
     fixes.extend(source.fix_text(pkg))
-    box_env = sandbox.box_env({'PATH': '/usr/bin:/bin'})  # what $(env) reads in the run box, nothing of ours
+    box_env = boxenv.box_env({'PATH': '/usr/bin:/bin'})  # what $(env) reads in the run box, nothing of ours
     analyses = [launch.analyse(path, pkg, name, box_env) for path in launch.launch_files(pkg)]
     sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
     notes.insert(0, how)

@@ -6,7 +6,7 @@ The runner starts it in a box of its own, without network, bounded in time and m
 
 and reads back ``OUT/intake.json``, an :class:`~exam_lab.grader.score.records.IntakeRecord`: each
 student's name and the path of its submission relative to ``OUT``, and why its files were refused when
-they were (:func:`~exam_lab.grader.boxed.unpack.unpack_class`: that student's row says so, the others
+they were (:func:`~exam_lab.grader.boxed.classlist.unpack_class`: that student's row says so, the others
 are graded). (A class that is a folder is not
 unpacked: root lists its entries by name, and stages each student's upload for that student's box.)
 """
@@ -14,7 +14,7 @@ import argparse
 import os
 import sys
 
-from exam_lab.grader.boxed import unpack
+from exam_lab.grader.boxed import archives, classlist
 from exam_lab.grader.score import records
 
 
@@ -28,8 +28,8 @@ def main(argv=None):
         return 2
     refused = {}
     try:
-        students = unpack.list_students(args.klass, args.out, refused)
-    except unpack.UnpackError as err:
+        students = classlist.list_students(args.klass, args.out, refused)
+    except archives.UnpackError as err:
         sys.stderr.write('intake: the class archive cannot be opened safely: %s\n' % err)
         return 3
     try:

@@ -272,7 +272,7 @@ def analyse(path, package_dir, package=PACKAGE, env=None):
     content.
 
     :param env: what ``$(env)`` / ``$(optenv)`` see: the environment of a ROS process in the box
-        (:func:`exam_lab.grader.host.sandbox.box_env`); none when not given.
+        (:func:`exam_lab.grader.score.boxenv.box_env`); none when not given.
     """
     analysis = Analysis(path, package_dir, package, env)
     if inside(package_dir, path) is None:

@@ -26,7 +26,8 @@ import sys
 import tempfile
 
 from exam_lab.grader import workspace
-from exam_lab.grader.boxed import unpack
+from exam_lab.grader.boxed import archives
+from exam_lab.grader.boxed.package import open_submission
 
 VERSION = '0.5.0'
 #: copydetect's noise threshold (k, characters of normalised code) and window.
@@ -149,7 +150,7 @@ def stage(submissions, target):
         notes_here = []
         scratch = os.path.join(target, 'unpacked-%d' % index)
         try:
-            package = unpack.open_submission(path, scratch, notes_here)
+            package = open_submission(path, scratch, notes_here)
             taken, left = student_code(package)
             folder = os.path.join(target, 'code', str(index))
             for relative in taken:
@@ -163,7 +164,7 @@ def stage(submissions, target):
         if left:
             notes.append('%s: %d code file(s) compared, %d left out (at most %d files and %d bytes of a student): %s'
                          % (name, len(taken), len(left), MAX_STUDENT_FILES, MAX_STUDENT_BYTES,
-                            unpack.listed([unpack.shown_name(r) for r in left])))
+                            archives.listed([archives.shown_name(r) for r in left])))
         if os.path.isdir(folder):
             staged[name] = folder
         else:

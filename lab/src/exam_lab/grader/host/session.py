@@ -36,7 +36,9 @@ import re
 import sys
 import time
 
-from exam_lab.grader.host.sandbox import FILE_CAP, Box, memory_use, read_capped, reset_memory_peak
+from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
+from exam_lab.grader.host.egress import FILE_CAP, read_capped
+from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
@@ -270,7 +272,7 @@ class Budget(object):
 
 def master_problem(master, died):
     """Why a run whose master ended early (``died``) or hit its memory bound (``master``: the cgroup's
-    :func:`~exam_lab.grader.host.sandbox.memory_use`) is not one to score, or None."""
+    :func:`~exam_lab.grader.host.cgroups.memory_use`) is not one to score, or None."""
     memory = master.get('memory') or {}
     if memory.get('oom_kills'):
         return ('the master the node talks to went over its memory bound of %d MB (%d process(es) killed): '

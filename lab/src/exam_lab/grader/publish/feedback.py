@@ -29,6 +29,7 @@ import zipfile
 from exam_lab.grader.publish import flightplot, hand, moodle, student_view
 from exam_lab.grader.publish.report import NOT_SCORED
 from exam_lab.grader.score import safe_text
+from exam_lab.grader.score.identity import identity
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS, SHEETS
 
 FILE = 'moodle-feedback.zip'
@@ -217,7 +218,7 @@ def write(out, records, single=False, show=None):
         return _nothing(target, safe_text.one_line(err))
     pages, waiting, numbers = [], [], {}
     for record in records:
-        number = moodle.identity(record).participant
+        number = identity(record).participant
         shown, why = released(record, hands, number)
         if why is None and number is None:
             why = 'no Moodle participant number in its folder\'s name (%s)' % (record.get('folder') or 'none')

@@ -13,7 +13,7 @@ rows for new students. An empty cell is a point not given yet, never a 0: :func:
 missing.
 
 A row is the student's by Moodle's participant number where the class has one (the ``participant``
-column, from the "download all submissions" name: :func:`exam_lab.grader.publish.moodle.identity`),
+column, from the "download all submissions" name: :func:`exam_lab.grader.score.identity.identity`),
 by the name only where there is none; the name is shown, never matched, so two students whose names
 clean to the same (``Jane Doe`` and ``Jane Doe.``), or who really share a name, never share or swap a
 row, even when a late submission renames one of them. :func:`match` gives each graded student its row
@@ -25,7 +25,8 @@ import csv
 import io
 import os
 
-from exam_lab.grader.publish import cells, moodle
+from exam_lab.grader.publish import cells
+from exam_lab.grader.score.identity import identity
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 
 FILE = 'hand.csv'
@@ -47,7 +48,7 @@ class HandError(Exception):
 def key(record):
     """What a grade record's row in hand.csv is keyed by: its participant number (an int) where it
     has one, else its name (a str)."""
-    who = moodle.identity(record)
+    who = identity(record)
     return who.participant if who.participant is not None else record['student']
 
 

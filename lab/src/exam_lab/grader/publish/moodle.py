@@ -9,16 +9,15 @@ The layout is Moodle's own (``mod/assign/gradingtable.php`` in download mode, wr
 - The importer finds its columns by their header, in the teacher's language: the identifier
   (``Identifier``, values ``Participant 1234567``; the number after the word is the participant's
   unique id, the same number as in the "download all submissions" folder ``Jane Doe_1234567_
-  assignsubmission_file_``), ``Grade``, ``Last modified (grade)`` and each feedback plugin's field
-  (``Feedback comments``). It needs every row to have as many fields as the header; it skips a grade
-  that is empty, negative, above the maximum or equal to the one it has, and any row whose grade was
-  changed in Moodle after the worksheet was downloaded.
+  assignsubmission_file_``: :mod:`~exam_lab.grader.score.identity`), ``Grade``, ``Last modified
+  (grade)`` and each feedback plugin's field (``Feedback comments``). It needs every row to have as
+  many fields as the header; it skips a grade that is empty, negative, above the maximum or equal to
+  the one it has, and any row whose grade was changed in Moodle after the worksheet was downloaded.
 
 So the filled copy changes only the grade and the feedback cells of the rows it matched, byte for byte
 everything else (the mark, the quoting of every other cell, the line ends), and leaves a grade or a
 feedback already in the worksheet as it was (a teacher's grade wins over the machine's).
 """
-import collections
 import html
 import re
 
@@ -26,8 +25,6 @@ from exam_lab.grader.publish import cells, student_view
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 
-#: The participant's number in a "download all submissions" name (folder or flat file).
-_FOLDER_NUMBER = re.compile(r'_(\d+)_assign(?:submission|feedback)_')
 #: A cell of the identifier column: Moodle's word for participant (any language), then the number.
 _IDENTIFIER = re.compile(r'^\D*?(\d+)$')
 #: Moodle's own headers of the worksheet, as ``get_string`` gives them in each language (matched
@@ -81,38 +78,6 @@ def class_name(path):
             match = _CLASS_ZIP.match(name)
             return match.group(1) if match else name
     return name
-
-
-def participant_number(name):
-    """The participant's unique id in a Moodle "download all submissions" name, or None."""
-    match = _FOLDER_NUMBER.search(name + '_' if not name.endswith('_') else name)
-    return int(match.group(1)) if match else None
-
-
-#: Who a grade record is (:func:`identity`).
-Identity = collections.namedtuple('Identity', 'participant folder key')
-_MOODLE_FOLDER = re.compile(r'^(.*?_\d+_assign(?:submission|feedback)_[a-z]+_)')
-
-
-def identity(record):
-    """Who a grade record is, for everything kept across runs and everything sent back to Moodle.
-
-    :returns: :class:`Identity`: ``participant``, Moodle's participant number (the record's, read from
-        the "download all submissions" name) or None; ``folder``, the name Moodle gave the student's
-        folder in that zip (``Jane Doe_1234567_assignsubmission_file_``; for a flat download, the same
-        prefix of the file's name) or None when the name is not Moodle's; ``key``, what identifies the
-        student across runs: ``('participant', 1234567)`` where there is a number, else ``('name',
-        student)``. The student's name is for display only where there is a number: two students with
-        the same or nearly the same name (``Jane Doe`` and ``Jane Doe.``, both cleaned to ``Jane Doe``)
-        have two keys.
-    """
-    number = record.get('participant')
-    name = record.get('folder') or ''
-    if number is None:
-        number = participant_number(name)
-    match = _MOODLE_FOLDER.match(name) if number is not None else None
-    folder = match.group(1) if match and participant_number(match.group(1)) == number else None
-    return Identity(number, folder, ('participant', number) if number is not None else ('name', record['student']))
 
 
 def parse(text):

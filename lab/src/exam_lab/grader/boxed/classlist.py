@@ -1,0 +1,175 @@
+"""A class's students: one sub-folder (or archive) per student, as Moodle's "download all
+submissions" gives, from a folder or from an archive of it. No rospy here.
+
+A class archive is bounded as a whole (CLASS_FILES entries, CLASS_BYTES unpacked); each student's
+files are checked and paid by the student's own bounds (:class:`~exam_lab.grader.boxed.archives.Budget`,
+the checks of :class:`~exam_lab.grader.boxed.archives.Plan`), so one student's bad files refuse that
+student only. Names are cleaned by :func:`~exam_lab.grader.score.identity.student_name`.
+"""
+import os
+import shutil
+import tarfile
+
+from exam_lab.grader.boxed import archives
+from exam_lab.grader.boxed.archives import (ARCHIVE_ENDINGS, SKIPPED_DIRS, UNREADABLE, Plan, UnpackError, open_archive,
+                                            shown_name, tar_entries, unreadable_why, without_ending, write_plan,
+                                            zip_entries)
+from exam_lab.grader.score.identity import student_name
+
+#: A class archive ("download all submissions") holds every student's uploads: its bounds as a whole
+#: (entries, bytes of the students it unpacks); each student's files are paid from MAX_FILES / MAX_BYTES.
+CLASS_FILES = 100000
+CLASS_BYTES = 4 * 1024 * 1024 * 1024
+
+
+def list_students(class_path, scratch, refused=None):
+    """``[(student, folder or archive)]`` of a class: one sub-folder per student, as "download all"
+    gives.
+
+    ``class_path`` may be an archive of that, unpacked below ``scratch`` by :func:`unpack_class`: the
+    class's bounds as a whole, each student's files by the student's own; a student whose files are
+    refused is listed all the same (an empty folder or file in its place) and ``refused`` (a dict)
+    receives ``{its path: why}``. A class whose top holds archives instead of folders counts each
+    archive as one student (named after it).
+    """
+    class_path = os.path.abspath(class_path)
+    if os.path.isfile(class_path):
+        class_path = unpack_class(class_path, os.path.join(scratch, 'class'), {} if refused is None else refused)
+    students = []
+    for entry in sorted(os.listdir(class_path)):
+        full = os.path.join(class_path, entry)
+        if entry.startswith('.') or entry in SKIPPED_DIRS or os.path.islink(full):
+            continue
+        if os.path.isdir(full):
+            students.append((student_name(entry), full))
+        elif entry.lower().endswith(ARCHIVE_ENDINGS):
+            students.append((student_name(without_ending(entry)), full))
+    return students
+
+
+def _class_entries(kind, opened, label):
+    """``[(member, name, kind, size, link target)]`` of an open class archive, read as far as the
+    class's bounds allow (a compressed tar is decompressed while it is listed); raises UnpackError past
+    them."""
+    if kind == 'zip':
+        count = len(opened.infolist())
+        if count > CLASS_FILES:
+            raise UnpackError('%s holds %d entries (at most %d for a class)' % (label, count, CLASS_FILES))
+        return list(zip_entries(opened, links=False))
+    entries, read = [], 0
+    try:
+        for entry in tar_entries(opened):
+            read += entry[0].size
+            if len(entries) >= CLASS_FILES or read > CLASS_BYTES:
+                raise UnpackError('%s holds more than %d entries or %d bytes (the bounds of a class)'
+                                  % (label, CLASS_FILES, CLASS_BYTES))
+            entries.append(entry)
+    except (tarfile.TarError, OSError, EOFError) as err:
+        raise UnpackError('%s is not a readable tar archive: %s' % (label, err))
+    return entries
+
+
+def _raw_parts(name):
+    """The parts of an entry's name as written (before any check), and whether it is rooted."""
+    path = name.replace('\\', '/')
+    rooted = path.startswith('/') or (len(path) > 1 and path[1] == ':')
+    return [p for p in path.split('/') if p not in ('', '.')], rooted
+
+
+def unpack_class(archive, target, refused):
+    """Unpack a class archive into ``target``; return the folder that holds one entry per student.
+
+    The class is bounded as a whole: CLASS_FILES entries, CLASS_BYTES unpacked, and an entry that
+    cannot be said to belong to one student (``../``, an absolute path at the top) refuses it. Each
+    student's files (everything below its top folder, or its archive at the top) are checked and paid
+    by the student's own bounds (:class:`~exam_lab.grader.boxed.archives.Budget`,
+    :func:`~exam_lab.grader.boxed.archives.entry_path`): one that fails them is not unpacked, and
+    ``refused`` receives ``{the student's path: why}`` (an empty folder, or an empty file for an
+    archive, holds its place). No ratio of Moodle's compression is judged: a student's one-colour
+    screenshot or log is no bomb, and the student's bytes are bounded by its budget."""
+    label = os.path.basename(archive)
+    kind, opened = open_archive(archive, label)
+    with opened:
+        groups, base = _students_of(_class_entries(kind, opened, label))
+        os.makedirs(target, exist_ok=True)
+        top = os.path.join(target, base) if base else target
+        plans, total = [], 0
+        for key, members in sorted(groups.items()):
+            place = os.path.join(top, key)
+            try:
+                plan = _student_plan(key, members)
+            except UnpackError as err:
+                refused[place] = str(err)
+                plans.append((key, place, None, members))
+                continue
+            total += plan.nbytes
+            plans.append((key, place, plan, members))
+        if total > CLASS_BYTES:
+            raise UnpackError('the students\' files in %s come to %d bytes (at most %d for a class)'
+                              % (label, total, CLASS_BYTES))
+        for key, place, plan, members in plans:
+            archive_at_top = all(len(p) == 1 for _, p in members) and members[0][0][2] != 'dir'
+            if plan is not None:
+                try:
+                    _write_student(opened, kind, top if archive_at_top else place, plan)
+                    continue
+                except UnpackError as err:
+                    refused[place] = str(err)
+                    shutil.rmtree(place, ignore_errors=True)
+                    if os.path.isfile(place):
+                        os.unlink(place)
+            try:
+                if archive_at_top:
+                    open(place, 'wb').close()
+                else:
+                    os.makedirs(place, exist_ok=True)
+            except OSError as err:
+                raise UnpackError('%s of the class archive cannot be written: %s' % (shown_name(key), err.strerror))
+    return top
+
+
+def _students_of(entries):
+    """``({student's key: [(entry, parts below the class)]}, the class folder at the archive's top or
+    '')``: the entries grouped by their top folder, or by the one below when the archive holds the class
+    folder (unless that folder is one package)."""
+    groups = {}
+    for entry in entries:
+        parts, rooted = _raw_parts(entry[1])
+        if rooted or (parts and parts[0] == '..'):
+            raise UnpackError('entry %s of the class archive lies outside it' % shown_name(entry[1]))
+        if not parts or parts[0] == '__MACOSX':
+            continue
+        groups.setdefault(parts[0], []).append((entry, parts))
+    if len(groups) == 1:
+        (top, members), = groups.items()
+        if all(len(parts) > 1 for _, parts in members) and \
+                not any(parts[1:] == ['package.xml'] or parts[2:] == ['package.xml'] for _, parts in members):
+            inner = {}
+            for entry, parts in members:
+                inner.setdefault(parts[1], []).append((entry, parts[1:]))
+            return inner, top
+    return groups, ''
+
+
+def _student_plan(key, members):
+    """The checked plan of one student's files, paid by its own budget; UnpackError when they fail."""
+    plan = Plan(key)
+    for (member, name, kind, size, link), parts in members:
+        if len(parts) == 1 and kind != 'dir':
+            plan.add(member, parts[0], kind, size, link)
+        else:
+            plan.add(member, '/'.join(parts[1:]), kind, size, link)
+    if any(len(p) == 1 for _, p in members) and any(len(p) > 1 for _, p in members):
+        raise UnpackError('%s is both a file and a folder' % shown_name(key))
+    budget = archives.Budget(archives.MAX_BYTES, archives.MAX_FILES)  # read now: a test may lower them
+    budget.take(len(plan.files), plan.nbytes, 'the files of %s' % shown_name(key))
+    return plan
+
+
+def _write_student(opened, kind, target, plan):
+    """Write one student's planned files below ``target`` (the class's folder for an archive at its top:
+    the plan's one file is the student's key)."""
+    try:
+        write_plan(plan, target, opened.open if kind == 'zip' else opened.extractfile)
+    except UNREADABLE as err:
+        raise UnpackError('%s cannot be unpacked: %s' % (shown_name(plan.label), unreadable_why(err)))

@@ -1,0 +1,86 @@
+"""The uids of the boxes and their judges: a slot each, taken under a lock, dropped to, and emptied.
+
+Each box holds a slot N (an exclusive ``flock`` on ``LOCK_DIR/box-N``, so concurrent gradings on one
+machine, even of two graders, never share one) and runs as uid ``BOX_UID_BASE + N``; its judge (the
+session's masters and probe) as ``JUDGE_UID_BASE + N``: uids no account and no process uses.
+"""
+import fcntl
+import os
+import pwd
+import signal
+import time
+
+#: First uid of the boxes (isolate uses 60000+); slot N runs as BOX_UID_BASE + N.
+BOX_UID_BASE = 61000
+#: First uid of the judges: slot N's masters and probe run as JUDGE_UID_BASE + N.
+JUDGE_UID_BASE = 62000
+SLOTS = 64
+LOCK_DIR = '/run/lock/exam-grader'
+
+
+def take_slot():
+    """``(slot, its lock file, held open)`` of a free slot: locked by no grader, neither uid in use by
+    an account or a process; None when every slot is taken."""
+    os.makedirs(LOCK_DIR, mode=0o700, exist_ok=True)
+    for slot in range(SLOTS):
+        lock = open(os.path.join(LOCK_DIR, 'box-%d' % slot), 'w')
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            lock.close()
+            continue
+        if _uid_in_use(BOX_UID_BASE + slot) or _uid_in_use(JUDGE_UID_BASE + slot):
+            lock.close()
+            continue
+        return slot, lock
+    return None
+
+
+def as_user(uid):
+    """The command-line prefix that drops root for ``uid`` (its own group, none else, no capabilities)."""
+    return ['setpriv', '--reuid=%d' % uid, '--regid=%d' % uid, '--clear-groups', '--no-new-privs',
+            '--inh-caps=-all', '--']
+
+
+def _uid_in_use(uid):
+    try:
+        pwd.getpwuid(uid)
+        return True
+    except KeyError:
+        return bool(pids_of_uid(uid))
+
+
+def pids_of_uid(uid):
+    """Living processes whose real or effective uid is ``uid`` (zombies left out: they are dead)."""
+    found = []
+    for entry in os.listdir('/proc'):
+        if not entry.isdigit():
+            continue
+        try:
+            with open('/proc/%s/status' % entry) as f:
+                status = dict(line.split(':', 1) for line in f if ':' in line)
+        except (OSError, ValueError):
+            continue
+        uids = status.get('Uid', '').split()
+        if status.get('State', '').strip().startswith('Z') or len(uids) < 2:
+            continue
+        if str(uid) in uids[:2]:
+            found.append(int(entry))
+    return found
+
+
+def end_uid(uid):
+    """Kill whatever still runs as ``uid``; returns how many there were."""
+    left = pids_of_uid(uid)
+    for _ in range(3 if left else 0):
+        for pid in pids_of_uid(uid):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass
+        deadline = time.monotonic() + 5.0
+        while time.monotonic() < deadline and pids_of_uid(uid):
+            time.sleep(0.05)
+        if not pids_of_uid(uid):
+            break
+    return len(left)

@@ -1,0 +1,66 @@
+"""Who a submission is, from the name Moodle gave it: the participant number, Moodle's folder, the
+student's name. Pure: no rospy, no I/O.
+
+Moodle's "download all submissions" zip holds one folder per student, ``Jane Doe_1234567_
+assignsubmission_file_`` (or, flat, files named with that prefix): the number is the participant's
+unique id, the same as in the offline grading worksheet's ``Participant 1234567``. One definition
+here for everyone who tells students apart: the box that lists a class (its folders' names), the
+runner (the grade record's ``participant`` and ``folder``), and the outputs sent back to Moodle
+(the worksheet, hand.csv, the feedback pages).
+"""
+import collections
+import re
+
+#: The participant's number in a "download all submissions" name (folder or flat file).
+_FOLDER_NUMBER = re.compile(r'_(\d+)_assign(?:submission|feedback)_')
+#: The whole prefix Moodle gives a student's folder (or flat file) in that zip.
+_MOODLE_FOLDER = re.compile(r'^(.*?_\d+_assign(?:submission|feedback)_[a-z]+_)')
+#: Endings of the files a class's run writes in OUT beside the students' folders (grades.csv, index.html,
+#: hand.csv, similarity.json, the filled worksheet...): a student's folder never has one.
+OUTPUT_ENDINGS = ('.csv', '.html', '.json', '.jsonl', '.md', '.png', '.txt', '.log', '.zip')
+
+#: Who a grade record is (:func:`identity`).
+Identity = collections.namedtuple('Identity', 'participant folder key')
+
+
+def participant_number(name):
+    """The participant's unique id in a Moodle "download all submissions" name, or None."""
+    match = _FOLDER_NUMBER.search(name + '_' if not name.endswith('_') else name)
+    return int(match.group(1)) if match else None
+
+
+def identity(record):
+    """Who a grade record is, for everything kept across runs and everything sent back to Moodle.
+
+    :returns: :class:`Identity`: ``participant``, Moodle's participant number (the record's, read from
+        the "download all submissions" name) or None; ``folder``, the name Moodle gave the student's
+        folder in that zip (``Jane Doe_1234567_assignsubmission_file_``; for a flat download, the same
+        prefix of the file's name) or None when the name is not Moodle's; ``key``, what identifies the
+        student across runs: ``('participant', 1234567)`` where there is a number, else ``('name',
+        student)``. The student's name is for display only where there is a number: two students with
+        the same or nearly the same name (``Jane Doe`` and ``Jane Doe.``, both cleaned to ``Jane Doe``)
+        have two keys.
+    """
+    number = record.get('participant')
+    name = record.get('folder') or ''
+    if number is None:
+        number = participant_number(name)
+    match = _MOODLE_FOLDER.match(name) if number is not None else None
+    folder = match.group(1) if match and participant_number(match.group(1)) == number else None
+    return Identity(number, folder, ('participant', number) if number is not None else ('name', record['student']))
+
+
+def student_name(folder):
+    """A name usable as a folder and a CSV cell: Moodle's ``Jane Doe_1234_assignsubmission_file_``
+    becomes ``Jane Doe``; anything but letters, digits, space, ``-._`` becomes ``_``. A name that ends
+    like one of the class's outputs (OUTPUT_ENDINGS: ``grades.csv``, ``index.html``) has its last dot
+    made ``_`` (``grades_csv``): a student's folder and the class's files can never be one path."""
+    name = folder.split('_assignsubmission')[0]
+    parts = name.rsplit('_', 1)
+    if len(parts) == 2 and parts[1].isdigit():
+        name = parts[0]
+    cleaned = ''.join(c if c.isalnum() or c in ' -._' else '_' for c in name).strip(' .')
+    if cleaned.lower().endswith(OUTPUT_ENDINGS):
+        stem, ending = cleaned.rsplit('.', 1)
+        cleaned = '%s_%s' % (stem, ending)
+    return cleaned or 'student'
