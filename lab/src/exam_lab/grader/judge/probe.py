@@ -58,6 +58,8 @@ from exam_lab.harness.wait import wait_until
 
 #: Seconds after an input change before the node's output is read (several 10 Hz ticks).
 SETTLE_S = 0.8
+#: After a change of both inputs, read one period of the slowest input plus this later.
+SETTLE_SLACK_S = 0.5
 #: Published values older than this after an input change are not read (the change may be half seen).
 IGNORE_S = 0.3
 #: Seconds to wait for the second input's subscription once the node is up.
@@ -211,13 +213,14 @@ def _last_value(recorder, since):
     return (samples[-1][1] if samples else None), len(samples)
 
 
-def _settled(recorder, since, before=None):
-    """The node's value after an input change at ``since``: read SETTLE_S later; when it is still the
-    ``before`` value, waited for until it moves, up to STALE_S (a node that blocks in a callback)."""
-    time.sleep(max(0.0, since + SETTLE_S - time.time()))
-    if before is not None:
-        wait_until(lambda: _last_value(recorder, since)[0] not in (None, before), STALE_S - SETTLE_S,
-                   period=0.1)
+def _settled(recorder, since, before=None, settle=SETTLE_S):
+    """The node's value after an input change at ``since``: read ``settle`` s later; when it is still the
+    ``before`` value (or none), waited for until it moves, up to STALE_S (a node that blocks in a callback)."""
+    time.sleep(max(0.0, since + settle - time.time()))
+    # Also when nothing came yet: a node computes only once it has a reading of each input, and the
+    # slowest comes once a period.
+    wait_until(lambda: _last_value(recorder, since)[0] not in (None, before), max(0.0, STALE_S - settle),
+               period=0.1)
     return _last_value(recorder, since)
 
 
@@ -270,6 +273,8 @@ class Probe(object):
         self.result['input_rates'] = dict(self.drone.rates)
         self.recorder = self.drone.output
         self.fixed_now = None
+        #: How long after the last change the node's value is read (see set_inputs).
+        self.settle = SETTLE_S
         self.t0 = time.time()
         self.flown = []  # [time, oracle value] at every input change, for the flight plot's trace
 
@@ -283,9 +288,13 @@ class Probe(object):
         time of the first reading of the new values (the later input's next tick)."""
         drone = self.drone
         changed = None
+        self.settle = SETTLE_S
         if fixed != self.fixed_now:
             changed = drone.feeder.set(drone.fixed_topic, fixed)
             self.fixed_now = fixed
+            # A node that computes on each reading publishes a mixed pair in between (new fixed, old
+            # moving); one that waits for a fresh reading of each follows up to the slowest period later.
+            self.settle = max(SETTLE_S, 1.0 / min(drone.rates.values()) + SETTLE_SLACK_S)
         since = drone.feeder.set(drone.moving_topic, moving)
         since = max(since, changed or since)
         self.flown.append([since, drone.expected(fixed, moving)])
@@ -399,7 +408,7 @@ class Probe(object):
             else:
                 moving = oracle.pressure_robot_at(x, fixed)
             since = self.set_inputs(fixed, moving)
-            value, count = _settled(self.recorder, since, before)
+            value, count = _settled(self.recorder, since, before, self.settle)
             before = value
             rows.append({'inputs': {drone.fixed_topic: fixed, drone.moving_topic: moving},
                          'expected': drone.expected(fixed, moving), 'published': value, 'samples': count})
@@ -439,7 +448,7 @@ class Probe(object):
             for _ in range(4 if side == 'near' else 3):
                 previous = _last_value(self.recorder, 0.0)[0] if self.recorder is not None else None
                 since = self.fly(x)
-                value = _settled(self.recorder, since, previous)[0] if self.recorder is not None else None
+                value = _settled(self.recorder, since, previous, self.settle)[0] if self.recorder is not None else None
                 if calibration['by'] != 'own' or value is None or not math.isfinite(value) \
                         or close[side](value, target):
                     break

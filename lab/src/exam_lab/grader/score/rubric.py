@@ -34,7 +34,7 @@ NUMERIC_TYPES = tuple('std_msgs/%s' % t for t in ('Float32', 'Float64', 'Int8', 
 NO_COMMENT_LOSS = 0.5
 #: Question 11's lag: the node's value follows its inputs within one period of its slowest input (a
 #: node that waits for a fresh reading of each) plus this: a tick of its 10 Hz and the transport.
-LAG_SLACK_S = 0.3
+LAG_SLACK_S = 0.5
 #: The slowest input's rate of a probe that did not record its rates (the lab's drone before issue 35).
 OLD_SLOWEST_HZ = 2.0
 
