@@ -208,11 +208,17 @@ FAIR_EXPECTED = {
     'float64_pressure': {'Q10': 1.0},     # /pressure as Float64, the input that moves: Q10 alone, the rest flown
     'led_colours': {'Q13': 2.0},          # "RED"/"GREEN" (depth sheet): read as WARNING/NORMAL, half of 13 once
     'two_uploads': {},                    # exam.zip (14:52, no delay) and exam_v2.zip (16:58, complete)
+    # Issue 35: the sheet's drone (0.778 / 2 Hz), each rule timed from the node's own value.
+    'fresh_readings': {},                 # a new altitude only from a fresh reading of each input: lags 1.3 s
+    'margin_normal': {'Q14b': 2.5},       # NORMAL only 5 m below the threshold: the return "at once" alone
+    'delay_minus_period': {'Q14b': 1.5},  # 10 readings of the 2 Hz pressure from the first: 4.5 s, the delay alone
+    'count_messages': {},                 # 10 periods of the 2 Hz pressure_robot (depth): right at the drone's rate
 }
 FAIR_STATUS = {'lowercase_service': 'needs a hand grade', 'duplicate_names': 'graded with fixes',
                'float64_temperature': 'graded with fixes', 'float64_pressure': 'graded with fixes',
-               'led_colours': 'needs a hand grade', 'two_uploads': 'graded'}
-FAIR_SHEETS = {'led_colours': 'depth'}
+               'led_colours': 'needs a hand grade', 'two_uploads': 'graded', 'fresh_readings': 'graded',
+               'margin_normal': 'graded', 'delay_minus_period': 'graded', 'count_messages': 'graded'}
+FAIR_SHEETS = {'led_colours': 'depth', 'count_messages': 'depth'}
 #: Who must be in the page's "needs the teacher" box, whatever the status.
 FAIR_DOUBTS = ('lowercase_service', 'duplicate_names', 'led_colours', 'two_uploads')
 
@@ -229,7 +235,7 @@ def dated_zip(source, path, when):
 
 @pytest.fixture(scope='module')
 def fair(tmp_path_factory):
-    """A class of six graded with the default JOBS, and its desk (the page) written."""
+    """A class of ten graded with the default JOBS, and its desk (the page) written."""
     from exam_lab.grader.publish import desk
     root = tmp_path_factory.mktemp('fair')
     klass = root / 'class'
@@ -292,6 +298,14 @@ def test_fair_evidence_is_what_happened(fair):
         assert '>%s</a>' % name in box, name
     assert '>float64_temperature</a>' not in box
     assert os.path.isfile(os.path.join(str(out), 'lowercase_service', 'flight.png'))
+    fresh = evidence['fresh_readings']
+    assert 'its value followed the inputs within 1.' in fresh['Q11'], fresh['Q11']
+    assert 'after its own value went above the threshold and stayed (ok' in fresh['Q14b'], fresh['Q14b']
+    margin = evidence['margin_normal']['Q14b']
+    assert 'no NORMAL while its own value was back just below the threshold (1299.90, 0.10 below)' in margin, margin
+    assert 'further below: it waits for a margin' in margin, margin
+    short = evidence['delay_minus_period']['Q14b']
+    assert 'WARNING 4.' in short and '(outside: 4.7-5.5 s)' in short, short
 
 
 def test_our_node_on_the_depth_sheet(tmp_path):
