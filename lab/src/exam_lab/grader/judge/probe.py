@@ -402,6 +402,9 @@ class Probe(object):
         points, rows = [], []
         # The value before the first change, so that a node that follows a reading later is waited for.
         before = _last_value(self.recorder, 0.0)[0]
+        # The fixed input sent again at its next tick: the node's subscription may have connected after
+        # its last reading (a publisher registered anew in the node's type), and it reads it once a period.
+        self.fixed_now = None
         for fixed, x in cases:
             if self.sheet == 'altitude':
                 moving = oracle.pressure_at(x, fixed)
