@@ -69,13 +69,14 @@ RETYPE_S = 1.0
 #: Seconds to wait for the output publisher once the node subscribed.
 OUTPUT_S = 3.0
 #: The flight's holds, s from the node's own first value on the leg's side (docs/grading.md, legs).
-#: The short excursion: with a return up to one input period late (1.3 s) the node's own value stays
-#: above less than the delay's lower bound (4.75 s), so a right node never warns there.
+#: The short excursion: with a return as late as the rubric's lag tolerance (one period of the slowest
+#: input and 0.5 s: 1.79 s) the node's own value stays above 4.3 s at most, less than the WARNING
+#: window's start (4.7 s), so a right node never warns there.
 REST_S = 2.0
 SHORT_S = 2.5
 #: Just below the threshold after the short excursion: a count that is not reset there shows later.
 GAP_S = 2.0
-#: The long excursion lasts delay + AFTER_S: past the WARNING window's end (delay + 0.3 s).
+#: The long excursion lasts delay + AFTER_S: past the WARNING window's end (delay + 0.5 s).
 AFTER_S = 1.5
 #: Just below the threshold after the long excursion: NORMAL must come here, at once.
 BACK_S = 1.5
