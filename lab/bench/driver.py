@@ -18,9 +18,8 @@ import rospy
 
 from exam_lab.harness.fake_drone import Drone, TopicRecorder
 
-# mydrone's default sensor rates (0.778 Hz and 2 Hz): the node under test sees the same input load as
-# with the simulator; scripted steps are published at once on top of them.
-SENSOR_RATES = {'temperature': 0.778, 'pressure': 2.0}
+# The fake drone flies mydrone's default sensor rates (its SPEC's): the node under test sees the same
+# input load as with the simulator; scripted steps are published at once on top of them.
 
 
 def init(uri):
@@ -31,7 +30,7 @@ def init(uri):
 
 def drone(ns, slow=0.0):
     """The fake aerial drone of the node in ``ns``, without LED topic; each call takes ``slow`` s."""
-    fake = Drone('altitude', led=False, rates=SENSOR_RATES, tcp_nodelay=True, namespace=ns,
+    fake = Drone('altitude', led=False, tcp_nodelay=True, namespace=ns,
                  queue_size=None)
     fake.service.configure(delay=slow)
     return fake

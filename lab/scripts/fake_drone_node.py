@@ -26,7 +26,7 @@ import threading
 import rospy
 from std_msgs.msg import String
 
-from exam_lab.harness.fake_drone import Drone
+from exam_lab.harness.fake_drone import TEST_RATES, Drone
 
 
 def main():
@@ -46,7 +46,7 @@ def main():
             record_pub.publish(String(json.dumps(record)))
 
     holder['started'] = rospy.get_time()
-    holder['drone'] = drone = Drone(mode, on_call=publish_record)
+    holder['drone'] = drone = Drone(mode, rates=TEST_RATES[mode], on_call=publish_record)  # the rostests' faster inputs
     publish_record()
     drone.feeder.set(drone.fixed_topic, drone.fixed_value)
     drone.fly_to(value)

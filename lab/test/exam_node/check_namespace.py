@@ -29,7 +29,7 @@ class NamespaceScenario(unittest.TestCase):
 
     def test_names_and_warning_under_namespace(self):
         self.assertEqual(rospy.get_namespace(), '/drone7/', 'namespace.test must run this node in /drone7')
-        drone = fake_drone.Drone('altitude')
+        drone = fake_drone.Drone('altitude', rates=fake_drone.TEST_RATES['altitude'])  # faster than mydrone: shorter waits
         drone.start(LOW)
         drone.settle(LOW)
         master = rosgraph.Master(rospy.get_name())

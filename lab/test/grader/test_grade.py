@@ -215,12 +215,19 @@ FAIR_EXPECTED = {
     # One misplaced line: the WARNING call is never reached. Not a silent zero (issue 35 point 5): the
     # points the run could not give, and a hand grade naming the call's line.
     'never_warns': {'Q13': 0.0, 'Q14a': 0.5, 'Q14b': 0.0},
+    # Issue 35: the sheet's drone (0.778 / 2 Hz), each rule timed from the node's own value.
+    'fresh_readings': {},                 # a new altitude only from a fresh reading of each input: lags 1.3 s
+    'margin_normal': {'Q14b': 2.5},       # NORMAL only 5 m below the threshold: the return "at once" alone
+    'delay_minus_period': {'Q14b': 1.5},  # 10 readings of the 2 Hz pressure from the first: 4.5 s, the delay alone
+    'count_messages': {},                 # 10 periods of the 2 Hz pressure_robot (depth): right at the drone's rate
 }
 FAIR_STATUS = {'lowercase_service': 'needs a hand grade', 'duplicate_names': 'graded with fixes',
                'float64_temperature': 'graded with fixes', 'float64_pressure': 'graded with fixes',
                'led_colours': 'needs a hand grade', 'two_uploads': 'graded', 'args_threshold': 'graded',
-               'rosparam_threshold': 'graded', 'included_threshold': 'graded', 'never_warns': 'needs a hand grade'}
-FAIR_SHEETS = {'led_colours': 'depth'}
+               'rosparam_threshold': 'graded', 'included_threshold': 'graded', 'never_warns': 'needs a hand grade',
+               'fresh_readings': 'graded', 'margin_normal': 'graded', 'delay_minus_period': 'graded',
+               'count_messages': 'graded'}
+FAIR_SHEETS = {'led_colours': 'depth', 'count_messages': 'depth'}
 #: Who must be in the page's "needs the teacher" box, whatever the status.
 FAIR_DOUBTS = ('lowercase_service', 'duplicate_names', 'led_colours', 'two_uploads', 'never_warns')
 
@@ -313,6 +320,14 @@ def test_fair_evidence_is_what_happened(fair):
         assert 1300 - 4 * 130 <= drawn <= 1300 - 2.5 * 130, drawn
         assert 'set to %g' % drawn in q14a, (drawn, q14a)
     assert "argument --threshold" in evidence['args_threshold']['Q14a']
+    fresh = evidence['fresh_readings']
+    assert 'its value followed the inputs within 1.' in fresh['Q11'], fresh['Q11']
+    assert 'after its own value went above the threshold and stayed (ok' in fresh['Q14b'], fresh['Q14b']
+    margin = evidence['margin_normal']['Q14b']
+    assert 'no NORMAL while its own value was back just below the threshold (1299.90, 0.10 below)' in margin, margin
+    assert 'further below: it waits for a margin' in margin, margin
+    short = evidence['delay_minus_period']['Q14b']
+    assert 'WARNING 4.' in short and '(outside: 4.7-5.5 s)' in short, short
 
 
 def test_our_node_on_the_depth_sheet(tmp_path):

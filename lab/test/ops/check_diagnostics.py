@@ -24,7 +24,7 @@ import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 
-from exam_lab.harness.fake_drone import Drone
+from exam_lab.harness.fake_drone import TEST_RATES, Drone
 from exam_lab.harness.wait import wait_until as wait_for
 
 PKG = 'exam_lab'
@@ -53,7 +53,7 @@ class DiagnosticsTest(unittest.TestCase):
         # "Node starting up" (an array of one status as each is added).
         cls.arrays = []
         cls.sub = rospy.Subscriber('/diagnostics', DiagnosticArray, cls.on_diagnostics)
-        cls.drone = Drone('altitude')
+        cls.drone = Drone('altitude', rates=TEST_RATES['altitude'])  # faster than mydrone: shorter waits
         cls.drone.start(1000.0)
 
     @classmethod

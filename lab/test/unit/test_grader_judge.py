@@ -12,6 +12,7 @@ import pytest
 
 from exam_lab.grader.host import cgroups, limits, sandbox, uids
 from exam_lab.grader.host.session import uid_of
+from exam_lab.grader.judge import probe
 from exam_lab.harness.supervisor import Supervisor, descendants
 from exam_lab.harness.wait import wait_until
 
@@ -87,3 +88,32 @@ def test_the_master_runs_as_the_judge_not_root(box, tmp_path):
         assert set(owners.values()) == {box.judge_uid}, owners
         use = cgroups.memory_use(box.judge_cgroups['master'])
         assert use['limit'] == limits.MASTER_MEMORY_BYTES and 0 < use['peak'] < use['limit'], use
+
+
+def test_a_leg_says_when_the_value_reached_its_side_and_when_it_stayed():
+    """The delay counts from when the node's own value went beyond and stayed: a value that goes above,
+    back, and above again stays from the second time."""
+    samples = [(0.0, 1299.9), (0.1, 1301.0), (0.2, 1299.0), (0.3, 1301.0), (0.4, 1430.0), (0.5, 1430.0)]
+    leg = probe.leg_check(samples, 1300.0, 'above', 0.0, 0.5)
+    assert leg['reached'] == 0.1 and leg['stays'] == 0.3 and leg['off_side'] == 1
+    ending_off = probe.leg_check(samples + [(0.6, 1299.0)], 1300.0, 'above', 0.0, 0.6)
+    assert ending_off['reached'] == 0.1 and ending_off['stays'] is None
+    below = probe.leg_check(samples, 1300.0, 'below', 0.0, 0.5)
+    assert below['reached'] == 0.0 and below['stays'] is None
+
+
+def test_the_judges_drone_is_the_sheets_drone():
+    """The probe's drone takes its rates, service and LED from the drone packages' SPEC (one place);
+    only the exam node's rostests fly faster, and say so."""
+    pytest.importorskip('rospy')
+    from exam_lab.harness import fake_drone
+    from mydrone.simulator import SPEC as MYDRONE
+    from submarinedrone.simulator import SPEC as SUBMARINEDRONE
+    for sheet, spec in (('altitude', MYDRONE), ('depth', SUBMARINEDRONE)):
+        drone = fake_drone.SHEETS[sheet]
+        assert drone['rates'] == {s.topic: s.default_rate for s in spec.sensors}
+        assert (drone['service'], drone['srv'], drone['led'], drone['label']) == (
+            spec.service_name, spec.service_type, spec.led_topic, spec.led_label)
+        assert all(fake_drone.TEST_RATES[sheet][t] > hz for t, hz in drone['rates'].items())
+    assert fake_drone.SHEETS['altitude']['rates'] == {'temperature': 0.778, 'pressure': 2.0}
+    assert fake_drone.SHEETS['depth']['rates'] == {'pressure_robot': 2.0, 'pressure_remote': 1.0}

@@ -241,3 +241,83 @@ def test_a_private_parameter_read_before_init_node_is_no_reading_of_it():
     evidence = _item(rubric.score('altitude', early, skipped), 'Q14a')['evidence']
     assert 'it reads ~threshold before init_node (scripts/exam_node.py:6), where rospy resolves it as ' \
         '.../unnamed/threshold (its name until then)' in evidence, evidence
+
+
+#: A flight on the sheet's drone (issue 35), s: rest 0, short excursion 2-5, just below 5-7.5, long
+#: excursion 7.5-14.5, just below 14.5-16.5, further below 16.5-18.5.
+FLIGHT = {'rest': 0.0, 'short_up': 2.0, 'short_down': 5.0, 'long_up': 7.5, 'long_down': 14.5, 'deep_down': 16.5,
+          'end': 18.5}
+
+
+def flown(calls, lag=0.1, lags=None, stays=None):
+    """The main run of a node whose own value reaches each leg's side ``lag`` s after the leg's first
+    reading (``lags``: per leg), and stays there from ``stays`` (per leg; from then on by default)."""
+    session = measured(calls=calls)
+    probe = session['runs'][0]['probe']
+    probe.update(schedule=dict(FLIGHT), threshold=1300.0, input_rates={'temperature': 0.778, 'pressure': 2.0})
+    probe['calibration']['near'] = {'x': 1299.9, 'value': 1299.9, 'target': 1299.9}
+    probe['legs'] = {}
+    for name in ('rest', 'short_up', 'short_down', 'long_up', 'long_down', 'deep_down'):
+        side = 'above' if name.endswith('up') else 'below'
+        reached = FLIGHT[name] + (lags or {}).get(name, lag)
+        value = 1430.0 if side == 'above' else 1299.9
+        probe['legs'][name] = {'side': side, 'reached': reached, 'stays': (stays or {}).get(name, reached),
+                               'off_side': 0, 'first': value, 'last': value, 'samples': 20}
+    return session
+
+
+def evidence_of(session, item_id):
+    return [i for i in rubric.score('altitude', STATIC, session) if i['id'] == item_id][0]['evidence']
+
+
+def test_a_node_that_waits_for_a_fresh_reading_of_each_input_is_timed_from_its_own_value():
+    """Its value follows 1.2 s after the pressure (the next temperature): it warned 5.0 s after its own
+    value went above (6.2 s after the reading) and came back at once after its own value did."""
+    calls = [[7.5 + 1.2 + 5.0, 'WARNING'], [14.5 + 1.2 + 0.05, 'NORMAL']]
+    session = flown(calls, lag=1.2)
+    assert lost(session) == {}
+    assert 'its value followed the inputs within 1.20 s (at most 1.79 s' in evidence_of(session, 'Q11')
+    assert 'WARNING 5.00 s after its own value went above the threshold and stayed' in evidence_of(session, 'Q14b')
+    assert rubric.lag_tolerance(session['runs'][0]['probe']) == pytest.approx(1 / 0.778 + rubric.LAG_SLACK_S)
+    assert rubric.lag_tolerance({}) == pytest.approx(1 / rubric.OLD_SLOWEST_HZ + rubric.LAG_SLACK_S)
+
+
+def test_the_delay_counts_from_when_the_own_value_stays_beyond():
+    """Its value went above once at 7.6, back, and stayed above from 8.6: the 5 s count from 8.6."""
+    calls = [[8.6 + 5.0, 'WARNING'], [14.6, 'NORMAL']]
+    assert lost(flown(calls, stays={'long_up': 8.6})) == {}
+    assert lost(flown(calls)) == {'Q14b': 1.5}, 'from the first value above it is 6.0 s: late'
+
+
+def test_a_delay_one_reading_short_loses_the_delay_only():
+    """10 readings of the 2 Hz pressure counted from the first: 4.5 s."""
+    calls = [[7.5 + 0.1 + 4.45, 'WARNING'], [14.6, 'NORMAL']]
+    session = flown(calls)
+    assert lost(session) == {'Q14b': 1.5}
+    assert 'WARNING 4.45 s after its own value went above' in evidence_of(session, 'Q14b')
+
+
+def test_a_margin_before_normal_loses_the_return_only():
+    """NORMAL only when the value is 5 m below: not on the return just below, but further below."""
+    calls = [[7.5 + 0.1 + 5.0, 'WARNING'], [16.5 + 0.1 + 0.05, 'NORMAL']]
+    session = flown(calls)
+    assert lost(session) == {'Q14b': 0.5}
+    q14b = evidence_of(session, 'Q14b')
+    assert 'no NORMAL while its own value was back just below the threshold (1299.90, 0.10 below)' in q14b, q14b
+    assert 'it came 2.05 s later, further below: it waits for a margin' in q14b, q14b
+    assert 'WARNING while above, NORMAL once back below' in evidence_of(session, 'Q13')
+
+
+def test_a_node_slower_than_one_input_period_is_timed_from_the_readings():
+    """Its value followed 2.5 s late, its WARNING came 5.05 s after the reading: right from the reading
+    (from its own value it would be 2.55 s), and Q11 says how late it followed."""
+    calls = [[7.5 + 5.05, 'WARNING'], [14.5 + 0.1, 'NORMAL']]
+    session = flown(calls, lags={'long_up': 2.5})
+    assert lost(session) == {}
+    assert 'its value followed the inputs 2.5 s late in the long excursion above' in evidence_of(session, 'Q11')
+    assert 'more than one input period: timed from the reading' in evidence_of(session, 'Q14b')
+
+
+def test_a_warning_in_the_short_excursion_is_judged_on_its_own_length():
+    calls = [[2.1 + 2.0, 'WARNING'], [5.2, 'NORMAL'], [7.6 + 5.0, 'WARNING'], [14.6, 'NORMAL']]
+    assert lost(flown(calls)) == {'Q14b': 1.0}

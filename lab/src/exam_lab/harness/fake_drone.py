@@ -3,7 +3,15 @@
 It plays the drone for an exam node under test (ours in the rostests and the bench, a student's in the
 grader): it publishes the two sensor inputs of either sheet with the values a script sets, serves the
 warning service and records every call with the time it arrived, and publishes the LED colour on a
-latched topic as the real drones do. It also records what the exam node publishes. Times are ROS time
+latched topic as the real drones do. It also records what the exam node publishes.
+
+It is the sheet's drone, taken from one place: the topics, their rates, the service's name and type
+come from the drone packages' own ``SPEC`` (``mydrone.simulator``, ``submarinedrone.simulator``), the
+service's answers and refusals from their LED (:class:`drone_sim.led.WarningLed`), the LED topic's queue
+from :data:`drone_sim.simulator.LED_QUEUE`. ``lab/test/simulators/fake_vs_real.test`` flies both side by
+side and compares them. With ``on_ticks`` (the grader's probe) a new value goes out at the sensor's next
+tick, as a real drone's reading does, never as an extra message; without it (the exam node's rostests,
+which also say when they fly faster than the drone: :data:`TEST_RATES`) it goes out at once. Times are ROS time
 (``rospy.get_time()``), the clock the exam node counts its delay in, unless a ``clock`` is given: the
 grader's probe passes ``time.time`` so that a student's ``/clock`` can never become the judge's.
 
@@ -25,8 +33,10 @@ import unittest
 import rospy
 from std_msgs.msg import Float32, Float64, String
 
-from mydrone.srv import AltitudeWarning
-from submarinedrone.srv import DepthWarning
+from drone_sim.led import WarningLed
+from drone_sim.simulator import LED_QUEUE
+from mydrone.simulator import SPEC as MYDRONE
+from submarinedrone.simulator import SPEC as SUBMARINEDRONE
 
 from exam_lab.harness import oracle
 from exam_lab.harness.wait import wait_until
@@ -35,8 +45,8 @@ from exam_lab.harness.wait import wait_until
 AIR_TEMPERATURE = 15.0
 #: Pressure the fake remote measures at sea level, Pa.
 REMOTE_PRESSURE = oracle.P0
-#: The statuses of the sheets and the LED colour each sets.
-COLOURS = {'NORMAL': 'GREEN', 'WARNING': 'RED'}
+#: What the drone answers a refused request when a test scripts a broken LED driver.
+SCRIPTED_REFUSAL = 'LED driver fault (scripted)'
 
 
 #: The message types whose ``data`` is a float; every other numeric std_msgs type holds an integer.
@@ -51,18 +61,25 @@ class SensorFeeder(object):
     """Publishes each input topic from its own thread at its own rate, with the value the test sets.
 
     The rates differ and are below the exam node's 10 Hz on purpose: the node must cache the latest
-    value of each input rather than wait for a pair. A new value is published at once by :meth:`set`
-    and the time returned, so a test knows when the node saw its first reading of it. Publishing
-    happens under one lock, so a periodic message can never overtake a newer value.
+    value of each input rather than wait for a pair. Each topic ticks on a fixed schedule (a late tick
+    does not shift the next ones), as a ``rospy.Timer`` of the real drone does. A new value is published
+    by :meth:`set` at once, or with ``on_ticks`` at the topic's next tick (no extra message: the
+    stream is the real drone's); either way :meth:`set` returns the time of its first message, so a
+    test knows when the node saw its first reading of it. Publishing happens under one lock, so a
+    periodic message can never overtake a newer value.
 
     :param rates: dict topic name -> publishing rate in Hz.
     :param tcp_nodelay: ask subscribers for TCP_NODELAY (the bench: no Nagle batching in the stamps).
     :param clock: the function that gives the times returned (default ``rospy.get_time``).
+    :param on_ticks: a new value waits for its topic's next tick (the grader's probe).
     """
 
-    def __init__(self, rates, tcp_nodelay=False, clock=None):
+    def __init__(self, rates, tcp_nodelay=False, clock=None, on_ticks=False):
         self._clock = clock or rospy.get_time
         self._lock = threading.Lock()
+        self._ticked = threading.Condition(self._lock)
+        self._on_ticks = on_ticks
+        self._ticks = {topic: 0 for topic in rates}
         self._tcp_nodelay = tcp_nodelay
         self._pubs = {}
         self._types = {}
@@ -94,11 +111,17 @@ class SensorFeeder(object):
         return wait_until(self.connected, timeout, alive=_alive)
 
     def set(self, topic, value):
-        """Publish ``value`` now and keep publishing it; return the ROS time of the first message."""
+        """Publish ``value`` from now on; return the time of its first message (now, or with
+        ``on_ticks`` the topic's next tick, waited for)."""
         with self._lock:
             self._values[topic] = value
             self._quiet_until[topic] = 0.0
-            return self._publish(topic, value)
+            if not self._on_ticks:
+                return self._publish(topic, value)
+            tick = self._ticks[topic]
+            while self._ticks[topic] == tick and not self._stopped.is_set() and not rospy.is_shutdown():
+                self._ticked.wait(0.1)
+            return self._last_sent.get(topic)
 
     def stop(self, topic):
         """Stop publishing ``topic`` (a sensor gone silent); return the ROS time of its last message.
@@ -141,7 +164,10 @@ class SensorFeeder(object):
             pub.unregister()
 
     def _run(self, topic, period):
-        while not rospy.is_shutdown() and not self._stopped.wait(period):
+        due = time.monotonic() + period
+        while not rospy.is_shutdown() and not self._stopped.wait(max(0.0, due - time.monotonic())):
+            # The next tick on the schedule; one missed entirely (a stalled process) is skipped.
+            due = max(due + period, time.monotonic())
             with self._lock:
                 value = self._values[topic]
                 if value is None or time.monotonic() < self._quiet_until[topic]:
@@ -150,6 +176,8 @@ class SensorFeeder(object):
                     self._publish(topic, value)
                 except rospy.ROSException:
                     return  # the publisher closed: the node is shutting down
+                self._ticks[topic] += 1
+                self._ticked.notify_all()
 
     def _publish(self, topic, value):
         """Publish one message (the caller holds the lock); return its ROS time."""
@@ -162,8 +190,10 @@ class SensorFeeder(object):
 class FakeWarningService(object):
     """The drone's warning service: sets a fake LED and records every call with its arrival time.
 
-    Like the real drone it publishes the LED colour on a latched topic, GREEN at start, following the
-    calls it accepts; with ``led_topic`` None it publishes none (a drone without LED reports). It can
+    Like the real drone it answers with the drone's own LED (:class:`drone_sim.led.WarningLed`: its
+    success and its words, its refusal of any other request) and publishes the colour on a latched
+    topic, GREEN at start, once per change; with ``led_topic`` None it publishes none (a drone without
+    LED reports). It can
     be absent (:meth:`withdraw`, or ``advertise=False``), slow (``delay`` s per call), failing (the
     handler raises, so the caller gets a ServiceException) or refusing (answers success false, as a
     broken LED driver would).
@@ -172,7 +202,7 @@ class FakeWarningService(object):
     :param clock: the function that times the calls (default ``rospy.get_time``).
     """
 
-    def __init__(self, name, srv_class, led_topic, advertise=True, on_call=None, clock=None):
+    def __init__(self, name, srv_class, led_topic, advertise=True, on_call=None, clock=None, label='ALT WARN'):
         self._clock = clock or rospy.get_time
         self._name = name
         self._srv_class = srv_class
@@ -187,9 +217,10 @@ class FakeWarningService(object):
         self._service = None
         self._withdrawn = False
         self._led = None
-        self.colour = 'GREEN'
+        self._state = WarningLed(label)
+        self.colour = self._state.colour
         if led_topic is not None:
-            self._led = rospy.Publisher(led_topic, String, queue_size=1, latch=True)
+            self._led = rospy.Publisher(led_topic, String, queue_size=LED_QUEUE, latch=True)
             self._led.publish(String(self.colour))
         if advertise:
             self.advertise()
@@ -271,22 +302,20 @@ class FakeWarningService(object):
             time.sleep(delay)
         if failing:
             raise rospy.ServiceException('the fake drone was told to fail')
-        colour = None if refusing else COLOURS.get(request.status)
         with self._lock:
+            if refusing:
+                success, message, changed = False, SCRIPTED_REFUSAL, False
+            else:
+                success, message, changed = self._state.apply(request.status)
+            self.colour = self._state.colour
             self._calls.append((now, request.status))
-            if colour is not None and colour != self.colour:
-                self.colour = colour
-                if self._led is not None:
-                    self._led.publish(String(colour))
+            if changed and self._led is not None:
+                self._led.publish(String(self.colour))
         if self._on_call is not None:
-            self._on_call(request.status, colour is not None)
-        if refusing:
-            message = 'LED driver fault (scripted)'
-        else:
-            message = 'LED set' if colour is not None else 'unknown status'
+            self._on_call(request.status, success)
         with self._lock:
-            self._answers.append((now, request.status, colour is not None, message))
-        return self._srv_class._response_class(colour is not None, message)
+            self._answers.append((now, request.status, success, message))
+        return self._srv_class._response_class(success, message)
 
 
 def _service_registered(resolved_name):
@@ -349,16 +378,24 @@ class TopicRecorder(object):
             self._samples.append((now, msg.data))
 
 
-#: What differs between the two sheets' drones: inputs (the one that does not move first) and their
-#: rates, the service, the LED topic and the output the exam node publishes.
+def _sheet(spec, output, fixed, moving):
+    """A sheet's drone from its package's SPEC: inputs and their default rates, the service, the LED;
+    plus what the lab adds: the output the exam node publishes, which input stays fixed (at which
+    value) and which one moves."""
+    return dict(rates={sensor.topic: sensor.default_rate for sensor in spec.sensors},
+                service=spec.service_name, srv=spec.service_type, led=spec.led_topic, label=spec.led_label,
+                output=output, fixed=fixed, moving=moving)
+
+
+#: What differs between the two sheets' drones, the drone's part read from its package's SPEC.
 SHEETS = {
-    'altitude': dict(rates={'temperature': 2.0, 'pressure': 5.0}, service='altitude_warning',
-                     srv=AltitudeWarning, led='alt_warn_led', output='altitude',
-                     fixed=('temperature', AIR_TEMPERATURE), moving='pressure'),
-    'depth': dict(rates={'pressure_remote': 2.0, 'pressure_robot': 5.0}, service='depth_warning',
-                  srv=DepthWarning, led='depth_warn_led', output='depth',
-                  fixed=('pressure_remote', REMOTE_PRESSURE), moving='pressure_robot'),
+    'altitude': _sheet(MYDRONE, 'altitude', ('temperature', AIR_TEMPERATURE), 'pressure'),
+    'depth': _sheet(SUBMARINEDRONE, 'depth', ('pressure_remote', REMOTE_PRESSURE), 'pressure_robot'),
 }
+#: Faster inputs than the sheets' drones (0.778 / 2 Hz, 1 / 2 Hz), said so where used: the exam node's
+#: scenario rostests (:class:`DroneScenario`), so each waits less for a fresh reading. Never the judge's.
+TEST_RATES = {'altitude': {'temperature': 2.0, 'pressure': 5.0},
+              'depth': {'pressure_remote': 2.0, 'pressure_robot': 5.0}}
 
 
 class Drone(object):
@@ -370,7 +407,7 @@ class Drone(object):
     :param mode: ``'altitude'`` (sheet 000) or ``'depth'`` (sheet 001).
     :param advertise: start with the warning service advertised.
     :param led: publish the LED topic.
-    :param rates: dict topic -> Hz, to override the default input rates.
+    :param rates: dict topic -> Hz, to override the sheet's drone's rates (say why where you do).
     :param tcp_nodelay: see :class:`SensorFeeder`.
     :param on_call: see :class:`FakeWarningService`.
     :param namespace: where the node under test lives (``'/latency_ours_3'``): every topic and the
@@ -379,20 +416,24 @@ class Drone(object):
         :attr:`fixed_topic` and :attr:`moving_topic` are the resolved ones.
     :param queue_size: of the output recorder, see :class:`TopicRecorder`.
     :param clock: the function every time is read from (default ``rospy.get_time``).
+    :param on_ticks: see :class:`SensorFeeder` (the grader's probe: the sheet's drone exactly).
     """
 
     def __init__(self, mode='altitude', advertise=True, led=True, rates=None, tcp_nodelay=False,
-                 on_call=None, namespace='', queue_size=100, clock=None):
+                 on_call=None, namespace='', queue_size=100, clock=None, on_ticks=False):
         sheet = SHEETS[mode]
         self.mode = mode
 
         def name(relative):
             return namespace.rstrip('/') + '/' + relative if namespace else relative
 
-        rates = dict(sheet['rates'], **(rates or {}))
-        self.feeder = SensorFeeder({name(topic): rate for topic, rate in rates.items()}, tcp_nodelay, clock)
+        #: The input rates flown, Hz, by the sheet's relative topic names.
+        self.rates = dict(sheet['rates'], **(rates or {}))
+        self.feeder = SensorFeeder({name(topic): rate for topic, rate in self.rates.items()}, tcp_nodelay, clock,
+                                   on_ticks)
         self.service = FakeWarningService(name(sheet['service']), sheet['srv'],
-                                          name(sheet['led']) if led else None, advertise, on_call, clock)
+                                          name(sheet['led']) if led else None, advertise, on_call, clock,
+                                          sheet['label'])
         self.output = TopicRecorder(name(sheet['output']), tcp_nodelay=tcp_nodelay, queue_size=queue_size,
                                     clock=clock)
         fixed_topic, self.fixed_value = sheet['fixed']
@@ -461,8 +502,9 @@ class DroneScenario(unittest.TestCase):
     Subclasses set ``MODE`` and ``REST`` (a value in m on the safe side of the threshold), and may name
     in ``FIRST`` the test that must meet the exam node before it ever had an input; unittest runs the
     tests in the order of their names, so that one is named ``test_01_...``. ``ADVERTISE`` False starts
-    the drone without its warning service, ``LED`` False without its LED topic, ``RATES`` overrides
-    the input rates.
+    the drone without its warning service, ``LED`` False without its LED topic. ``RATES`` are the
+    input rates: :data:`TEST_RATES` unless a subclass says otherwise, faster than the sheet's drone so
+    that the scenarios wait less (the grader's probe flies the drone's own rates).
     """
     MODE = 'altitude'
     ADVERTISE = True
@@ -473,7 +515,7 @@ class DroneScenario(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.drone = Drone(cls.MODE, cls.ADVERTISE, cls.LED, cls.RATES)
+        cls.drone = Drone(cls.MODE, cls.ADVERTISE, cls.LED, TEST_RATES[cls.MODE] if cls.RATES is None else cls.RATES)
 
     def setUp(self):
         if self._testMethodName != self.FIRST:

@@ -4,8 +4,10 @@ Run inside its own rospy process, on the master of one submission, by :mod:`exam
 
     python3 -m exam_lab.grader.judge.probe PLAN.json RESULT.json
 
-The drone is the harness's :class:`~exam_lab.harness.fake_drone.Drone`, driven by a script with
-noise-free values from the oracle, so the same package gets the same measurements. The probe only
+The drone is the harness's :class:`~exam_lab.harness.fake_drone.Drone`, the sheet's own drone (its
+topics, rates, service, answers and LED, from the drone package's SPEC; a new value goes out at the
+sensor's next tick, as the real drone's reading does), driven by a script with noise-free values from
+the oracle, so the same package gets the same measurements. The probe only
 measures; the points are given by :mod:`exam_lab.grader.score.rubric` from the JSON it writes.
 
 Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of question 14a, the same
@@ -25,12 +27,14 @@ The main scenario (times are the script's, all recorded as wall-clock times of t
 2. question 11: a few input pairs (one with another temperature / remote pressure), the value the node
    publishes for each after it settled;
 3. calibration: from those values, the inputs that make the *node's own* value sit ``margin`` below
-   and above the threshold, checked by flying there (a wrong formula costs question 11 only);
-4. the flight: rest below (``REST_S``), a short excursion above (``SHORT_S`` < delay), below again, a long
-   excursion (delay + ``AFTER_S``, longer for a late WARNING), below again; every service call is
-   recorded with its arrival time. Each leg's hold counts from the node's own first value on its side,
-   and every leg is checked on the node's own values (``legs``): the rubric judges nothing on a leg the
-   node's value did not reach.
+   and above the threshold and ``NEAR_M`` below it, checked by flying there (a wrong formula costs
+   question 11 only);
+4. the flight (docs/grading.md's table of legs says which wrong node each leg tells from a right one):
+   rest below (``REST_S``), a short excursion above (``SHORT_S``), just below (``near``, ``GAP_S``), a
+   long excursion (delay + ``AFTER_S``, longer for a late WARNING), just below (``BACK_S``), further
+   below (``DEEP_S``); every service call is recorded with its arrival time. Each leg's hold counts from
+   the node's own first value on its side, and every leg is checked on the node's own values (``legs``):
+   the rubric times each rule from them and judges nothing on a leg the node's value did not reach.
 """
 import ast
 import json
@@ -55,6 +59,8 @@ from exam_lab.harness.wait import wait_until
 
 #: Seconds after an input change before the node's output is read (several 10 Hz ticks).
 SETTLE_S = 0.8
+#: After a change of both inputs, read one period of the slowest input plus this later.
+SETTLE_SLACK_S = 0.5
 #: Published values older than this after an input change are not read (the change may be half seen).
 IGNORE_S = 0.3
 #: Seconds to wait for the second input's subscription once the node is up.
@@ -63,11 +69,25 @@ SUBSCRIBE_S = 6.0
 RETYPE_S = 1.0
 #: Seconds to wait for the output publisher once the node subscribed.
 OUTPUT_S = 3.0
-#: The flight: rest below, short excursion above (< delay), gap below, long excursion lasts delay + AFTER_S.
-REST_S = 3.0
-SHORT_S = 3.0
-GAP_S = 2.5
-AFTER_S = 2.5
+#: The flight's holds, s from the node's own first value on the leg's side (docs/grading.md, legs).
+#: The short excursion: with a return as late as the rubric's lag tolerance (one period of the slowest
+#: input and 0.5 s: 1.79 s) the node's own value stays above 4.3 s at most, less than the WARNING
+#: window's start (4.7 s), so a right node never warns there.
+REST_S = 2.0
+SHORT_S = 2.5
+#: Just below the threshold after the short excursion: a count that is not reset there shows later.
+GAP_S = 2.0
+#: The long excursion lasts delay + AFTER_S: past the WARNING window's end (delay + 0.5 s).
+AFTER_S = 1.5
+#: Just below the threshold after the long excursion: NORMAL must come here, at once.
+BACK_S = 1.5
+#: Further below (the rest's value): the NORMAL of a node that waits for a margin, for question 13.
+DEEP_S = 1.5
+#: The return legs fly the node's own value this far below the threshold (student units), accepted
+#: up to NEAR_MAX_M below: closer than any noise band a student might wait for (mydrone's thermometer
+#: alone moves the altitude by about 0.45 m).
+NEAR_M = 0.1
+NEAR_MAX_M = 0.2
 #: The most seconds a leg waits for the node's own value to reach the side of the threshold it is
 #: flown for (a node that blocks a callback for 5 s publishes a stale value meanwhile).
 REACH_S = 8.0
@@ -334,13 +354,14 @@ def _last_value(recorder, since):
     return (samples[-1][1] if samples else None), len(samples)
 
 
-def _settled(recorder, since, before=None):
-    """The node's value after an input change at ``since``: read SETTLE_S later; when it is still the
-    ``before`` value, waited for until it moves, up to STALE_S (a node that blocks in a callback)."""
-    time.sleep(max(0.0, since + SETTLE_S - time.time()))
-    if before is not None:
-        wait_until(lambda: _last_value(recorder, since)[0] not in (None, before), STALE_S - SETTLE_S,
-                   period=0.1)
+def _settled(recorder, since, before=None, settle=SETTLE_S):
+    """The node's value after an input change at ``since``: read ``settle`` s later; when it is still the
+    ``before`` value (or none), waited for until it moves, up to STALE_S (a node that blocks in a callback)."""
+    time.sleep(max(0.0, since + settle - time.time()))
+    # Also when nothing came yet: a node computes only once it has a reading of each input, and the
+    # slowest comes once a period.
+    wait_until(lambda: _last_value(recorder, since)[0] not in (None, before), max(0.0, STALE_S - settle),
+               period=0.1)
     return _last_value(recorder, since)
 
 
@@ -351,18 +372,29 @@ def on_side(value, threshold, side):
     return value > threshold if side == 'above' else value <= threshold
 
 
+#: The main flight's legs, in their order.
+FLIGHT_LEGS = ('rest', 'short_up', 'short_down', 'long_up', 'long_down', 'deep_down')
+
+
 def leg_check(samples, threshold, side, start, end):
     """Whether the node's own published values were on ``side`` of the threshold during a leg that
     was flown from ``start`` to ``end``: ``{"side", "reached" (time of the first value on that side,
-    or None), "off_side" (values on the other side after that), "first", "last" (values)}``.
+    or None), "stays" (time of the first value from which every value of the leg is on that side, or
+    None), "off_side" (values on the other side after "reached"), "first", "last" (values)}``.
 
     Judged only on what the node published: a leg whose values never reached the side (a stale
-    reading, a node that does not react) is not one the rubric may judge anything on.
+    reading, a node that does not react) is not one the rubric may judge anything on. The rubric times
+    the delay from "stays" (the node's own value went beyond and stayed), the return from "reached".
     """
     inside = [(t, v) for t, v in samples if start <= t <= end]
     reached = next((t for t, v in inside if on_side(v, threshold, side)), None)
     off = len([1 for t, v in inside if reached is not None and t >= reached and not on_side(v, threshold, side)])
-    return {'side': side, 'reached': reached, 'off_side': off,
+    stays = None
+    for t, v in reversed(inside):
+        if not on_side(v, threshold, side):
+            break
+        stays = t
+    return {'side': side, 'reached': reached, 'stays': stays, 'off_side': off,
             'first': inside[0][1] if inside else None, 'last': inside[-1][1] if inside else None,
             'samples': len(inside)}
 
@@ -381,8 +413,12 @@ class Probe(object):
         # Handles of the watch's own: an XML-RPC connection is never shared between two threads.
         watched, lookups = Graph(), rosgraph.Master(rospy.get_name())
         self.watch = NodeWatch(watched.student_nodes, lambda name: node_uri(lookups, name), node_pid).start()
-        self.drone = Drone(self.sheet, clock=time.time)
+        self.drone = Drone(self.sheet, clock=time.time, on_ticks=True)
+        self.result['input_rates'] = dict(self.drone.rates)
         self.recorder = self.drone.output
+        self.fixed_now = None
+        #: How long after the last change the node's value is read (see set_inputs).
+        self.settle = SETTLE_S
         self.t0 = time.time()
         self.flown = []  # [time, oracle value] at every input change, for the flight plot's trace
 
@@ -392,9 +428,19 @@ class Probe(object):
         return rospy.resolve_name(name)
 
     def set_inputs(self, fixed, moving):
+        """Change the inputs (the fixed one only when it changes, as a real drone's would); return the
+        time of the first reading of the new values (the later input's next tick)."""
         drone = self.drone
-        drone.feeder.set(drone.fixed_topic, fixed)
+        changed = None
+        self.settle = SETTLE_S
+        if fixed != self.fixed_now:
+            changed = drone.feeder.set(drone.fixed_topic, fixed)
+            self.fixed_now = fixed
+            # A node that computes on each reading publishes a mixed pair in between (new fixed, old
+            # moving); one that waits for a fresh reading of each follows up to the slowest period later.
+            self.settle = max(SETTLE_S, 1.0 / min(drone.rates.values()) + SETTLE_SLACK_S)
         since = drone.feeder.set(drone.moving_topic, moving)
+        since = max(since, changed or since)
         self.flown.append([since, drone.expected(fixed, moving)])
         return since
 
@@ -498,14 +544,18 @@ class Probe(object):
         cases = [(drone.fixed_value, threshold - 2 * margin), (drone.fixed_value, threshold + 2 * margin),
                  (other_fixed, threshold)]
         points, rows = [], []
-        before = None
+        # The value before the first change, so that a node that follows a reading later is waited for.
+        before = _last_value(self.recorder, 0.0)[0]
+        # The fixed input sent again at its next tick: the node's subscription may have connected after
+        # its last reading (a publisher registered anew in the node's type), and it reads it once a period.
+        self.fixed_now = None
         for fixed, x in cases:
             if self.sheet == 'altitude':
                 moving = oracle.pressure_at(x, fixed)
             else:
                 moving = oracle.pressure_robot_at(x, fixed)
             since = self.set_inputs(fixed, moving)
-            value, count = _settled(self.recorder, since, before)
+            value, count = _settled(self.recorder, since, before, self.settle)
             before = value
             rows.append({'inputs': {drone.fixed_topic: fixed, drone.moving_topic: moving},
                          'expected': drone.expected(fixed, moving), 'published': value, 'samples': count})
@@ -519,7 +569,10 @@ class Probe(object):
         threshold: fits value = a*x + b through the check points, flies there, corrects with the
         fitted slope (twice at most). Falls back to the oracle's values when that fails."""
         threshold, margin = self.plan['threshold'], self.plan['margin']
-        targets = {'lo': threshold - margin, 'hi': threshold + margin}
+        targets = {'lo': threshold - margin, 'hi': threshold + margin, 'near': threshold - NEAR_M}
+        # How close to its target each value must come: the near one just below the threshold.
+        close = {'lo': lambda v, t: abs(v - t) < margin / 3, 'hi': lambda v, t: abs(v - t) < margin / 3,
+                 'near': lambda v, t: threshold - NEAR_MAX_M <= v <= threshold}
         calibration = {'by': 'oracle', 'reason': '', 'fit': None}
         usable = [(x, y) for x, y in points if y is not None and math.isfinite(y)]
         if self.recorder is None or len(usable) < 2:
@@ -539,17 +592,17 @@ class Probe(object):
                 a, b = calibration['fit']
                 x = (target - b) / a
             value = None
-            for _ in range(3):
+            for _ in range(4 if side == 'near' else 3):
                 previous = _last_value(self.recorder, 0.0)[0] if self.recorder is not None else None
                 since = self.fly(x)
-                value = _settled(self.recorder, since, previous)[0] if self.recorder is not None else None
+                value = _settled(self.recorder, since, previous, self.settle)[0] if self.recorder is not None else None
                 if calibration['by'] != 'own' or value is None or not math.isfinite(value) \
-                        or abs(value - target) < margin / 3:
+                        or close[side](value, target):
                     break
                 x += (target - value) / calibration['fit'][0]
             chosen[side] = {'x': x, 'target': target, 'value': value}
         own_ok = all(v['value'] is not None and math.isfinite(v['value']) for v in chosen.values()) \
-            and chosen['lo']['value'] <= threshold < chosen['hi']['value']
+            and chosen['lo']['value'] <= threshold < chosen['hi']['value'] and chosen['near']['value'] <= threshold
         if calibration['by'] == 'own' and not own_ok:
             calibration.update(by='oracle', fit=None, reason=(
                 'the node\'s values did not come out on both sides of the threshold (%s): flying by the '
@@ -557,7 +610,7 @@ class Probe(object):
             chosen = {side: {'x': target, 'target': target, 'value': None} for side, target in targets.items()}
         calibration.update(chosen)
         self.result['calibration'] = calibration
-        return chosen['lo']['x'], chosen['hi']['x']
+        return chosen['lo']['x'], chosen['hi']['x'], chosen['near']['x']
 
     def leg(self, x, side, hold, late=0.0):
         """Fly at ``x`` for ``hold`` s counted from the node's own first value on ``side`` (the input's
@@ -576,18 +629,19 @@ class Probe(object):
                        or not self.graph.student_nodes(), start + late - time.time(), period=0.1)
         return since
 
-    def flight(self, lo, hi):
+    def flight(self, lo, hi, near):
         delay = self.plan['delay']
         late = self.plan.get('late_warning', 0.0)
         schedule = {}
         schedule['rest'] = self.leg(lo, 'below', REST_S)
         schedule['short_up'] = self.leg(hi, 'above', SHORT_S)
-        schedule['short_down'] = self.leg(lo, 'below', GAP_S)
+        schedule['short_down'] = self.leg(near, 'below', GAP_S)
         schedule['long_up'] = self.leg(hi, 'above', delay + AFTER_S, late)
-        schedule['long_down'] = self.leg(lo, 'below', AFTER_S)
+        schedule['long_down'] = self.leg(near, 'below', BACK_S)
+        schedule['deep_down'] = self.leg(lo, 'below', DEEP_S)
         schedule['end'] = time.time()
         self.result['schedule'] = schedule
-        self.result['legs'] = self.legs(schedule, ('rest', 'short_up', 'short_down', 'long_up', 'long_down'))
+        self.result['legs'] = self.legs(schedule, FLIGHT_LEGS)
         if self.recorder is not None:
             samples = self.recorder.samples(schedule['rest'], schedule['end'])
             rate = {'samples': len(samples), 'hz': None, 'max_gap': None}
@@ -631,8 +685,7 @@ class Probe(object):
         if self.wait_for_node():
             readable = self.find_output()
             points = self.formula() if readable else []
-            lo, hi = self.calibrate(points)
-            self.flight(lo, hi)
+            self.flight(*self.calibrate(points))
 
     def run(self):
         if self.plan['kind'] == 'main':

@@ -11,7 +11,7 @@ import os
 from exam_lab.grader.score.rubric import calls
 
 #: Legs of each run, in order, and the side of the threshold each is flown on.
-LEGS = {'rest': 'below', 'short_up': 'above', 'short_down': 'below', 'long_up': 'above', 'long_down': 'below',
+LEGS = {'rest': 'below', 'short_up': 'above', 'short_down': 'below', 'long_up': 'above', 'long_down': 'below', 'deep_down': 'below',
         'start': 'below', 'step': 'above'}
 _SIDE_COLOUR = {'above': '#f4cccc', 'below': '#d9e8f5'}
 #: Up to this many calls of a kind, each is also a vertical line across the panel.

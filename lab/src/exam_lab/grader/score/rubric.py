@@ -19,10 +19,11 @@ RATE_TOLERANCE = 0.10
 #: Question 11: a published value agrees when within this many metres, or this share of the value.
 VALUE_TOLERANCE_M = 0.5
 VALUE_TOLERANCE_REL = 0.001
-#: Question 14b: WARNING accepted from delay - EARLY to delay + LATE s after the first reading beyond.
+#: Question 14b: WARNING accepted from delay - EARLY to delay + LATE s after the node's own value went
+#: beyond the threshold and stayed: 5 s less one reading of the 2 Hz input (4.5 s) falls outside.
 WARNING_EARLY_S = 0.3
 WARNING_LATE_S = 0.5
-#: Question 14b: NORMAL accepted up to this many s after the first reading back (at once).
+#: Question 14b: NORMAL accepted up to this many s after the node's own value came back (at once).
 NORMAL_LATE_S = 0.5
 #: Question 13: this many calls repeating the previous status make "called in a loop".
 LOOP_REPEATS = 3
@@ -31,8 +32,11 @@ NUMERIC_TYPES = tuple('std_msgs/%s' % t for t in ('Float32', 'Float64', 'Int8', 
                                                   'UInt8', 'UInt16', 'UInt32', 'UInt64'))
 #: Question 12: what a launch file without a single comment loses ("la moitie si pas de commentaires").
 NO_COMMENT_LOSS = 0.5
-#: A leg whose node's value reached its side this many s after the input changed is said to lag.
-LAG_S = 0.5
+#: Question 11's lag: the node's value follows its inputs within one period of its slowest input (a
+#: node that waits for a fresh reading of each) plus this: a tick of its 10 Hz and the transport.
+LAG_SLACK_S = 0.5
+#: The slowest input's rate of a probe that did not record its rates (the lab's drone before issue 35).
+OLD_SLOWEST_HZ = 2.0
 
 #: Every student's status: what the teacher must do with the grade.
 GRADED = 'graded'
@@ -224,6 +228,9 @@ def score_q11(sheet, session):
                      % (len(wrong), len(rows), VALUE_TOLERANCE_M, VALUE_TOLERANCE_REL * 100, shown or 'none read'))
     if rate.get('non_finite'):
         notes.append('%d published value(s) were not finite numbers' % rate['non_finite'])
+    lag = lag_words(probe)
+    if lag:
+        notes.append(lag)
     return item('Q11', points, '; '.join(notes))
 
 
@@ -332,7 +339,8 @@ def _driven_by(probe):
 
 #: The legs of the flights, in words.
 LEG_WORDS = {'rest': 'rest below', 'short_up': 'short excursion above', 'short_down': 'gap below',
-             'long_up': 'long excursion above', 'long_down': 'return below', 'start': 'start below',
+             'long_up': 'long excursion above', 'long_down': 'return just below', 'deep_down': 'return further below',
+             'start': 'start below',
              'step': 'step above the new threshold'}
 
 
@@ -356,9 +364,68 @@ def _reached(probe, name):
     return leg.get('reached') or probe['schedule'][name]
 
 
-def _lag(probe, name):
-    lag = _reached(probe, name) - probe['schedule'][name]
-    return (' (the node\'s own value followed %.1f s after the input)' % lag) if lag > LAG_S else ''
+def lag_tolerance(probe):
+    """Seconds the node's value may take to follow its inputs: one period of the slowest input the
+    drone flew (``input_rates`` of the probe) plus LAG_SLACK_S."""
+    rates = [r for r in ((probe or {}).get('input_rates') or {}).values() if r and r > 0]
+    return 1.0 / min(rates or [OLD_SLOWEST_HZ]) + LAG_SLACK_S
+
+
+def leg_lag(probe, name):
+    """Seconds from the input's change to the node's own first value on leg ``name``'s side, or None
+    (the leg was not flown, its value never reached the side, or the output cannot be read)."""
+    leg = ((probe or {}).get('legs') or {}).get(name) or {}
+    start = ((probe or {}).get('schedule') or {}).get(name)
+    if leg.get('reached') is None or start is None:
+        return None
+    return leg['reached'] - start
+
+
+def timed_from(probe, name, stays=False):
+    """``(time, words)``: where a timing rule on leg ``name`` counts from, in the node's own frame: when
+    its own value went beyond and stayed (``stays``: the delay) or first came to the leg's side (the
+    return). A node whose value took longer than :func:`lag_tolerance` to follow its inputs there is
+    timed from the input's change instead (its lag is then its mistake, said here and in Q11), and so
+    is one whose output cannot be read."""
+    start = probe['schedule'][name]
+    lag = leg_lag(probe, name)
+    if lag is None:
+        return start, 'the first reading'
+    if lag > lag_tolerance(probe):
+        return start, 'the first reading (the node\'s own value followed %.1f s later, more than one input ' \
+                      'period: timed from the reading)' % lag
+    leg = probe['legs'][name]
+    own = leg.get('stays') if stays and leg.get('stays') is not None else leg['reached']
+    return own, 'its own value'
+
+
+def lag_words(probe):
+    """Question 11's evidence of how fast the node's value followed its inputs on the flight's legs,
+    or '' when nothing was measured."""
+    measured = [(name, leg_lag(probe, name)) for name in LEG_WORDS if leg_lag(probe, name) is not None
+                and name in ((probe or {}).get('schedule') or {}) and name not in ('start', 'step')]
+    if not measured:
+        return ''
+    name, worst = max(measured, key=lambda m: m[1])
+    tolerance = lag_tolerance(probe)
+    if worst <= tolerance:
+        return 'its value followed the inputs within %.2f s (at most %.2f s: one period of the slowest input ' \
+               'and a tick); the timing items are judged from its own values' % (max(worst, 0.0), tolerance)
+    return 'its value followed the inputs %.1f s late in the %s, more than one period of the slowest input ' \
+           '(%.2f s): the timing items are judged from the readings there' % (worst, LEG_WORDS[name], tolerance)
+
+
+def _up_end(probe):
+    """Until when a WARNING belongs to the long excursion: the node's own value back below (or the
+    input's return, if later)."""
+    schedule = probe['schedule']
+    return max(schedule['long_down'], _reached(probe, 'long_down'))
+
+
+def _back_end(probe):
+    """Until when a NORMAL is the return's "at once": the end of the leg just below the threshold."""
+    schedule = probe['schedule']
+    return schedule.get('deep_down', schedule['end'])
 
 
 def score_q13(sheet, session):
@@ -369,13 +436,14 @@ def score_q13(sheet, session):
     if unreached_legs(probe, ['long_up']):
         return item('Q13', 0, '%s (%s)' % (_leg_words(probe, 'long_up'), _driven_by(probe)))
     service = SHEETS[sheet].service
-    up = _calls_between(probe, schedule['long_up'], schedule['long_down'], 'WARNING')
+    up = _calls_between(probe, schedule['long_up'], _up_end(probe), 'WARNING')
     down_judged = not unreached_legs(probe, ['long_down'])
     down = _calls_between(probe, schedule['long_down'], schedule['end'], 'NORMAL') if up else []
     repeats = _repeats(probe, schedule['rest'])
     total = len(_calls_between(probe, schedule['rest'], schedule['end']))
     looped = repeats >= LOOP_REPEATS
     above = schedule['long_down'] - _reached(probe, 'long_up')
+    up_from = timed_from(probe, 'long_up', stays=True)[0]
     if up and down and down_judged:
         points = 4.0
         evidence = 'WARNING while above, NORMAL once back below'
@@ -392,9 +460,9 @@ def score_q13(sheet, session):
         if others:
             evidence += ' (it called with %s, which mean neither WARNING nor NORMAL)' % ', '.join(
                 '"%s"' % r[:40] for r in others[:4])
-    if up and up[0][0] - schedule['long_up'] > probe.get('delay', DELAY) + WARNING_LATE_S:
+    if up and up[0][0] - up_from > probe.get('delay', DELAY) + WARNING_LATE_S:
         evidence += ' (the WARNING came late, %.1f s after the value went above: the flight waited for it)' % (
-            up[0][0] - schedule['long_up'])
+            up[0][0] - up_from)
     refused = refused_calls(probe, schedule['rest'], schedule['end'])
     if refused and points:
         points /= 2
@@ -498,42 +566,63 @@ def score_q14b(sheet, session):
     if unreached_legs(probe, ['long_up']):
         return item('Q14b', 0, _leg_words(probe, 'long_up'))
     delay = probe.get('delay', DELAY)
-    warnings = _calls_between(probe, schedule['long_up'], schedule['long_down'], 'WARNING')
+    warnings = _calls_between(probe, schedule['long_up'], _up_end(probe), 'WARNING')
     if not warnings:
         return item('Q14b', 0, 'no WARNING in %.1f s above the threshold, so no delay to judge'
                     % (schedule['long_down'] - _reached(probe, 'long_up')))
-    latency = warnings[0][0] - schedule['long_up']
+    up_from, up_words = timed_from(probe, 'long_up', stays=True)
+    latency = warnings[0][0] - up_from
     warn_ok = delay - WARNING_EARLY_S <= latency <= delay + WARNING_LATE_S
     short_judged = not unreached_legs(probe, ['short_up'])
     short = _calls_between(probe, schedule['short_up'], schedule['long_up'], 'WARNING')
-    short_ok = short_judged and not short
+    short_from = timed_from(probe, 'short_up')[0]
+    short_back = timed_from(probe, 'short_down')[0]
+    # Above for the delay in its own frame (only a node beyond the lag tolerance gets there, and it is
+    # then timed from the readings): a WARNING there is no mistake of the delay.
+    own_long = short_back - short_from >= delay - WARNING_EARLY_S
+    short_ok = short_judged and (not short or own_long)
     normal_judged = not unreached_legs(probe, ['long_down'])
-    normals = _calls_between(probe, schedule['long_down'], schedule['end'], 'NORMAL')
-    normal_latency = normals[0][0] - schedule['long_down'] if normals else None
+    back_from, back_words = timed_from(probe, 'long_down')
+    normals = _calls_between(probe, schedule['long_down'], _back_end(probe), 'NORMAL')
+    normal_latency = normals[0][0] - back_from if normals else None
     normal_ok = normal_judged and normal_latency is not None and normal_latency <= NORMAL_LATE_S
     points = 1.5 * warn_ok + 1.0 * short_ok + (0.5 * normal_ok if (warn_ok or short_ok) else 0.0)
-    notes = ['WARNING %.2f s after the first reading above%s (%s: %.1f-%.1f s) (%s/1.5)' % (
-        latency, _lag(probe, 'long_up'), 'ok' if warn_ok else 'outside', delay - WARNING_EARLY_S,
+    notes = ['WARNING %.2f s after %s went above the threshold and stayed (%s: %.1f-%.1f s) (%s/1.5)' % (
+        latency, up_words, 'ok' if warn_ok else 'outside', delay - WARNING_EARLY_S,
         delay + WARNING_LATE_S, 1.5 if warn_ok else 0)]
     if not short_judged:
         notes.append('short excursion: %s (0/1)' % _leg_words(probe, 'short_up'))
     else:
-        back = _reached(probe, 'short_down') - schedule['short_down']
-        notes.append('%.1f s excursion%s%s: %s (%s/1)' % (
-            schedule['short_down'] - schedule['short_up'], _lag(probe, 'short_up'),
-            ' (the node\'s own value stayed above %.1f s longer: it did not follow its inputs)' % back
-            if back > LAG_S else '',
-            'no WARNING' if short_ok else 'WARNING %.2f s after it began' % (short[0][0] - schedule['short_up']),
+        stayed = (leg_lag(probe, 'short_down') or 0.0)
+        notes.append('%.1f s excursion above%s%s: %s (%s/1)' % (
+            short_back - short_from, '' if short_from != schedule['short_up'] else ' (from the readings)',
+            ' (the node\'s own value stayed above %.1f s longer: it did not follow its inputs)' % stayed
+            if stayed > lag_tolerance(probe) else '',
+            'no WARNING' if not short else 'WARNING %.2f s after it began%s' % (
+                short[0][0] - short_from, ', as long as the delay in its own values' if own_long else ''),
             1 if short_ok else 0))
+    below = _near_words(probe)
     if not normal_judged:
         notes.append('NORMAL: %s (0/0.5)' % _leg_words(probe, 'long_down'))
     elif normal_latency is None:
-        notes.append('no NORMAL after the return below (0/0.5)')
+        later = _calls_between(probe, _back_end(probe), schedule['end'], 'NORMAL')
+        notes.append('no NORMAL while %s was back just below the threshold%s%s (0/0.5)' % (
+            back_words, below, '; it came %.2f s later, further below: it waits for a margin' % (
+                later[0][0] - back_from) if later else ''))
     else:
-        notes.append('NORMAL %.2f s after the first reading back below (%s/0.5%s)' % (
-            normal_latency, 0.5 if normal_ok and (warn_ok or short_ok) else 0,
+        notes.append('NORMAL %.2f s after %s came back just below the threshold%s (%s/0.5%s)' % (
+            normal_latency, back_words, below, 0.5 if normal_ok and (warn_ok or short_ok) else 0,
             '' if warn_ok or short_ok else ', counted only with a delay'))
     return item('Q14b', points, '; '.join(notes))
+
+
+def _near_words(probe):
+    """How far below the threshold the node's own value was on the return ('' when not recorded)."""
+    near = ((probe or {}).get('calibration') or {}).get('near') or {}
+    value, threshold = near.get('value'), (probe or {}).get('threshold')
+    if value is None or threshold is None or not math.isfinite(value):
+        return ''
+    return ' (%.2f, %.2f below)' % (value, threshold - value)
 
 
 def score(sheet, static, session):
