@@ -68,6 +68,15 @@ MISTAKES = [
     ('never_warns', 'one line misplaced (`counter = 0` out of its `else`): the WARNING call is never reached',
      NOTES['Q13'] + ' and ' + NOTES['Q14b'] + ': no call, none of their points; Q14a\'s half from the code; '
      'read the code, the reason names the call\'s line'),
+    ('fresh_readings', 'a new value published only from a fresh reading of each input (it lags up to one '
+     'temperature period, 1.3 s)', NOTES['Q11'] + ': its own value is judged, so nothing lost; the lag is '
+     'reported on its own'),
+    ('count_messages', 'the 5 s delay counted in messages of the 2 Hz `pressure_robot` (depth)',
+     NOTES['Q14b'] + ': 10 periods of the drone\'s own rate are 5 s, so full marks'),
+    ('delay_minus_period', 'the delay counted one reading short: 10 readings of the 2 Hz pressure from the first '
+     '(4.5 s)', NOTES['Q14b'] + ': the 1.5 of the delay lost, the rest kept'),
+    ('margin_normal', 'NORMAL only once the altitude is 5 m below the threshold',
+     NOTES['Q14b'] + ' ("the counter reset below": back to green at once): its half point lost'),
     ('renamed_package', 'a launch file without a single comment (and the package named `exam_pkg`)',
      NOTES['Q12'] + '; the name is question 9\'s business, in the report'),
     ('type_without_py', 'the launch file names `type="exam_node"` for `scripts/exam_node.py`',
