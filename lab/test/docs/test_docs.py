@@ -358,7 +358,7 @@ def test_grading_examples_are_the_generators_output_with_every_item_of_the_rubri
                                                                re.escape(grading_examples.END % name)), text, re.S)
         assert found, 'docs/grading.md: no generated example %r between its markers' % name
         grade = found.group(1)
-        assert grade.startswith('# %s: ' % os.path.basename(submission)), grade[:80]
+        assert grade.startswith('# %s: ' % name), grade[:80]  # graded as the student named like its example
         for item, (points, _) in ITEMS.items():
             assert re.search(r'^\| %s \| .* \| [0-9.]+ / %g \|' % (item, points), grade, re.M), item
 
