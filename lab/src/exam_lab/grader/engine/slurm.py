@@ -3,18 +3,20 @@ on a Slurm cluster"). No rospy here.
 
 Two halves, both run as whoever submits (the teacher; root only on a local try-out):
 
-- On the host that submits (a cluster's login node), :func:`grade_class` lists the students as a local
-  run does (:func:`~exam_lab.grader.runner.class_students`), builds the simulators' underlay once,
-  writes into ``OUT/.slurm/`` a manifest (one JSON line per student: name, submission) and the task's
-  batch script, submits ``sbatch --array=0-(N-1)`` and follows the array with ``squeue`` (a line each
-  time the pending, running and done counts change). A task that leaves the queue without a grade
-  (failed, cancelled, timed out, its node lost) is resubmitted once; after a second such end, that
-  student's record is "not graded" with what ``scontrol show job`` said. Then grades.csv, exactly as
+- On the host that submits (a cluster's login node), :func:`grade_class` lists the students with the
+  local run's own function (:func:`~exam_lab.grader.runner.class_students`; a Moodle archive's students
+  are then copied onto OUT for the nodes: :func:`shared_students`), builds the simulators' underlay
+  once, writes into ``OUT/.slurm/`` a manifest (one JSON line per student: name, submission) and the
+  task's batch script, submits ``sbatch --array=0-(N-1) --no-requeue`` and follows the array with
+  ``squeue`` (a line each time the pending, running and done counts change). A task that leaves the
+  queue without a grade (failed, cancelled, timed out, its node lost: NODE_FAIL) is resubmitted once,
+  said with Slurm's words and the node; after a second such end, that student's record is "not
+  graded" with what ``scontrol show job`` said. Then grades.csv, exactly as
   :func:`~exam_lab.grader.runner.grade_class` writes it; the caller writes the rest of OUT (the desk).
 - On the node, each task runs ``python3 -m exam_lab.grader.engine.slurm task ...``: :func:`run_task`
   grades its manifest line with :func:`~exam_lab.grader.runner.grade_student`, the local run's own code
-  path, and leaves the record in ``OUT/.slurm/results/<index>.json`` (written whole, then renamed: the
-  host never reads half a record).
+  path, names the node in the record (``graded_on``) and leaves it in ``OUT/.slurm/results/<index>.json``
+  (written whole, then renamed: the host never reads half a record).
 
 The nodes must see OUT, the class, this repository and its workspace at the same paths as the host (a
 shared file system), and have what a local run needs: ROS from Debian, bubblewrap, the build.
