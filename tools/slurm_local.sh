@@ -200,6 +200,7 @@ start() {
   if [ "$(nodes)" -eq "$n" ] && all_alive; then
     say "already running ($dir)"
     echo "export SLURM_CONF=$conf"
+    [ "$n" -eq 1 ] || echo "netns $(ctl_ns)"
     return 0
   fi
   [ "$(id -u)" -eq 0 ] || die "starting the daemons needs root (they run jobs as whoever submits them)"

@@ -18,7 +18,7 @@
 - The first student's task is cancelled with scancel while it runs, submitted once more, cancelled
   again, and is then "not graded" with what Slurm said.
 
-About 10 minutes (603 s measured) on the shared two cores (the teacher's workspace built, seven students graded locally,
+About 6 to 10 minutes (377 and 603 s measured) on the shared two cores (the teacher's workspace built, seven students graded locally,
 six and the lost ones on Slurm, one CPU per node). Needs root (the daemons, the account, the
 namespaces); installs Slurm when missing.
 """
@@ -119,16 +119,13 @@ def _node_processes(netns):
     return dict((pid, procs[pid]) for pid in mine)
 
 
-def _lose_node(netns):
-    """The node as if its machine died: every process of it stopped, then killed."""
-    for sig in (signal.SIGSTOP, signal.SIGKILL):
-        for _ in range(3):  # what forked meanwhile
-            for pid in _node_processes([netns]):
-                try:
-                    os.kill(pid, sig)
-                except OSError:
-                    pass
-    assert wait_until(lambda: not _node_processes([netns]), 30.0, period=0.2), _node_processes([netns])
+def _signal_node(netns, sig):
+    for _ in range(3):  # what forked meanwhile
+        for pid in _node_processes([netns]):
+            try:
+                os.kill(pid, sig)
+            except OSError:
+                pass
 
 
 def _class_zip(path):
@@ -270,16 +267,17 @@ class _Watch(object):
         out = self.slurm('squeue', '-h', '-r', '--name', 'exam-grade-out', '-o', '%F %K %T %N')
         return [tuple(l.split()) + ('',) * (4 - len(l.split())) for l in out.splitlines() if len(l.split()) >= 3]
 
-    def graded_on(self, node):
-        results = os.path.join(self.out, '.slurm', 'results')
+    def results(self):
+        """``{task index: the node that graded it}`` of the records written so far."""
+        results, found = os.path.join(self.out, '.slurm', 'results'), {}
         for name in os.listdir(results) if os.path.isdir(results) else ():
             try:
-                with open(os.path.join(results, name)) as f:
-                    if json.load(f).get('graded_on') == node:
-                        return True
-            except (OSError, ValueError):
-                pass  # being renamed
-        return False
+                if name.endswith('.json'):
+                    with open(os.path.join(results, name)) as f:  # written whole, then renamed
+                        found[name[:-len('.json')]] = json.load(f).get('graded_on')
+            except OSError:
+                pass  # the class is over: OUT/.slurm removed
+        return found
 
     def check_uids(self):
         for pid, (_, comm, _, uids) in _node_processes(self.nodes).items():
@@ -295,10 +293,25 @@ class _Watch(object):
                 self.cancelled.append(job)
         on_lost = set((job, index) for job, index, node in running if node == LOST)
         # Task 0 is cancelled twice: a node lost under it would end it otherwise.
-        if self.lost is None and on_lost and not [i for _, i in on_lost if i == '0'] and self.graded_on(LOST):
-            self.lost, self.lost_at = on_lost, time.monotonic()
-            _lose_node(self.nodes[0])
+        if self.lost is None and on_lost and '0' not in [i for _, i in on_lost] and \
+                LOST in self.results().values():
+            self.lose()
         self.check_uids()
+
+    def lose(self):
+        """exam-node1 as if its machine died: every process of it stopped, then killed. Its tasks that
+        were running and had written no record once stopped (none can write one then) are lost."""
+        _signal_node(self.nodes[0], signal.SIGSTOP)
+        done = self.results()
+        lost = set((job, index) for job, index, state, node in self.queue()
+                   if state == 'RUNNING' and node == LOST and index not in done)
+        if not lost or '0' in [i for _, i in lost]:  # a record just written, task 0 just started: later
+            _signal_node(self.nodes[0], signal.SIGCONT)
+            return
+        self.lost, self.lost_at = lost, time.monotonic()
+        _signal_node(self.nodes[0], signal.SIGKILL)
+        assert wait_until(lambda: not _node_processes(self.nodes[:1]), 30.0, period=0.2), \
+            _node_processes(self.nodes[:1])
 
     def follow(self, deadline):
         while self.grading.poll() is None:
