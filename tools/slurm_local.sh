@@ -239,7 +239,8 @@ start() {
     done
   fi
   wait_until nodes_idle ||
-    die "the nodes did not become idle: $(in_ctl sinfo -h -N -o '%N %t %E' | tr '\n' ' '); $(tail -5 "$dir"/slurmd*.log)"
+    die "the nodes did not become idle: $(in_ctl sinfo -h -N -o '%N %t %E' | tr '\n' ' ');" \
+      "$(tail -5 "$dir"/slurmd*.log)"
   trap - EXIT
   say "running: $(in_ctl sinfo -h -N -o 'node %N, %c CPUs, %t' | tr '\n' ';' | sed 's/;$//') ($dir)"
   [ "$n" -eq 1 ] || say "the controller is reached from its namespace: $0 login COMMAND... (netns $(ctl_ns))"
@@ -300,5 +301,6 @@ case "$command" in
   stop) stop ;;
   status) status ;;
   login) login "$@" ;;
-  *) die "usage: $0 start [--nodes N] | login COMMAND... | status | stop   (state in \$EXAM_SLURM_DIR, default \$EXAM_WS/slurm)" ;;
+  *) die "usage: $0 start [--nodes N] | login COMMAND... | status | stop" \
+       "(state in \$EXAM_SLURM_DIR, default \$EXAM_WS/slurm)" ;;
 esac

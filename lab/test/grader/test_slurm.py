@@ -18,8 +18,8 @@
 - The first student's task is cancelled with scancel while it runs, submitted once more, cancelled
   again, and is then "not graded" with what Slurm said.
 
-About 6 to 10 minutes (377 and 603 s measured) on the shared two cores (the teacher's workspace built, seven students graded locally,
-six and the lost ones on Slurm, one CPU per node). Needs root (the daemons, the account, the
+About 6 to 10 minutes (377 and 603 s measured) on the shared two cores (the teacher's workspace
+built, seven students graded locally, six and the lost ones on Slurm, one CPU per node). Needs root (the daemons, the account, the
 namespaces); installs Slurm when missing.
 """
 import csv
@@ -442,6 +442,7 @@ def test_slurm_stops_and_leaves_nothing_running(cluster, graded, teacher):
     code, output = _slurm_local(['stop'], state)
     assert code == 0, output
     assert _left_running(state) == []
-    assert wait_until(lambda: not sandbox.pids_of_uid(teacher.uid), 30.0, period=0.2), sandbox.pids_of_uid(teacher.uid)
+    assert wait_until(lambda: not sandbox.pids_of_uid(teacher.uid), 30.0, period=0.2), \
+        sandbox.pids_of_uid(teacher.uid)
     namespaces = subprocess.run(['ip', 'netns', 'list'], stdout=subprocess.PIPE).stdout.decode()
     assert cluster[2][:-len('_ctl')] not in namespaces, namespaces
