@@ -1,11 +1,14 @@
 """The Slurm engine's own logic, without Slurm: what it reads of squeue and scontrol, what it submits,
 and the retry rule (a task that ends without a grade is submitted once more, then is "not graded" with
 Slurm's words), against a scripted Slurm. lab/test/grader/test_slurm.py runs it on a real one."""
+import csv
 import json
 import os
+import zipfile
 
 import pytest
 
+from exam_lab.grader import runner
 from exam_lab.grader.engine import slurm
 
 
@@ -36,10 +39,21 @@ def test_what_slurm_said_of_a_task():
     assert slurm.slurm_said({}) == 'the task left the queue and Slurm keeps no record of it'
 
 
+def test_a_lost_node_is_named():
+    fields = slurm.parse_scontrol('JobId=15 JobState=NODE_FAIL Reason=NodeDown Dependency=(null)\n'
+                                  '   NodeList=exam-node1 BatchHost=exam-node1 ExitCode=0:0\n')
+    assert slurm.slurm_said(fields) == 'NODE_FAIL on node exam-node1 (the node stopped answering the ' \
+                                       'controller: its task is lost), reason NodeDown'
+    assert slurm.slurm_said(slurm.parse_scontrol('JobState=CANCELLED NodeList=(null) ExitCode=0:15')) == \
+        'CANCELLED, exit code 0:15'
+
+
 def test_the_state_line_counts_pending_running_and_done():
     tasks = {('12', 0): ('RUNNING', 'None'), ('12', 1): ('PENDING', 'Resources'), ('13', 2): ('PENDING', 'Priority')}
     assert slurm.state_line(['12', '13'], tasks, 3, 1, 8) == \
         'slurm job 12+13: 2 pending, 1 running, 4 done of 8 (1 not graded)'
+    assert slurm.state_line(['12', '13'], tasks, 3, 0, 8, again=2) == \
+        'slurm job 12+13 (2 tasks submitted again): 2 pending, 1 running, 3 done of 8'
 
 
 class ScriptedSlurm(object):
@@ -102,6 +116,7 @@ def test_a_task_that_fails_is_submitted_once_more_then_not_graded_with_slurms_wo
         run.look(float(now))
     assert [c[c.index('--array') + 1] for c in fake.calls if c[0] == 'sbatch'] == ['0-2', '1-2']
     assert all('--partition=p' in c for c in fake.calls if c[0] == 'sbatch')
+    assert all('--no-requeue' in c for c in fake.calls if c[0] == 'sbatch'), 'the engine alone retries'
     assert [r['status'] for r in run.records] == ['graded', 'graded', 'not graded']
     assert run.records[2]['status_reason'] == 'could not grade: Slurm said: CANCELLED, exit code 0:9'
     assert os.path.isfile(os.path.join(str(run.out_dir), 's2', 'grade.json'))
@@ -156,3 +171,55 @@ def test_a_task_of_a_student_the_intake_refused_says_why(tmp_path):
     assert record['participant'] == 12
     assert json.loads((tmp_path / '.slurm' / 'results' / '0.json').read_text())['status_reason'] == record['status_reason']
     assert [r['status_reason'] for r in runner.rescore(str(tmp_path))[0]] == [record['status_reason']]
+
+
+def test_a_task_says_in_the_grade_which_node_graded_it(tmp_path, monkeypatch):
+    manifest = tmp_path / '.slurm' / 'manifest.jsonl'
+    (tmp_path / '.slurm' / 'results').mkdir(parents=True)
+    manifest.write_text(json.dumps({'student': 'Ann', 'submission': '/class/Ann'}) + '\n')
+    monkeypatch.setenv('SLURMD_NODENAME', 'exam-node2')
+    monkeypatch.setattr(runner, 'grade_student', lambda name, folder, out, sheet, unsandboxed, refused=None: runner.could_not_grade(
+        name, sheet, 'scripted'))
+    slurm.run_task(str(manifest), 0, str(tmp_path))
+    with open(str(tmp_path / 'Ann' / 'grade.json')) as f:
+        assert json.load(f)['graded_on'] == 'exam-node2'
+    with open(str(tmp_path / '.slurm' / 'results' / '0.json')) as f:
+        assert json.load(f)['graded_on'] == 'exam-node2'
+
+
+def test_a_moodle_class_zip_is_graded_as_a_folder_is(tmp_path, monkeypatch):
+    """The zip a teacher downloads from Moodle: its students listed by the function the local engine
+    uses (runner.class_students, the intake in its box), unpacked on the shared OUT for the nodes, and
+    removed at the end. It used to raise AttributeError before anything was submitted."""
+    klass = tmp_path / 'class.zip'
+    with zipfile.ZipFile(str(klass), 'w') as zf:
+        for name, number in (('Ann Lee', 11), ('Bob Ray', 12)):
+            zf.writestr('%s_%d_assignsubmission_file_/exam/package.xml' % (name, number),
+                        '<package format="2"><name>exam</name></package>')
+    out = tmp_path / 'out'
+    seen = {}
+
+    class FromManifest(ScriptedSlurm):
+        """Each task "grades" its line: the submission the manifest names must be there, on OUT."""
+
+        def __call__(self, argv):
+            if argv[0] == 'squeue':
+                with open(os.path.join(self.base, 'manifest.jsonl')) as f:
+                    for index, line in enumerate(f):
+                        entry = json.loads(line)
+                        seen[entry['student']] = entry['submission']
+                        assert os.path.isfile(os.path.join(entry['submission'], 'exam', 'package.xml'))
+                        with open(os.path.join(self.base, 'results', '%d.json' % index), 'w') as r:
+                            json.dump(runner.could_not_grade(entry['student'], None, 'scripted'), r)
+                return 0, '', ''
+            return ScriptedSlurm.__call__(self, argv)
+
+    monkeypatch.setattr(slurm, '_call', FromManifest(str(out / '.slurm'), {}))
+    monkeypatch.setattr(runner, 'ensure_underlay', lambda cache: cache)
+    monkeypatch.setattr(slurm.shutil, 'which', lambda command: '/usr/bin/' + command)
+    records = slurm.grade_class(str(klass), str(out), unsandboxed=True, poll_s=0.0)
+    assert [r['student'] for r in records] == ['Ann Lee', 'Bob Ray']
+    assert all(path.startswith(str(out / '.slurm' / 'class')) for path in seen.values()), seen
+    with open(str(out / 'grades.csv')) as f:
+        assert [row['student'] for row in csv.DictReader(f)] == ['Ann Lee', 'Bob Ray']
+    assert not (out / '.slurm').exists(), 'the unpacked class is removed with the rest'

@@ -3,18 +3,20 @@ on a Slurm cluster"). No rospy here.
 
 Two halves, both run as whoever submits (the teacher; root only on a local try-out):
 
-- On the host that submits (a cluster's login node), :func:`grade_class` lists the students as a local
-  run does (:func:`~exam_lab.grader.runner.class_students`), builds the simulators' underlay once,
-  writes into ``OUT/.slurm/`` a manifest (one JSON line per student: name, submission) and the task's
-  batch script, submits ``sbatch --array=0-(N-1)`` and follows the array with ``squeue`` (a line each
-  time the pending, running and done counts change). A task that leaves the queue without a grade
-  (failed, cancelled, timed out, its node lost) is resubmitted once; after a second such end, that
-  student's record is "not graded" with what ``scontrol show job`` said. Then grades.csv, exactly as
+- On the host that submits (a cluster's login node), :func:`grade_class` lists the students with the
+  local run's own function (:func:`~exam_lab.grader.runner.class_students`; a Moodle archive's students
+  are then copied onto OUT for the nodes: :func:`shared_students`), builds the simulators' underlay
+  once, writes into ``OUT/.slurm/`` a manifest (one JSON line per student: name, submission) and the
+  task's batch script, submits ``sbatch --array=0-(N-1) --no-requeue`` and follows the array with
+  ``squeue`` (a line each time the pending, running and done counts change). A task that leaves the
+  queue without a grade (failed, cancelled, timed out, its node lost: NODE_FAIL) is resubmitted once,
+  said with Slurm's words and the node; after a second such end, that student's record is "not
+  graded" with what ``scontrol show job`` said. Then grades.csv, exactly as
   :func:`~exam_lab.grader.runner.grade_class` writes it; the caller writes the rest of OUT (the desk).
 - On the node, each task runs ``python3 -m exam_lab.grader.engine.slurm task ...``: :func:`run_task`
   grades its manifest line with :func:`~exam_lab.grader.runner.grade_student`, the local run's own code
-  path, and leaves the record in ``OUT/.slurm/results/<index>.json`` (written whole, then renamed: the
-  host never reads half a record).
+  path, names the node in the record (``graded_on``) and leaves it in ``OUT/.slurm/results/<index>.json``
+  (written whole, then renamed: the host never reads half a record).
 
 The nodes must see OUT, the class, this repository and its workspace at the same paths as the host (a
 shared file system), and have what a local run needs: ROS from Debian, bubblewrap, the build.
@@ -28,12 +30,13 @@ import re
 import shlex
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import time
 
 from exam_lab.grader import runner, workspace
-from exam_lab.grader.host import sandbox
+from exam_lab.grader.host import sandbox, staging
 from exam_lab.grader.publish import report
 
 #: Seconds between two looks at the queue: light on a shared controller, quick enough for a class.
@@ -104,6 +107,10 @@ def slurm_said(fields, last_seen=None):
         seen = ' (last seen %s)' % ', '.join(w for w in last_seen if w and w != 'None') if last_seen else ''
         return 'the task left the queue and Slurm keeps no record of it%s' % seen
     words = [fields['JobState']]
+    if fields.get('NodeList', '(null)') not in ('', '(null)', 'None'):
+        words[0] += ' on node %s' % fields['NodeList']
+    if fields['JobState'] == 'NODE_FAIL':
+        words[0] += ' (the node stopped answering the controller: its task is lost)'
     if fields.get('Reason', 'None') != 'None':
         words.append('reason %s' % fields['Reason'])
     if fields.get('ExitCode', '0:0') != '0:0':
@@ -111,13 +118,15 @@ def slurm_said(fields, last_seen=None):
     return ', '.join(words)
 
 
-def state_line(jobs, tasks, graded, not_graded, total):
-    """The array's state for the terminal: ``slurm job 12: 3 pending, 2 running, 5 done of 10``."""
+def state_line(jobs, tasks, graded, not_graded, total, again=0):
+    """The array's state for the terminal: ``slurm job 12: 3 pending, 2 running, 5 done of 10``, and
+    what went wrong so far: ``slurm job 12+13 (2 tasks submitted again): ... (1 not graded)``."""
     pending = sum(1 for state, _ in tasks.values() if state in PENDING)
     running = len(tasks) - pending
     failed = ' (%d not graded)' % not_graded if not_graded else ''
-    return 'slurm job %s: %d pending, %d running, %d done of %d%s' % (
-        '+'.join(jobs), pending, running, graded + not_graded, total, failed)
+    retried = ' (%d task%s submitted again)' % (again, '' if again == 1 else 's') if again else ''
+    return 'slurm job %s%s: %d pending, %d running, %d done of %d%s' % (
+        '+'.join(jobs), retried, pending, running, graded + not_graded, total, failed)
 
 
 def job_name(out_dir):
@@ -178,6 +187,9 @@ def run_task(manifest, index, out_dir, sheet=None, unsandboxed=False):
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     record = runner.grade_student(entry['student'], entry['submission'], out_dir, sheet, unsandboxed=unsandboxed,
                                   refused=entry.get('refused'))
+    # Which node graded it (a lost node's students are graded again elsewhere): in grade.json too.
+    record['graded_on'] = os.environ.get('SLURMD_NODENAME') or socket.gethostname()
+    report.write_grade(os.path.join(out_dir, entry['student']), record)
     _write_json(os.path.join(os.path.dirname(manifest), 'results', '%d.json' % index), record)
     return record
 
@@ -200,7 +212,10 @@ class _Array(object):
     def submit(self, indices):
         argv = ['sbatch', '--parsable', '--job-name', self.name, '--array', array_spec(indices),
                 '--output', os.path.join(self.base, 'logs', '%A_%a.out'), '--time', str(TASK_MINUTES),
-                '--ntasks', '1', '--cpus-per-task', '1', '--chdir', self.base] + self.sbatch_args + [self.script]
+                '--ntasks', '1', '--cpus-per-task', '1', '--chdir', self.base,
+                # A task whose node is lost ends NODE_FAIL rather than being requeued by Slurm
+                # unseen: the retry below is the only one, counted and said.
+                '--no-requeue'] + self.sbatch_args + [self.script]
         code, out, err = _call(argv)
         if code != 0 or not out.strip():
             raise RuntimeError('sbatch refused the class\'s array job (exit %d): %s' % (code, (err or out).strip()))
@@ -282,7 +297,8 @@ class _Array(object):
             job = self.submit(retry)
             self.say('slurm: job %s: %d task(s) submitted again (%s)' % (job, len(retry), array_spec(retry)))
         graded = sum(1 for r in self.records if r is not None) - self.not_graded
-        return state_line(self.jobs, tasks, graded, self.not_graded, len(self.students))
+        again = sum(1 for n in self.attempts.values() if n > 1)
+        return state_line(self.jobs, tasks, graded, self.not_graded, len(self.students), again)
 
     def _ended_without_record(self, index, now):
         """Why the task is over without a record, or None while it may still be alive or its record on
@@ -332,9 +348,54 @@ def grade_class(class_path, out_dir, sheet=None, progress=None, unsandboxed=Fals
     for folder in ('results', 'logs'):
         os.makedirs(os.path.join(base, folder))
     say = progress.say if progress else (lambda line: None)
-    refused = {}  # students whose files the intake refused by their own bounds: their rows say why
-    students = runner.class_students(class_path, [], os.path.join(base, 'class'), refused, out=out_dir)
-    records = []
+    work_dirs, refused = [], {}  # refused: students whose files the intake refused by their own bounds
+    try:
+        students = runner.class_students(class_path, work_dirs, refused=refused, out=out_dir)
+        students, refused = shared_students(students, work_dirs, os.path.join(base, 'class'), refused)
+        records, array = _grade(students, refused, base, out_dir, sheet, progress, unsandboxed, sbatch_args,
+                                poll_s, timeout, say)
+    finally:
+        for work in work_dirs:
+            shutil.rmtree(work, ignore_errors=True)
+    report.write_csv(os.path.join(out_dir, 'grades.csv'), records)
+    if array is not None and array.not_graded:
+        shutil.rmtree(os.path.join(base, 'class'), ignore_errors=True)
+        say('slurm: the tasks\' output is kept in %s' % os.path.join(base, 'logs'))
+    else:
+        shutil.rmtree(base, ignore_errors=True)
+    return records
+
+
+def shared_students(students, work_dirs, shared, refused):
+    """The students as the nodes must see them. A folder class is read where it is (the class is on the
+    shared file system). An archive was unpacked by the intake's box in this host's temp folder (as a
+    local run does: a box's uid may not reach a private OUT): each student's folder is copied into
+    ``shared`` (under OUT), as an upload is staged for a box (links kept as links, never followed;
+    FIFOs and devices left out), the class's size already bounded by the intake's box. Returns the
+    students and ``refused`` (folder -> why the intake refused it) at the folders the nodes see."""
+    if not work_dirs:
+        return students, refused
+    os.makedirs(shared, mode=0o711, exist_ok=True)
+    copied, refused_there = [], {}
+    for index, (name, folder) in enumerate(students):
+        target = os.path.join(shared, str(index), os.path.basename(folder))
+        os.makedirs(os.path.dirname(target), mode=0o711)
+        if folder in refused:
+            # Refused by its own bounds: nothing of it is read again (its row says why).
+            os.makedirs(target, mode=0o711)
+            refused_there[target] = refused[folder]
+        else:
+            staging.stage_upload(folder, target, max_bytes=1 << 62, max_files=1 << 62)
+        copied.append((name, target))
+    for work in work_dirs:
+        shutil.rmtree(work, ignore_errors=True)
+    del work_dirs[:]
+    return copied, refused_there
+
+
+def _grade(students, refused, base, out_dir, sheet, progress, unsandboxed, sbatch_args, poll_s, timeout, say):
+    """The array of these students, followed to its end: ``(records, the array or None)``."""
+    records, array = [], None
     if students:
         runner.ensure_underlay(runner.default_underlay())  # here, once, rather than by the first tasks at once
         manifest = os.path.join(base, 'manifest.jsonl')
@@ -348,13 +409,7 @@ def grade_class(class_path, out_dir, sheet=None, progress=None, unsandboxed=Fals
             progress.begin([name for name, _ in students])
         array = _Array(students, base, script, job_name(out_dir), sbatch_args, sheet, out_dir, say, progress)
         records = _follow(array, poll_s, timeout, say)
-    report.write_csv(os.path.join(out_dir, 'grades.csv'), records)
-    if students and array.not_graded:
-        shutil.rmtree(os.path.join(base, 'class'), ignore_errors=True)
-        say('slurm: the tasks\' output is kept in %s' % os.path.join(base, 'logs'))
-    else:
-        shutil.rmtree(base, ignore_errors=True)
-    return records
+    return records, array
 
 
 def _follow(array, poll_s, timeout, say):
