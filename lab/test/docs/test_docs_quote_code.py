@@ -659,8 +659,10 @@ def slurm_problems(text=None):
     if slurm.state_line([job], tasks, int(done), 0, int(total)) != state:
         problems.append('not the engine\'s state line: %s' % state)
     said = quoted_output(r'`(could not grade: Slurm said: [^`]+)`', text)
-    fields = dict(zip(('JobState', 'ExitCode'), re.match(r'could not grade: Slurm said: (\w+), exit code ([\d:]+)$',
-                                                         said).groups()))
+    words = re.match(r'could not grade: Slurm said: (\w+)(?: on node ([\w.-]+))?, exit code ([\d:]+)$', said)
+    if words is None:
+        return problems + ['not the engine\'s reason: %s' % said]
+    fields = {'JobState': words.group(1), 'NodeList': words.group(2) or '(null)', 'ExitCode': words.group(3)}
     reason = runner.could_not_grade('x', 'altitude', 'Slurm said: %s' % slurm.slurm_said(fields))['status_reason']
     if reason != said:
         problems.append('not the engine\'s reason: %s (it says %s)' % (said, reason))
