@@ -170,7 +170,7 @@ def test_class_outputs(graded):
     assert any('made executable' in hint for hint in records['no_kelvin']['for_the_teacher'])
     assert any('KeyError' in hint for hint in records['crash_at_start']['for_the_teacher'])
     assert [r['status'] for r in rows] == [records[r['student']]['status'] for r in rows]
-    assert list(rows[0])[:3] == ['student', 'sheet', 'status']
+    assert list(rows[0])[:4] == ['student', 'participant', 'sheet', 'status']
 
 
 def test_what_the_teacher_reads_of_each_status(graded):
