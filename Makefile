@@ -7,14 +7,20 @@ SHELL := /bin/bash
 ENV := source tools/env.sh
 # `make test TESTS=run_tests_exam` runs one catkin test target instead of all of them.
 TESTS ?= run_tests
+# make test-unit: every package's pytest unit tests (catkin names them run_tests_<package>_pytest_unit;
+# each package folder is named as its package, but lab/ holds exam_lab) and lab's docs checks.
+UNIT_TESTS := run_tests_exam_lab_pytest_unit run_tests_exam_lab_pytest_docs \
+	$(patsubst %/test/unit,run_tests_%_pytest_unit,$(filter-out lab/test/unit,$(wildcard */test/unit)))
 
-.PHONY: help deps build run run-submarine run-simple test report bench soak mutation grade rescore worksheet check clean
+.PHONY: help deps build run run-submarine run-simple test test-unit test-grader report bench soak mutation grade rescore worksheet check clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
 	@echo "make run-submarine  the same with the underwater drone"
 	@echo "make run-simple [SHEET=altitude|depth]  the simple answer of docs/report.md, built on its own"
 	@echo "make test           install, build, and run every unit and rostest test"
+	@echo "make test-unit      the pytest unit and docs tests only (seconds, no ROS master)"
+	@echo "make test-grader    the grader's tests only (lab/test/grader: classes graded by running, root)"
 	@echo "make report         regenerate docs/ (command outputs, figures, PDF) from a live run"
 	@echo "make bench          benchmarks of the exam node against the naive baseline"
 	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
@@ -49,6 +55,12 @@ run-simple: deps
 
 test: build
 	@tools/run_tests.sh $(TESTS)
+
+test-unit: build
+	@tools/run_tests.sh $(UNIT_TESTS)
+
+test-grader: build
+	@tools/run_tests.sh run_tests_exam_lab_pytest_grader
 
 report: build
 	@lab/report/report.sh

@@ -1,21 +1,22 @@
-"""The judge's time, master and CPU are its own (issue 26 points 2 and 3): one class run, ``JOBS=2``.
+"""The judge's time, master and CPU are its own (issue 26 points 2 and 3), read from the session's one
+hostile class (conftest.py ``hostile_class``, hostile_run.py: graded once with ``JOBS=2``).
 
-The class: ``a_burner`` (140 busy processes, each ``setsid``, for 60 s while it builds), ``b_good`` (the
-good student's package, graded beside the burner: it keeps its 17 points and its node comes up in a
-few seconds), ``c_clock`` (sets ``/use_sim_time`` and publishes a ``/clock`` 5/7 as fast as the wall's,
-so its node warns 7 s late while a grader on that clock sees 5 s: refused, a hand grade), and
-``d_param_flood`` (ten ``setParam`` calls of 64 MB: the master stays within its memory bound, the run is
-refused and the class goes on), ``e_hooked`` (a launch file roslaunch refuses, and a catkin environment
-hook that answers for roslaunch's check when the student's workspace is sourced for it: issue 36 point
-4), ``f_respawner`` (a chatty node that dies once, started again by roslaunch's ``respawn``: its death
-lies in the middle of the launch log the grader cuts; issue 36 point 4). All but ``a_burner`` run the
-good student's node beside their payload (copied in here). Payloads in lab/test/grader/hostile/, doing
-nothing as root. About 4 minutes on two cores; and one submission, ``sleeper``, graded alone with a
+This module's students of that class: ``a_burner`` (140 busy processes, each ``setsid``, for 60 s while
+it builds), ``b_victim`` (the good student's package, graded beside the burner, the first two of the
+class starting together: it keeps its 17 points and its node comes up in a few seconds), ``g_clock``
+(sets ``/use_sim_time`` and publishes a ``/clock`` 5/7 as fast as the wall's, so its node warns 7 s late
+while a grader on that clock sees 5 s: refused, a hand grade), and ``h_param_flood`` (ten ``setParam``
+calls of 64 MB: the master stays within its memory bound, the run is refused and the class goes on).
+``l_hooked`` (a launch file roslaunch refuses, and a catkin environment hook that answers for roslaunch's
+check when the student's workspace is sourced for it: issue 36 point 4), ``m_respawner`` (a chatty node
+that dies once, started again by roslaunch's ``respawn``: its death lies in the middle of the launch log
+the grader cuts; issue 36 point 4). All but ``a_burner`` run the good student's node beside their
+payload. Payloads in
+lab/test/grader/hostile/, doing nothing as root. And one submission, ``sleeper``, graded alone with a
 budget of BUDGET_S (issue 36 point 6), a minute of sleep.
 """
 import json
 import os
-import shutil
 import time
 
 import pytest
@@ -24,16 +25,10 @@ from exam_lab.grader import runner
 from exam_lab.grader.host import limits, session, uids
 from exam_lab.grader.score import rubric
 from exam_lab.grader.score.sheets import ITEMS
+from hostile_run import HOSTILE, NAMES, VICTIM_NAME
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-HOSTILE = os.path.join(HERE, 'hostile')
-GOOD = os.path.join(HERE, 'submissions', 'good_student', 'exam')
 FULL = {item: points for item, (points, _) in ITEMS.items()}
-CLASS = [('a_burner', os.path.join(HOSTILE, 'burner', 'exam')), ('b_good', GOOD),
-         ('c_clock', os.path.join(HOSTILE, 'clock', 'exam')), ('d_param_flood', os.path.join(HOSTILE, 'param_flood', 'exam')),
-         ('e_hooked', os.path.join(HOSTILE, 'hooked', 'exam')), ('f_respawner', os.path.join(HOSTILE, 'respawner', 'exam'))]
-#: The good student's node beside the payload of these.
-WITH_GOOD_NODE = ('c_clock', 'd_param_flood', 'e_hooked', 'f_respawner')
+BURNER, CLOCK, PARAM_FLOOD, HOOKED, RESPAWNER = 'a_burner', 'g_clock', 'h_param_flood', 'l_hooked', 'm_respawner'
 #: The budget the sleeper is graded with (its build sleeps 120 s).
 BUDGET_S = 45.0
 #: The most seconds the good student's node may take to register beside the burner (it took 15.9 s of
@@ -41,21 +36,9 @@ BUDGET_S = 45.0
 NODE_UP_S = 10.0
 
 
-@pytest.fixture(scope='module')
-def judged_class(tmp_path_factory):
-    if os.geteuid() != 0:
-        pytest.skip('the sandbox is made by root (docs/grading.md, "Isolation")')
-    root = tmp_path_factory.mktemp('judge')
-    klass = root / 'class'
-    for name, package in CLASS:
-        target = klass / name / 'exam'
-        shutil.copytree(package, str(target), ignore=shutil.ignore_patterns('__pycache__'))
-        if name in WITH_GOOD_NODE:
-            os.makedirs(str(target / 'scripts'), exist_ok=True)
-            shutil.copy2(os.path.join(GOOD, 'scripts', 'exam_node.py'), str(target / 'scripts' / 'exam_node.py'))
-    out = root / 'out'
-    records = {r['student']: r for r in runner.grade_class(str(klass), str(out), jobs=2)}
-    yield {'out': str(out), 'records': records}
+@pytest.fixture
+def judged_class(hostile_class):
+    return hostile_class
 
 
 def logs_of(judged_class, student, name):
@@ -73,16 +56,16 @@ def evidence(record):
 
 
 def test_the_classmate_of_a_burner_keeps_its_points_and_its_timing(judged_class):
-    assert 'burner: 140 processes burning' in logs_of(judged_class, 'a_burner', 'build.log'), \
+    assert 'burner: 140 processes burning' in logs_of(judged_class, BURNER, 'build.log'), \
         'the burner did not burn: this test proves nothing'
-    record = judged_class['records']['b_good']
+    record = judged_class['records'][VICTIM_NAME]
     assert {i['id']: i['points'] for i in record['items']} == FULL, evidence(record)
-    main = json.loads(logs_of(judged_class, 'b_good', 'probe-main.json'))
+    main = json.loads(logs_of(judged_class, VICTIM_NAME, 'probe-main.json'))
     assert main['node_seen_s'] is not None and main['node_seen_s'] < NODE_UP_S, main['node_seen_s']
 
 
 def test_a_node_on_a_clock_of_its_own_is_refused(judged_class):
-    record = judged_class['records']['c_clock']
+    record = judged_class['records'][CLOCK]
     assert record['total'] < 17.0, evidence(record)
     assert record['status'] == rubric.HAND_GRADE, evidence(record)
     assert '/use_sim_time was set' in record['status_reason'] and '/clock was published' in record['status_reason'], \
@@ -91,23 +74,23 @@ def test_a_node_on_a_clock_of_its_own_is_refused(judged_class):
 
 def test_a_parameter_flood_stays_within_the_masters_bound(judged_class):
     with open(os.path.join(judged_class['out'], 'grades.csv')) as f:
-        assert sorted(row.split(',')[0] for row in f.read().splitlines()[1:]) == [name for name, _ in CLASS]
-    record = judged_class['records']['d_param_flood']
+        assert sorted(row.split(',')[0] for row in f.read().splitlines()[1:]) == NAMES
+    record = judged_class['records'][PARAM_FLOOD]
     assert record['status'] == rubric.HAND_GRADE and 'memory bound' in record['status_reason'], evidence(record)
-    master = session_of(judged_class, 'd_param_flood')['runs'][0]['master']
+    master = session_of(judged_class, PARAM_FLOOD)['runs'][0]['master']
     assert master['memory']['limit'] == limits.MASTER_MEMORY_BYTES, master
     assert master['memory']['peak'] <= limits.MASTER_MEMORY_BYTES and master['memory']['oom_kills'] >= 1, master
 
 
 def test_the_judge_is_neither_root_nor_the_box(judged_class):
-    for student in ('b_good', 'c_clock'):
+    for student in (VICTIM_NAME, CLOCK):
         runs = session_of(judged_class, student)['runs']
         assert runs, student
         for run in runs:
             judge = run['master']['uid']
             assert uids.JUDGE_UID_BASE <= judge < uids.JUDGE_UID_BASE + uids.SLOTS, (student, run['master'])
             assert run['probe_uid'] == judge, (student, run['probe_uid'], judge)
-    probe = json.loads(logs_of(judged_class, 'b_good', 'probe-main.json'))
+    probe = json.loads(logs_of(judged_class, VICTIM_NAME, 'probe-main.json'))
     assert probe['judge_uid'] >= uids.JUDGE_UID_BASE and probe['clock']['ros_time_is_wall'] is True
 
 
@@ -126,9 +109,9 @@ def test_an_environment_hook_cannot_answer_for_roslaunch(judged_class):
     """Its launch file names two nodes /exam: roslaunch refuses it, whatever the hook (sourced with the
     student's workspace) would have said; Q12 is lost and the teacher told. The run itself, without the
     drone's node, keeps every other point."""
-    check = session_of(judged_class, 'e_hooked')['launch_check']
+    check = session_of(judged_class, HOOKED)['launch_check']
     assert check['status'] == 1 and 'multiple nodes named [/exam]' in check['refused'], check
-    record = judged_class['records']['e_hooked']
+    record = judged_class['records'][HOOKED]
     assert points_of(record) == dict(FULL, Q12=0.0), evidence(record)
     assert [d for d in record['doubts'] if 'roslaunch refuses' in d], record['doubts']
 
@@ -136,12 +119,12 @@ def test_an_environment_hook_cannot_answer_for_roslaunch(judged_class):
 def test_a_death_lost_in_the_cut_log_is_seen_by_the_judge(judged_class):
     """The chatter's death and respawn: roslaunch's words lie in the middle cut from the log, the probe's
     watch saw its pid change; it costs the runs point and a hand grade, like any death."""
-    assert 'bytes cut by the grader' in logs_of(judged_class, 'f_respawner', 'launch-main.log'), \
+    assert 'bytes cut by the grader' in logs_of(judged_class, RESPAWNER, 'launch-main.log'), \
         'the chatter did not fill the log: this test proves nothing'
-    main = session_of(judged_class, 'f_respawner')['runs'][0]
+    main = session_of(judged_class, RESPAWNER)['runs'][0]
     watched = [e for e in main['launch']['ended'] if e['detail'].startswith('seen by the judge')]
     assert [e['node'] for e in watched] == ['/chatter'], main['launch']['ended']
-    record = judged_class['records']['f_respawner']
+    record = judged_class['records'][RESPAWNER]
     assert points_of(record)['runs'] == 1.0 and record['status'] == rubric.HAND_GRADE, evidence(record)
     assert 'died' in record['status_reason'], record['status_reason']
 

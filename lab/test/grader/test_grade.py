@@ -101,13 +101,14 @@ def refused_zip(source, path):
         zf.writestr('../outside.txt', 'x')
 
 
-@pytest.fixture(scope='module')
-def graded(tmp_path_factory):
-    """Grade the whole class once: the fixture packages, ours (its sheet detected: altitude)."""
-    root = tmp_path_factory.mktemp('grader')
+def grade_main_class(root):
+    """Grade the whole class once in ``root`` (a pathlib.Path): the fixture packages, ours (its sheet
+    detected: altitude), each in a Moodle folder of its own participant number; return ``(OUT, [records],
+    the class folder)``. Run once a session by conftest.py's ``main_class``, which also writes its desk
+    (the page, the feedback zip) for test_page_browser."""
     klass = root / 'class'
-    for name in EXPECTED:
-        folder = klass / ('%s_%d_assignsubmission_file_' % (name, len(name)))
+    for index, name in enumerate(EXPECTED):
+        folder = klass / ('%s_%d_assignsubmission_file_' % (name, 101 + index))
         folder.mkdir(parents=True)
         source = OUR_EXAM if name == 'ours' else os.path.join(SUBMISSIONS, MADE_FROM.get(name, name), 'exam')
         if name == 'windows_zip':
@@ -119,7 +120,7 @@ def graded(tmp_path_factory):
         elif name == 'renamed_package':
             shutil.copytree(os.path.join(SUBMISSIONS, name, 'exam_pkg'), str(folder / 'exam_pkg'))
         elif name == 'good_student':  # uploaded as a zip, next to the report
-            (folder / 'report.pdf').write_bytes(b'%PDF-1.4\n')
+            two_page_pdf(str(folder / 'report.pdf'))
             with zipfile.ZipFile(str(folder / 'exam.zip'), 'w') as zf:
                 for dirpath, _, filenames in os.walk(source):
                     for filename in filenames:
@@ -131,7 +132,27 @@ def graded(tmp_path_factory):
     out = root / 'out'
     # The default JOBS (two per core): what a teacher's class run uses, held to the same points here.
     records = runner.grade_class(str(klass), str(out), jobs=runner.default_jobs())
-    return out, {r['student']: r for r in records}
+    return out, records, klass
+
+
+@pytest.fixture
+def graded(main_class):
+    """The main class (conftest.py ``main_class``): ``(OUT, {student: record})``."""
+    return main_class['out'], main_class['by_name']
+
+
+def two_page_pdf(path):
+    """A real PDF of two pages (the page says "report.pdf (2 pages)")."""
+    import matplotlib
+    matplotlib.use('Agg')
+    from matplotlib import pyplot as plt
+    from matplotlib.backends.backend_pdf import PdfPages
+    with PdfPages(path) as pdf:
+        for page in (1, 2):
+            figure = plt.figure()
+            figure.text(0.4, 0.5, 'page %d' % page)
+            pdf.savefig(figure)
+            plt.close(figure)
 
 
 def assert_graded(record, lost, status):

@@ -1,18 +1,20 @@
-"""The grader's sandbox against hostile students (issue 16): one class run with ``JOBS=2``.
+"""The grader's sandbox against hostile students (issue 16), read from the session's one hostile class
+(conftest.py ``hostile_class``, hostile_run.py: graded once with ``JOBS=2`` for this module and the
+three test_boundary_* ones).
 
-The class: ``a_saboteur`` (kills, reads and writes its classmate graded beside it), ``b_victim`` (the
-good student's package: it must keep its 17 points), ``c_forger`` (an idle node that writes a real
-probe result where the grader used to read its own), ``d_escapee`` (prints its environment and a
-root-only file, leaves links and a FIFO where the grader copies logs from, starts detached children at
-build and run time), ``e_snoop`` (no code: its launch file includes a root-only launch file whose node
-and parameter names carry a secret; issue 26 point 1). Their payloads live in lab/test/grader/hostile/
-and do nothing as root. About 2 minutes on two cores; the copy and refusal checks need no ROS.
+This module's students of that class: ``c_saboteur`` (kills, reads and writes the classmates graded
+beside it), ``b_victim`` (the good student's package: it must keep its 17 points), ``d_forger`` (an idle
+node that writes a real probe result where the grader used to read its own), ``e_escapee`` (prints its
+environment and a root-only file, leaves links and a FIFO where the grader copies logs from, starts
+detached children at build and run time), ``f_snoop`` (no code: its launch file includes a root-only
+launch file whose node and parameter names carry a secret; issue 26 point 1). Their payloads live in
+lab/test/grader/hostile/ and do nothing as root. A new hostile student of this kind: a line in
+hostile_run.CLASS and its name in STUDENTS below. The copy and refusal checks need no ROS.
 """
 import json
 import os
 import secrets
 import shutil
-import signal
 import subprocess
 import tempfile
 import time
@@ -24,127 +26,57 @@ from exam_lab.grader import runner
 from exam_lab.grader.host import egress, limits, sandbox, staging, uids
 from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
+from hostile_run import GOOD as VICTIM, HOSTILE, NAMES, SECRET_DIR, VICTIM_NAME, files_under, write_secrets
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-HOSTILE = os.path.join(HERE, 'hostile')
-VICTIM = os.path.join(HERE, 'submissions', 'good_student', 'exam')
 FULL = {item: points for item, (points, _) in ITEMS.items()}
-#: Where the escapee looks for the root-only file (its payload names it).
-SECRET_DIR = '/tmp/exam-hostile-secret'
-#: In the command line of the escapee's detached children.
-DETACHED = 'exam-hostile-detached'
-CLASS = [('a_saboteur', os.path.join(HOSTILE, 'saboteur', 'exam')), ('b_victim', VICTIM),
-         ('c_forger', os.path.join(HOSTILE, 'forger', 'exam')), ('d_escapee', os.path.join(HOSTILE, 'escapee', 'exam')),
-         ('e_snoop', os.path.join(HOSTILE, 'snoop', 'exam'))]
-#: The root-only launch file the snoop includes (its launch file names it).
-SECRET_LAUNCH = os.path.join(SECRET_DIR, 'secret.launch')
-
-
-def write_secrets(token):
-    """SECRET_DIR (readable) with secret.txt and secret.launch (root's, mode 600), each carrying ``token``."""
-    shutil.rmtree(SECRET_DIR, ignore_errors=True)
-    os.makedirs(SECRET_DIR)
-    os.chmod(SECRET_DIR, 0o755)
-    for path, text in ((os.path.join(SECRET_DIR, 'secret.txt'), token),
-                       (SECRET_LAUNCH, '<launch><node pkg="exam" type="exam_node_%s.py" name="exam">'
-                                       '<param name="threshold_%s" value="1300"/></node></launch>\n' % (token, token))):
-        with open(os.open(path, os.O_WRONLY | os.O_CREAT, 0o600), 'w') as f:
-            f.write(text)
-
-
-def detached_children():
-    found = []
-    for entry in os.listdir('/proc'):
-        try:
-            with open('/proc/%s/cmdline' % entry, 'rb') as f:
-                if DETACHED.encode() in f.read():
-                    found.append(int(entry))
-        except (OSError, ValueError):
-            continue
-    return [pid for pid in found if pid != os.getpid()]
-
-
-def files_under(folder):
-    for dirpath, _, filenames in os.walk(folder):
-        for name in filenames:
-            path = os.path.join(dirpath, name)
-            if os.path.isfile(path) and not os.path.islink(path):
-                with open(path, 'rb') as f:
-                    yield path, f.read().decode('utf-8', 'replace')
-
-
-@pytest.fixture(scope='module')
-def hostile_class(tmp_path_factory):
-    """Grade the class once, a secret file (root, mode 600) and a secret variable of the grader in
-    place; note the escapee's detached children still alive right after; clean everything up."""
-    if os.geteuid() != 0:
-        pytest.skip('the sandbox is made by root (docs/grading.md, "Isolation")')
-    root = tmp_path_factory.mktemp('hostile')
-    klass = root / 'class'
-    for name, package in CLASS:
-        shutil.copytree(package, str(klass / name / 'exam'), ignore=shutil.ignore_patterns('__pycache__'))
-    secret_file = 'root-only-%s' % secrets.token_hex(8)
-    write_secrets(secret_file)
-    secret_var = 'grader-env-%s' % secrets.token_hex(8)
-    saved = {k: os.environ.get(k) for k in ('EXAM_HOSTILE_SECRET', 'EXAM_HOSTILE_CLASS')}
-    os.environ.update(EXAM_HOSTILE_SECRET=secret_var, EXAM_HOSTILE_CLASS='1')
-    out = root / 'out'
-    try:
-        try:
-            records, error = {r['student']: r for r in runner.grade_class(str(klass), str(out), jobs=2)}, None
-        except Exception as err:  # today's grader: one student's links stop the class
-            records, error = {}, err
-        survivors = detached_children()
-        yield {'out': str(out), 'records': records, 'error': error, 'survivors': survivors,
-               'secrets': (secret_file, secret_var)}
-    finally:
-        for pid in detached_children():
-            try:
-                os.kill(pid, signal.SIGKILL)
-            except OSError:
-                pass
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
-        shutil.rmtree(SECRET_DIR, ignore_errors=True)
+#: This module's students of the hostile class (the saboteur's victim is the class's one victim).
+SABOTEUR, FORGER, ESCAPEE, SNOOP = 'c_saboteur', 'd_forger', 'e_escapee', 'f_snoop'
+STUDENTS = (SABOTEUR, VICTIM_NAME, FORGER, ESCAPEE, SNOOP)
 
 
 def test_links_and_fifos_do_not_stop_the_class(hostile_class):
-    assert hostile_class['error'] is None, repr(hostile_class['error'])
+    assert hostile_class['finished'], hostile_class['output']
     with open(os.path.join(hostile_class['out'], 'grades.csv')) as f:
         rows = f.read().splitlines()[1:]
-    assert sorted(row.split(',')[0] for row in rows) == [name for name, _ in CLASS]
+    assert sorted(row.split(',')[0] for row in rows) == NAMES
 
 
 def test_every_student_runs_in_a_box_of_its_own(hostile_class):
-    boxes = []
-    for name, record in sorted(hostile_class['records'].items()):
-        if name == 'e_snoop':
+    """Each of its own box's uid; the class's first two, which start together (JOBS=2), two uids (the
+    others start as a slot frees: one may take the uid of a classmate already done)."""
+    boxes = {}
+    for name in sorted(set(STUDENTS) | set(NAMES[:2])):
+        if name == SNOOP:
             continue  # no code: nothing of it runs (its upload is read in a box: test_a_snoop_reads_nothing_root_can)
+        record = hostile_class['records'][name]
         ran = [hint for hint in record['for_the_teacher'] if hint.startswith('ran ') and ' as ' in hint]
         assert len(ran) == 1 and ran[0].startswith('ran in a bubblewrap sandbox as uid '), (name, ran)
-        boxes.append(int(ran[0].split('as uid ')[1].split(':')[0]))
-    assert boxes[0] != boxes[1], 'the saboteur and its classmate, graded side by side, share a uid'
-    assert all(uid >= uids.BOX_UID_BASE for uid in boxes)
+        boxes[name] = int(ran[0].split('as uid ')[1].split(':')[0])
+    assert boxes[NAMES[0]] != boxes[NAMES[1]], 'two students graded side by side share a uid'
+    assert all(uid >= uids.BOX_UID_BASE for uid in boxes.values())
 
 
 def test_the_classmate_of_a_saboteur_keeps_its_points(hostile_class):
-    record = hostile_class['records']['b_victim']
+    """The victim keeps its points; no classmate's file says HACKED (the saboteur writes into every
+    classmate's logs it can reach: whoever is graded beside it); the saboteur read no code of the good
+    student (the victim's, and that of the classmates running its node) and killed nothing."""
+    record = hostile_class['records'][VICTIM_NAME]
     got = {i['id']: i['points'] for i in record['items']}
     assert got == FULL, '\n'.join('%s: %s' % (i['id'], i['evidence']) for i in record['items'])
-    victim_files = dict(files_under(os.path.join(hostile_class['out'], 'b_victim')))
+    victim_files = dict(files_under(os.path.join(hostile_class['out'], VICTIM_NAME)))
     assert not [p for p, text in victim_files.items() if 'HACKED' in text]
+    for name in NAMES:
+        if name != SABOTEUR:
+            assert not [p for p, text in files_under(os.path.join(hostile_class['out'], name)) if 'HACKED' in text], name
     with open(os.path.join(VICTIM, 'scripts', 'exam_node.py')) as f:
         victim_line = f.read().splitlines()[2]
-    saboteur_files = dict(files_under(os.path.join(hostile_class['out'], 'a_saboteur')))
+    saboteur_files = dict(files_under(os.path.join(hostile_class['out'], SABOTEUR)))
     assert not [p for p, text in saboteur_files.items() if victim_line in text]
     assert not [p for p, text in saboteur_files.items() if 'KILLED' in text]
 
 
 def test_a_forged_probe_file_changes_nothing(hostile_class):
-    record = hostile_class['records']['c_forger']
+    record = hostile_class['records'][FORGER]
     got = {i['id']: i['points'] for i in record['items']}
     assert got['Q11'] == 0.0 and got['Q13'] == 0.0 and got['Q14b'] == 0.0, got
     assert record['total'] <= 3.0
@@ -159,10 +91,10 @@ def test_no_detached_child_survives(hostile_class):
 
 
 def test_secrets_never_reach_the_results(hostile_class):
-    escapee = hostile_class['records']['d_escapee']
+    escapee = hostile_class['records'][ESCAPEE]
     assert escapee['items'][0]['points'] >= 1.0, 'the escapee built: its payload ran'
     for path, text in files_under(hostile_class['out']):
-        for secret in hostile_class['secrets']:
+        for secret in hostile_class['sandbox_secrets']:
             assert secret not in text, path
 
 
@@ -175,7 +107,7 @@ def read_as(record):
 def test_a_snoop_reads_nothing_root_can(hostile_class):
     """Its include of a root-only launch file is not there for the box that reads it: no node, no
     parameter, nothing to run; the class went on around it."""
-    record = hostile_class['records']['e_snoop']
+    record = hostile_class['records'][SNOOP]
     assert [uid for uid in read_as(record) if uid >= uids.BOX_UID_BASE] == read_as(record) != []
     # Two walls, either enough: the analysis reads no file outside the package, and the box sees none.
     assert [h for h in record['for_the_teacher'] if 'include' in h and ('not found' in h or 'outside the package'

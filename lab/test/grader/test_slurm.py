@@ -280,9 +280,9 @@ class _Watch(object):
         return found
 
     def check_uids(self):
-        for pid, (_, comm, _, uids) in _node_processes(self.nodes).items():
-            if 0 in uids and comm not in ('slurmd', 'slurmstepd'):
-                self.as_root[pid] = (comm, uids)
+        for pid, (_, comm, _, owners) in _node_processes(self.nodes).items():
+            if 0 in owners and comm not in ('slurmd', 'slurmstepd'):
+                self.as_root[pid] = (comm, owners)
 
     def look(self):
         tasks = self.queue()

@@ -52,7 +52,7 @@ import rospy
 from rosgraph_msgs.msg import Clock
 from std_msgs import msg as std_msgs
 
-from exam_lab.grader.score.sheets import LATE_WARNING_S, request_meaning
+from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness import oracle
 from exam_lab.harness.fake_drone import Drone, TopicRecorder
 from exam_lab.harness.wait import wait_until

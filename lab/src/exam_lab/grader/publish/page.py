@@ -7,7 +7,6 @@ check flagged, then one section per student with its flight plot, its documents 
 listed, not graded) and its grade.md.
 """
 import html
-import os
 import re
 
 from exam_lab.grader.publish import report
