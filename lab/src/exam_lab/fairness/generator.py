@@ -169,13 +169,18 @@ def answers(correct=40, seed=0):
 
 def sample(count=10, seed=0, correct_share=0.5):
     """``count`` answers drawn from the matrix (seeded): about ``correct_share`` correct, the rest
-    one-mistake, both sheets."""
+    one-mistake, each kind taken from both sheets in turn."""
     everything = answers(seed=seed)
     rng = random.Random(seed + 2)
-    right = [a for a in everything if a.mistake is None]
-    wrong = [a for a in everything if a.mistake is not None]
     n_right = int(round(count * correct_share))
-    drawn = rng.sample(right, n_right) + rng.sample(wrong, count - n_right)
+    drawn = []
+    for wanted, mistaken in ((n_right, False), (count - n_right, True)):
+        by_sheet = [[a for a in everything if (a.mistake is not None) == mistaken and a.style.sheet == sheet]
+                    for sheet in SHEETS]
+        for answers_of_sheet in by_sheet:
+            rng.shuffle(answers_of_sheet)
+        turns = itertools.chain.from_iterable(zip(*by_sheet))
+        drawn += list(itertools.islice(turns, wanted))
     return sorted(drawn, key=lambda a: a.name)
 
 
