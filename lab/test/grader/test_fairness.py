@@ -4,8 +4,9 @@ both sheets) graded in ONE class run at the default JOBS, each held to what it m
 answer 17/17 "graded", a one-mistake answer its rule's loss only, or flagged for the teacher.
 
 GRADED_WRONG_TODAY names the drawn answers the judge grades wrong on the code this test was written
-against (the whole matrix's table: docs/grading.md, "Generated answers"): each is a strict xfail, so
-the test fails as soon as the judge grades it right too, and the entry must then go. About 5 minutes.
+against (the whole matrix's table: docs/grading.md, "Generated answers"): an xfail each, strict where
+the judge is wrong every time (the test then fails as soon as the judge grades it right, and the entry
+must go), not strict where today's grade sits at a tolerance's edge. About 5 minutes.
 """
 import pytest
 
@@ -14,9 +15,22 @@ from exam_lab.grader import runner
 
 SAMPLE = generator.sample(10)
 
-#: Answer -> how the judge grades it wrong today (from `make fairness` on that code); empty once the
-#: judge is fair to every drawn answer.
-GRADED_WRONG_TODAY = {}
+#: Answer -> how the judge grades it wrong today (from `make fairness` on the grader of bdee478, the
+#: table in docs/grading.md) and whether it is wrong every time (strict) or at a tolerance's edge (the
+#: judge times from its inputs: a synchronised or two-node answer's WARNING lands at 5.50-5.6 s against
+#: a window ending at 5.5, its NORMAL at 0.50 s against 0.5). Empty once the judge is fair to them all.
+GRADED_WRONG_TODAY = {
+    'c23-alt-glob-timer-ticks-cache-args-1node': (True, 'args= threshold: "no parameter of the launch file looks '
+                                                        'like a threshold", Q14a 0'),
+    'c34-alt-glob-rate-counts-cache-priv-1node': (True, '10 readings of /pressure at the real drone\'s 2 Hz: the '
+                                                        'judge\'s drone publishes faster, WARNING at 1.8 s, Q14b 0'),
+    'c28-dep-dict-rate-ticks-sync-glob-1node': (False, 'synchronised inputs: NORMAL 0.50 s after the input went '
+                                                       'back (the node waits for a pair), Q14b 2.5'),
+    'c40-alt-glob-rate-ticks-sync-priv-1node': (False, 'synchronised inputs: WARNING 5.51 s after the input, '
+                                                       'NORMAL 0.50 s, Q14b 1'),
+    'm01-everycycle-alt-dict-rate-ticks-sync-glob-2nodes': (False, 'its base (two nodes, synchronised): WARNING '
+                                                                   '5.59 s after the input, Q14b 1.5 lost as well'),
+}
 
 
 @pytest.fixture(scope='module')
@@ -29,8 +43,10 @@ def graded(tmp_path_factory):
 
 def _cases():
     for answer in SAMPLE:
-        marks = [pytest.mark.xfail(strict=True, reason=GRADED_WRONG_TODAY[answer.name])] \
-            if answer.name in GRADED_WRONG_TODAY else []
+        marks = []
+        if answer.name in GRADED_WRONG_TODAY:
+            strict, reason = GRADED_WRONG_TODAY[answer.name]
+            marks = [pytest.mark.xfail(strict=strict, reason=reason)]
         yield pytest.param(answer, id=answer.name, marks=marks)
 
 

@@ -50,13 +50,21 @@ def test_the_matrix_holds_enough_answers_of_both_sheets():
     assert len(right) >= 40 and len(wrong) >= 15
     assert set(a.style.sheet for a in right) == set(a.style.sheet for a in wrong) == set(SHEETS)
     assert len(set(a.name for a in ANSWERS)) == len(ANSWERS)
-    assert [a.mistake for a in wrong] == list(generator.MISTAKES)
+    assert [a.mistake for a in wrong] == [m for m in generator.MISTAKES for _ in range(2)]
+    # one of each pair is the sheet's own answer (as close as the mistake allows), the other drawn
+    assert all(generator.reference_style(a.style.sheet, a.mistake) == a.style for a in wrong[::2])
+    assert [a.style for a in wrong[::2]] != [a.style for a in wrong[1::2]]
     for answer in wrong:
         assert generator._fits(answer.style, answer.mistake), answer.name
         if answer.expected != generator.FLAGGED:
-            assert answer.expected and all(0 <= p < ITEMS[i][0] for i, p in answer.expected.items()), answer.name
+            assert answer.expected and all(0 <= min(p if isinstance(p, tuple) else (p,)) <=
+                                           max(p if isinstance(p, tuple) else (p,)) < ITEMS[i][0]
+                                           for i, p in answer.expected.items()), answer.name
     drawn = generator.sample(10)
-    assert len(drawn) == 10 and 0 < len([a for a in drawn if a.mistake]) < 10
+    mistakes = [a.mistake for a in drawn if a.mistake]
+    assert len(drawn) == 10 and len(mistakes) == 5 and len(set(mistakes)) == 5
+    assert set(a.style.sheet for a in drawn if a.mistake) == set(a.style.sheet for a in drawn if not a.mistake) \
+        == set(SHEETS)
 
 
 def _record(points, status='graded'):
@@ -78,6 +86,10 @@ def test_the_verdict_holds_a_grade_to_what_the_answer_must_get():
     assert not generator.verdict(cycle, _record({}))[0]
     assert generator.verdict(cycle, _record({'Q13': 0.0}, 'needs a hand grade'))[0]
     assert generator.verdict(never, _record({'Q13': 0.0}, 'needs a hand grade'))[0]
+    reset = next(a for a in ANSWERS if a.mistake == 'no_reset')  # a range: 0 to 1.5 of 14b's 3
+    assert generator.verdict(reset, _record({'Q14b': 0.0}))[0] and generator.verdict(reset, _record({'Q14b': 1.5}))[0]
+    fair, how = generator.verdict(reset, _record({'Q14b': 2.0}))
+    assert not fair and 'Q14b 2/3 (wanted 0-1.5)' in how
     assert not generator.verdict(never, _record({'Q13': 0.0, 'Q14b': 0.0}))[0]
 
 

@@ -64,7 +64,8 @@ Style = collections.namedtuple('Style', list(AXES))
 Answer = collections.namedtuple('Answer', 'name style mistake expected')
 
 #: What one mistake is: the rule it breaks, in words; the points the items must get then (FLAGGED: a
-#: hand grade); the sheets it applies to; and what the correct answer it is made from must be.
+#: hand grade; ``(low, high)``: any points in that range); the sheets it applies to; and what the
+#: correct answer it is made from must be.
 Mistake = collections.namedtuple('Mistake', 'words expected sheets needs')
 
 _COUNTER = {'delay': ('ticks', 'counts')}
@@ -80,8 +81,10 @@ MISTAKES = collections.OrderedDict([
                          _COUNTER)),
     ('short_delay', Mistake('the delay 5 s less one input period (4.5 s: 9 readings at 2 Hz)', {'Q14b': 1.5},
                             ('altitude', 'depth'), {'delay': ('counts',), 'inputs': ('cache',), 'nodes': ('one',)})),
-    ('no_reset', Mistake('the counter not reset below the threshold', {'Q14b': 1.5}, ('altitude', 'depth'),
-                         _COUNTER)),
+    # How much of 14b it keeps depends on how long the flight kept it above before the long excursion
+    # (the short one, a calibration): it loses the short excursion's point at least, the delay's maybe.
+    ('no_reset', Mistake('the counter not reset below the threshold', {'Q14b': (0.0, 1.5)},
+                         ('altitude', 'depth'), _COUNTER)),
     ('margin', Mistake('NORMAL only once 5 % below the threshold, not at once', {'Q14b': 2.5},
                        ('altitude', 'depth'), _COUNTER)),
     ('normal_delayed', Mistake('NORMAL also after 5 s below, not at once', {'Q14b': 2.5}, ('altitude', 'depth'),
@@ -147,29 +150,55 @@ def _fits(style, mistake):
     return style.sheet in spec.sheets and all(getattr(style, axis) in values for axis, values in spec.needs.items())
 
 
+#: The sheet's own answer (its grader's notes: global variables, a ``rospy.Rate(10)`` loop counting
+#: cycles, the cached readings, ``<param name="threshold">`` at the top of the launch file, one node).
+REFERENCE = {'state': 'globals', 'loop': 'rate', 'delay': 'ticks', 'inputs': 'cache', 'threshold': 'global',
+             'nodes': 'one'}
+
+
+def reference_style(sheet, mistake):
+    """The sheet's own answer, changed only where the mistake needs another style (the first value it
+    allows), and then, if that makes no answer (loop ticks without a loop), in its delay."""
+    values = dict(REFERENCE, sheet=sheet)
+    for axis, allowed in MISTAKES[mistake].needs.items():
+        if values[axis] not in allowed:
+            values[axis] = allowed[0]
+    style = Style(**values)
+    for delay in AXES['delay']:
+        if valid(style) and _fits(style, mistake):
+            return style
+        style = style._replace(delay=delay)
+    return style
+
+
 def answers(correct=40, seed=0):
-    """The matrix: ``correct`` correct answers (a pairwise covering sample, both sheets) and one answer
-    per mistake of :data:`MISTAKES`, each made from a style of its sheet that fits it, both sheets in
-    turn where the mistake allows. Deterministic for a seed."""
+    """The matrix: ``correct`` correct answers (a pairwise covering sample, both sheets) and two
+    answers per mistake of :data:`MISTAKES`: one made from the sheet's own answer
+    (:func:`reference_style`), one from a correct answer of the sample that fits the mistake, drawn
+    (seeded), on the other sheet where the mistake allows. Deterministic for a seed."""
     styles = covering_sample(correct, seed)
     out = [Answer('c%02d-%s' % (n + 1, style_name(s)), s, None, {}) for n, s in enumerate(styles)]
     rng = random.Random(seed + 1)
     pool = _all_valid()
+    made = []
     for n, mistake in enumerate(MISTAKES):
         spec = MISTAKES[mistake]
         sheet = spec.sheets[n % len(spec.sheets)]
-        # made from a style of the sample where one fits (the variant of a graded correct answer)
-        fitting = [s for s in styles if s.sheet == sheet and _fits(s, mistake)] or \
-            [s for s in pool if s.sheet == sheet and _fits(s, mistake)]
-        base = rng.choice(fitting)
+        made.append((mistake, reference_style(sheet, mistake)))
+        other = spec.sheets[(n + 1) % len(spec.sheets)]
+        # the variant of a correct answer graded in the same run, where one fits
+        fitting = [s for s in styles if s.sheet == other and _fits(s, mistake) and s != made[-1][1]] or \
+            [s for s in pool if s.sheet == other and _fits(s, mistake) and s != made[-1][1]]
+        made.append((mistake, rng.choice(fitting)))
+    for n, (mistake, base) in enumerate(made):
         out.append(Answer('m%02d-%s-%s' % (n + 1, mistake.replace('_', ''), style_name(base)), base, mistake,
-                          spec.expected))
+                          MISTAKES[mistake].expected))
     return out
 
 
 def sample(count=10, seed=0, correct_share=0.5):
     """``count`` answers drawn from the matrix (seeded): about ``correct_share`` correct, the rest
-    one-mistake, each kind taken from both sheets in turn."""
+    one-mistake (each mistake once), each kind taken from both sheets in turn."""
     everything = answers(seed=seed)
     rng = random.Random(seed + 2)
     n_right = int(round(count * correct_share))
@@ -180,7 +209,14 @@ def sample(count=10, seed=0, correct_share=0.5):
         for answers_of_sheet in by_sheet:
             rng.shuffle(answers_of_sheet)
         turns = itertools.chain.from_iterable(zip(*by_sheet))
-        drawn += list(itertools.islice(turns, wanted))
+        taken, mistakes = [], set()
+        for answer in turns:  # each mistake once: as many rules as the count allows
+            if len(taken) == wanted:
+                break
+            if answer.mistake is None or answer.mistake not in mistakes:
+                taken.append(answer)
+                mistakes.add(answer.mistake)
+        drawn += taken
     return sorted(drawn, key=lambda a: a.name)
 
 
@@ -213,13 +249,24 @@ def verdict(answer, record):
         return True, 'flagged: %s' % record.get('status_reason', '')
     if wanted is None:
         return False, 'not flagged (%s), %s' % (status, _points_words(got))
-    diff = ['%s %g/%g (wanted %g)' % (item, got.get(item, 0.0), ITEMS[item][0], points)
-            for item, points in wanted.items() if got.get(item) != points]
+    diff = ['%s %g/%g (wanted %s)' % (item, got.get(item, 0.0), ITEMS[item][0], points_words(points))
+            for item, points in wanted.items() if not _within(got.get(item), points)]
     if answer.mistake is None and status != GRADED:
         diff.append('status "%s": %s' % (status, record.get('status_reason', '')))
     elif status not in (GRADED, 'graded with fixes'):
         diff.append('status "%s": %s' % (status, record.get('status_reason', '')))
     return (not diff), '; '.join(diff) if diff else 'as wanted'
+
+
+def _within(got, points):
+    if isinstance(points, tuple):
+        return got is not None and points[0] <= got <= points[1]
+    return got == points
+
+
+def points_words(points):
+    """``1.5``, or ``0-1.5`` for a range."""
+    return '%g-%g' % points if isinstance(points, tuple) else '%g' % points
 
 
 def _points_words(got):
