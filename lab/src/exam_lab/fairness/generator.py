@@ -172,12 +172,16 @@ def reference_style(sheet, mistake):
 
 
 def answers(correct=40, seed=0):
-    """The matrix: ``correct`` correct answers (a pairwise covering sample, both sheets) and two
-    answers per mistake of :data:`MISTAKES`: one made from the sheet's own answer
+    """The matrix: ``correct`` correct answers (a pairwise covering sample, both sheets), the sheet's own
+    answer of each sheet (:data:`REFERENCE`) unless the sample holds it, and two answers per mistake
+    of :data:`MISTAKES`: one made from the sheet's own answer
     (:func:`reference_style`), one from a correct answer of the sample that fits the mistake, drawn
     (seeded), on the other sheet where the mistake allows. Deterministic for a seed."""
     styles = covering_sample(correct, seed)
     out = [Answer('c%02d-%s' % (n + 1, style_name(s)), s, None, {}) for n, s in enumerate(styles)]
+    # the sheet's own answer of each sheet, correct, so its variants' other losses can be read
+    references = [s for s in (Style(**dict(REFERENCE, sheet=sheet)) for sheet in SHEETS) if s not in styles]
+    out += [Answer('r%02d-%s' % (n + 1, style_name(s)), s, None, {}) for n, s in enumerate(references)]
     rng = random.Random(seed + 1)
     pool = _all_valid()
     made = []
