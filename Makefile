@@ -12,7 +12,7 @@ TESTS ?= run_tests
 UNIT_TESTS := run_tests_exam_lab_pytest_unit run_tests_exam_lab_pytest_docs \
 	$(patsubst %/test/unit,run_tests_%_pytest_unit,$(filter-out lab/test/unit,$(wildcard */test/unit)))
 
-.PHONY: help deps build run run-submarine run-simple test test-unit test-grader report bench soak mutation grade rescore worksheet check clean
+.PHONY: help deps build run run-submarine run-simple test test-unit test-grader report bench soak mutation fairness grade rescore worksheet check clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
@@ -25,6 +25,8 @@ help:
 	@echo "make bench          benchmarks of the exam node against the naive baseline"
 	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
 	@echo "make mutation       mutation testing of the nodes' code against its tests (about 30 min)"
+	@echo "make fairness [JOBS=n] [OUT=<dir>]  the grader on generated student answers (40 correct, 36 one-mistake,"
+	@echo "                    both sheets) as one class; its report into docs/grading.md (about 30 min)"
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
 	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv> [WORKSHEET_SCALE=1]] [ENGINE=local|slurm] [SLURM_ARGS='...']"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
@@ -73,6 +75,10 @@ soak: build
 
 mutation: build
 	@lab/mutation/run.sh
+
+# make fairness [JOBS=n] [OUT=<dir>]: generated correct and one-mistake answers graded as one class (issue 35)
+fairness: build
+	@$(ENV) && exec python3 lab/scripts/fairness.py $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)")
 
 # make grade SUBMISSION=<dir or zip> | CLASS=<dir or zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]
 #            [WORKSHEET=<Moodle's offline grading worksheet, filled into OUT>]
