@@ -375,7 +375,7 @@ def test_each_student_gets_the_points_of_a_local_run(graded, local):
     for name, source in CLASS[1:]:
         record = _record(out, name)
         assert dict((i['id'], i['points']) for i in record['items']) == dict(FULL, **EXPECTED[source]), output
-        assert record['status'] == STATUS.get(source, 'graded') == rows[name]['status']
+        assert record['status'] == STATUS.get(source, 'graded') == rows[name]['status'], (name, record['status_reason'])
         assert float(rows[name]['total']) == record['total']
         assert rows[name] == local_rows[name], 'the same row in grades.csv as the local run\'s'
         for made in ('grade.md', 'results.json', 'flight.png', os.path.join('logs', 'build.log')):
