@@ -25,7 +25,8 @@ import zipfile
 from exam_lab.grader import runner
 from exam_lab.grader.publish import feedback
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+# realpath: a test imports this from the workspace's src/ link, and docs/ is the repository's.
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 GRADING = os.path.join(REPO, 'docs', 'grading.md')
 #: (name in docs/grading.md's markers, submission folder); the sheet is the grader's own choice.
 EXAMPLES = [('ours', 'exam'), ('no_kelvin', 'lab/test/grader/submissions/no_kelvin')]
