@@ -9,6 +9,7 @@ import math
 import os
 
 from exam_lab.grader.score.rubric import calls
+from exam_lab.grader.score.safe_text import one_line
 
 #: Legs of each run, in order, and the side of the threshold each is flown on.
 LEGS = {'rest': 'below', 'short_up': 'above', 'short_down': 'below', 'long_up': 'above', 'long_down': 'below', 'deep_down': 'below',
@@ -63,7 +64,7 @@ def draw(runs, path, title=''):
         for ax, (tag, probe) in zip(axes[:, 0], runs):
             _panel(ax, tag, probe)
         if title:
-            fig.suptitle(title, fontsize=11)
+            fig.suptitle(one_line(title), fontsize=11)  # a student's name: no control character
         fig.tight_layout()
         fig.savefig(path)
     finally:
