@@ -31,7 +31,7 @@ import time
 from exam_lab.grader import runner
 from exam_lab.grader.publish.provenance import grader_version
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.realpath(__file__))
 SUBMISSIONS = os.path.join(HERE, '..', 'test', 'grader', 'submissions')
 OUR_EXAM = os.path.realpath(os.path.join(HERE, '..', '..', 'exam'))
 

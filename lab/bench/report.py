@@ -184,7 +184,7 @@ def _header(r, grader):
 
 def _grader_section():
     """lab/bench/grader.md: the grader's section, measured by lab/bench/grader_bench.py --record."""
-    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'grader.md')
+    path = os.path.join(os.path.dirname(os.path.realpath(__file__)), 'grader.md')
     if not os.path.isfile(path):
         return None
     with open(path) as f:

@@ -17,7 +17,7 @@ import procs
 import stats
 
 PYTHON = '/usr/bin/python3'
-BENCH = os.path.dirname(os.path.abspath(__file__))
+BENCH = os.path.dirname(os.path.realpath(__file__))
 REPO = os.path.dirname(os.path.dirname(BENCH))
 SCRIPTS = {
     'ours': os.path.join(REPO, 'exam', 'scripts', 'exam_node.py'),

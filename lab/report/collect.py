@@ -114,7 +114,7 @@ def catkin_make(run):
 
     :returns: that workspace's environment (its devel/setup.bash sourced), to run the simple answer in.
     """
-    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
     workspace = os.path.join(run.supervisor.log_dir, 'catkin_ws')
     os.makedirs(os.path.join(workspace, 'src'))
     for package in STUDENT_PACKAGES:

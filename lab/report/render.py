@@ -411,7 +411,7 @@ def main():
     with open(os.path.join(args.work, 'outputs.json')) as f:
         outputs = json.load(f)
     values, blocks = facts(args.work, args.repo, outputs)
-    here = os.path.dirname(os.path.abspath(__file__))
+    here = os.path.dirname(os.path.realpath(__file__))
     with open(os.path.join(here, 'report_template.md')) as f:
         template = f.read()
     text = render(template, outputs, values, blocks, args.repo)

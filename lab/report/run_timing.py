@@ -106,7 +106,7 @@ def main():
         return
     import subprocess
     for launch, topic in LAUNCHES:
-        out = subprocess.run([sys.executable, os.path.abspath(__file__), '--one', launch], stdout=subprocess.PIPE,
+        out = subprocess.run([sys.executable, os.path.realpath(__file__), '--one', launch], stdout=subprocess.PIPE,
                              universal_newlines=True)
         if out.returncode != 0:
             sys.exit('run_timing: %s failed; README.md is left as it was' % launch)

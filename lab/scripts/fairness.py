@@ -26,7 +26,7 @@ import time
 from exam_lab.fairness import generator
 from exam_lab.grader import runner
 
-REPO = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
+REPO = os.path.realpath(os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..'))
 BEGIN = '<!-- fairness: written by `make fairness` (lab/scripts/fairness.py); do not edit -->'
 END = '<!-- end of fairness -->'
 

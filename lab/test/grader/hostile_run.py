@@ -21,7 +21,7 @@ import signal
 import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.realpath(__file__))
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 GRADE = os.path.join(REPO, 'lab', 'scripts', 'grade.py')
 HOSTILE = os.path.join(HERE, 'hostile')

@@ -16,7 +16,7 @@ import pytest
 from exam_lab.grader import runner
 from exam_lab.grader.score.sheets import ITEMS
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.realpath(__file__))
 SUBMISSIONS = os.path.join(HERE, 'submissions')
 OUR_EXAM = os.path.realpath(os.path.join(HERE, '..', '..', '..', 'exam'))
 FULL = {item: points for item, (points, _) in ITEMS.items()}

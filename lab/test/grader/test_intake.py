@@ -37,7 +37,7 @@ from exam_lab.grader.host import sandbox, staging
 from exam_lab.grader.publish import desk
 from exam_lab.grader.score import rubric
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.realpath(__file__))
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 PACKAGE_XML = b'<package format="2"><name>exam</name><version>0.0.1</version></package>\n'
 #: Code two students share: the answer's pure modules (no node: nothing is flown).

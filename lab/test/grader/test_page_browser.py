@@ -20,7 +20,7 @@ import pytest
 
 from exam_lab.grader.publish import feedback
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.realpath(__file__))
 DOCS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(HERE))), 'docs')
 CHROMIUM = shutil.which('chromium') or shutil.which('chromium-browser')
 #: The two students whose feedback pages are opened: the good student (its report.pdf of two pages)

@@ -16,7 +16,7 @@ from exam_lab.grader.score.sheets import ITEMS, SHEETS
 from exam_lab.harness.supervisor import Supervisor
 from exam_lab.harness.wait import wait_until
 
-REPO = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..'))
+REPO = os.path.realpath(os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..', '..'))
 SIMPLE = os.path.join(REPO, 'docs', 'simple_answer', 'exam')
 #: What `make run-simple` runs.
 RUN_SIMPLE = os.path.join(REPO, 'docs', 'simple_answer', 'run.sh')

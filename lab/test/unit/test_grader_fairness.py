@@ -222,7 +222,7 @@ def test_jobs_default_two_per_core_within_memory():
 
 
 def test_grade_refuses_jobs_below_one(capsys):
-    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'scripts', 'grade.py')
+    path = os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..', 'scripts', 'grade.py')
     spec = importlib.util.spec_from_file_location('grade_script', path)
     grade = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(grade)

@@ -380,7 +380,7 @@ def test_the_same_grade_gives_the_same_bytes(tmp_path):
 def test_the_setting_is_make_checks_file(tmp_path, monkeypatch):
     # realpath both: CI runs the tests from the workspace's src/ link to lab/.
     assert os.path.realpath(feedback.SETTING) == os.path.realpath(os.path.join(os.path.dirname(os.path.dirname(
-        os.path.dirname(os.path.abspath(__file__)))), 'check_visibility.ini'))
+        os.path.dirname(os.path.realpath(__file__)))), 'check_visibility.ini'))
     assert feedback.read_show() in student_view.SHOW
     out = str(tmp_path)
     r = record('Ann', folder='Ann_5_assignsubmission_file_')

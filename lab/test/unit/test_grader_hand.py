@@ -117,7 +117,7 @@ def test_a_student_twice_or_a_renamed_column_is_refused(tmp_path):
 def worksheet_script():
     import importlib.util
     import os
-    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
     spec = importlib.util.spec_from_file_location('worksheet_script', os.path.join(repo, 'lab', 'scripts',
                                                                                     'worksheet.py'))
     module = importlib.util.module_from_spec(spec)

@@ -8,7 +8,7 @@ import pytest
 
 from exam_lab.grader.boxed import launch
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.realpath(__file__))
 SUBMISSIONS = os.path.join(HERE, '..', 'grader', 'submissions')
 REPO = os.path.join(HERE, '..', '..', '..')
 

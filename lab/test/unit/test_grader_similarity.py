@@ -14,7 +14,7 @@ import pytest
 
 from exam_lab.grader.boxed import similarity
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.realpath(__file__))
 ORIGINAL = os.path.join(HERE, '..', 'grader', 'submissions', 'good_student', 'exam')
 
 #: An independent solution of sheet 000: a class, time stamps instead of a counter, no globals.

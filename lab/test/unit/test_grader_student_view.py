@@ -11,7 +11,7 @@ import pytest
 from exam_lab.grader.publish import report, student_view
 from exam_lab.grader.score.sheets import ITEMS
 
-LAB = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+LAB = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 #: The value the threshold run flew at: the student is never told it.
 HIDDEN = '1040'
 Q14A = 'launch file /threshold = 1300; set to %s, the node warned 5.00 s after reaching 1170.0' % HIDDEN

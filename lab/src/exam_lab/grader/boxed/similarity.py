@@ -220,7 +220,7 @@ def check(submissions, out_dir, python=None, shared=None, scratch_dir=None):
         try:
             python = python or ensure_venv()
             env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-                [os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))] +
+                [os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))] +
                 [p for p in os.environ.get('PYTHONPATH', '').split(os.pathsep) if p]))
             done = subprocess.run([python, '-m', 'exam_lab.grader.boxed.similarity', os.path.join(scratch, 'job.json')],
                                   env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=900)

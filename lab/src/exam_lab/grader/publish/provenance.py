@@ -12,7 +12,7 @@ import os
 import platform
 import subprocess
 
-_HERE = os.path.dirname(os.path.abspath(__file__))
+_HERE = os.path.dirname(os.path.realpath(__file__))
 _SCORE = os.path.join(os.path.dirname(_HERE), 'score')
 _cache = {}
 
