@@ -5,7 +5,7 @@ import os
 
 import pytest
 
-from exam_lab.grader.boxed import launch, source
+from exam_lab.grader.boxed import derive, launch, source
 
 from exam_lab.grader.host import session
 from exam_lab.grader.judge import probe
@@ -132,7 +132,7 @@ def test_launch_comments_and_a_package_named_otherwise(tmp_path):
     analysis = launch.analyse(str(pkg / 'launch' / 'a.launch'), str(pkg), 'exam_pkg')
     assert [n.type for n in analysis.exam_nodes] == ['n.py'] and analysis.starts_drone('altitude')
     assert analysis.comments() == 1
-    assert launch.threshold_param(analysis, 'altitude')[0].name == '/n/seuil'
+    assert derive.threshold_param(analysis, 'altitude')[0].name == '/n/seuil'
     assert launch.analyse(str(pkg / 'launch' / 'a.launch'), str(pkg)).exam_nodes == []
 
 

@@ -9,8 +9,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   archive unpacked after checking every entry), :mod:`~.boxed.package` (the package found in an upload,
   copied), :mod:`~.boxed.uploads` (which of several uploads is the last), :mod:`~.boxed.classlist` (a
   class's students, from a folder or an archive), :mod:`~.boxed.source` (what the sources say;
-  the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it,
-  the derived launch files the grader runs), :mod:`~.boxed.documents` (participant number, PDF
+  the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it),
+  :mod:`~.boxed.derive` (which launch file and threshold are run; the derived launch files the grader
+  runs), :mod:`~.boxed.documents` (participant number, PDF
   reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own).
 - ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`
   (rospy: plays the drone with the harness's fake drone, measures, watches the node's pid).
