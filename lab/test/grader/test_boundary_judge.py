@@ -95,10 +95,9 @@ def test_the_judge_is_neither_root_nor_the_box(judged_class):
 
 
 def test_no_judge_process_is_left(judged_class):
-    """Of the judge's uids (only this grader uses them; a box's uid may already be another grading's,
-    test_sandbox checks those), no process is left once the class is graded."""
-    assert [uid for uid in range(uids.JUDGE_UID_BASE, uids.JUDGE_UID_BASE + uids.SLOTS)
-            if uids.pids_of_uid(uid)] == []
+    """Of the judge's uids (test_sandbox checks the boxes'), none whose slot no grader holds has a
+    process left once the class is graded."""
+    assert uids.left_behind(uids.JUDGE_UID_BASE) == []
 
 
 def points_of(record):
