@@ -1,12 +1,15 @@
 """Unpacking what students upload: unsafe archives refused as a whole, the package found."""
+import io
 import os
 import re
 import stat
+import tarfile
 import zipfile
 
 import pytest
 
-from exam_lab.grader.boxed import archives, classlist, package
+from exam_lab.grader.boxed import archives, classlist, package, source
+from exam_lab.grader.host import staging
 
 PACKAGE_XML = '<package format="2"><name>exam</name></package>'
 
@@ -209,3 +212,51 @@ def test_a_name_in_any_bytes_is_shown_as_its_bytes():
     assert archives.shown_name(b'exam/lien\xfe'.decode('utf-8', 'surrogateescape')) == "'exam/lien\\xfe'"
     assert archives.shown_name('a\\udcff') == "'a\\\\udcff'"
     assert archives.shown_name('Größe\n') == "'Größe\\n'"
+
+
+def _class_archive(path, kind, entries):
+    """A class archive of ``(name, bytes, mode)`` entries, each with its Unix mode, as zip or tar."""
+    if kind == 'zip':
+        with zipfile.ZipFile(str(path), 'w', zipfile.ZIP_DEFLATED) as zf:
+            for name, data, mode in entries:
+                info = zipfile.ZipInfo(name, (2026, 6, 12, 14, 0, 0))
+                info.create_system = 3
+                info.external_attr = (stat.S_IFREG | mode) << 16
+                zf.writestr(info, data)
+    else:
+        with tarfile.open(str(path), 'w:gz') as tf:
+            for name, data, mode in entries:
+                info = tarfile.TarInfo(name)
+                info.size, info.mode = len(data), mode
+                tf.addfile(info, io.BytesIO(data))
+    return str(path)
+
+
+@pytest.mark.parametrize('kind', ['zip', 'tar'])
+def test_a_class_archive_keeps_each_script_s_x_bit_through_every_copy(tmp_path, kind):
+    """Issue 38: whether a script is executable is a fact of the grade (the sheet asks for chmod +x), so a
+    script handed in executable in a class archive stays so through every copy the grader makes (the
+    intake's unpacking, the staging for the student's box, the package's copy into the workspace),
+    whatever the umask (077 on a cluster's account), and one handed in without it is still "made
+    executable"."""
+    folder = 'Ann Lee_11_assignsubmission_file_/exam/'
+    archive = _class_archive(tmp_path / ('class.' + kind), kind, [
+        (folder + 'package.xml', PACKAGE_XML.encode(), 0o644),
+        (folder + 'scripts/exam_node.py', b'#!/usr/bin/env python3\nprint(1)\n', 0o755),
+        (folder + 'scripts/helper.py', b'#!/usr/bin/env python3\nprint(2)\n', 0o644)])
+    umask = os.umask(0o077)
+    try:
+        (name, unpacked), = classlist.list_students(archive, str(tmp_path / 'intake'))
+        staged = str(tmp_path / 'upload')
+        staging.stage_upload(unpacked, staged)
+        notes = []
+        pkg = str(tmp_path / 'ws' / 'exam')
+        package.copy_package(package.open_submission(staged, str(tmp_path / 'scratch'), notes), pkg, notes)
+        for at in (os.path.join(unpacked, 'exam'), staged + '/exam', pkg):
+            assert os.stat(os.path.join(at, 'scripts', 'exam_node.py')).st_mode & 0o777 == 0o755, at
+            assert os.stat(os.path.join(at, 'scripts', 'helper.py')).st_mode & 0o111 == 0, at
+        assert source.make_runnable(pkg, ['exam_node.py']) == [
+            'scripts/helper.py was not executable: made executable (chmod +x), as the sheet asks']
+    finally:
+        os.umask(umask)
+    assert name == 'Ann Lee'

@@ -170,6 +170,6 @@ def _write_student(opened, kind, target, plan):
     """Write one student's planned files below ``target`` (the class's folder for an archive at its top:
     the plan's one file is the student's key)."""
     try:
-        write_plan(plan, target, opened.open if kind == 'zip' else opened.extractfile)
+        write_plan(plan, target, kind, opened)
     except UNREADABLE as err:
         raise UnpackError('%s cannot be unpacked: %s' % (shown_name(plan.label), unreadable_why(err)))
