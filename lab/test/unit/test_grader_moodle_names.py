@@ -275,3 +275,22 @@ def test_the_zip_of_a_class_with_these_names_imports_each_page_to_its_student(tm
         for number, text in got.items():
             title = re.search(r'<h1>(.*?): ', text).group(1)
             assert title == html.escape(expected[number], quote=True), (number, title)
+
+
+def test_a_student_whose_name_starts_with_a_dot_is_listed(tmp_path):
+    """Moodle writes a full name starting with '.' as it is: that folder is a student's, not a hidden
+    file; .DS_Store and macOS's ._ copy of a flat download (its participant number included) are not."""
+    from test_grader_unpack import PACKAGE_XML, make_zip
+    inner = make_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML)])
+    with open(inner, 'rb') as f:
+        packed = f.read()
+    dotted = download_path('.Anna Roy', 77, '', '4.1').rstrip('/')
+    flat = download_path('Jane Doe', 12, 'exam.zip', 'flat')
+    archive = make_zip(tmp_path / 'class.zip', [(dotted + '/exam/package.xml', PACKAGE_XML), (flat, packed),
+                                                ('._' + flat, b'\0\5\26\7'), ('.DS_Store', b'\0')])
+    scratch = tmp_path / 'scratch'
+    scratch.mkdir()
+    listed = classlist.list_students(str(archive), str(scratch))
+    assert [(name, os.path.basename(path)) for name, path in listed] == [('Anna Roy', dotted), ('Jane Doe', flat)]
+    name = feedback.moodle_name({'folder': dotted, 'student': 'Anna Roy'}, 77)
+    assert name == '.Anna Roy' and moodle_import(feedback.folder_name(name, 77) + '/feedback.html', {77})[0] == 77
