@@ -344,7 +344,8 @@ def test_hand_points_merged_or_left_out(tmp_path):
 
 
 def test_the_same_grade_gives_the_same_bytes(tmp_path):
-    """Moodle imports only a new or changed file: a rescore that moves nothing must change no page."""
+    """A rescore that moves nothing changes no page (Moodle replaces every page of an upload all the same:
+    the teacher can tell by the bytes whose page moved)."""
     out = str(tmp_path)
     r = record('Ann', folder='Ann_5_assignsubmission_file_')
     graded_class(out, [r])
