@@ -16,6 +16,7 @@ from exam_lab.grader.publish import feedback, hand, report, student_view
 from exam_lab.grader.score import identity
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 from test_grader_desk import probe_result as desk_probe_result
+from test_grader_moodle_names import download_path, moodle_import
 
 #: The value the threshold run flew at: in the teacher's files, never in a student's.
 HIDDEN = '1040'
@@ -40,31 +41,9 @@ DOWNLOADS = [
 ]
 
 
-def moodle_import(path, participants):
-    """What Moodle's importer does with one file of the zip (mod/assign/feedback/file/importziplib.php,
-    is_valid_filename_for_import, ported line by line): ``(participant, subtype, type, filename)``, or
-    None when it skips the file. ``participants``: the assignment's unique ids."""
-    directory, _, name = path.rpartition('/')
-    if not name or name.startswith('.') or name.startswith('~'):
-        return None
-    parts = ('/import/%s/%s' % (directory, name) if directory else '/import/' + name).split('/')
-    while parts:
-        info = parts.pop(0).split('_', 4)
-        if len(info) < 4 or not re.match(r'^\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\s*$', info[1]):
-            continue
-        number = int(float(info[1]))
-        if number not in participants or (info[2], info[3]) not in (('assignfeedback', 'file'),
-                                                                     ('assignsubmission', 'file')):
-            continue
-        parts.insert(0, info[4] if len(info) == 5 else '')
-        return number, info[2], info[3], '/'.join(parts)
-    return None
-
-
 def download_folder(fullname, number, last):
-    """A download folder by Moodle's rule: the feedback folder's rule with the submission plugin."""
-    prefix = feedback.clean_filename('%s_%d' % (fullname.replace('_', ' '), number))
-    return feedback.clean_filename('%s_assignsubmission_file%s' % (prefix, last))
+    """A download folder by Moodle's rule (test_grader_moodle_names' port, not the product's)."""
+    return download_path(fullname, number, '', '3.1' if last else '4.1').rstrip('/')
 
 
 @pytest.mark.parametrize('folder, fullname, number', DOWNLOADS)
@@ -365,7 +344,8 @@ def test_hand_points_merged_or_left_out(tmp_path):
 
 
 def test_the_same_grade_gives_the_same_bytes(tmp_path):
-    """Moodle imports only a new or changed file: a rescore that moves nothing must change no page."""
+    """A rescore that moves nothing changes no page (Moodle replaces every page of an upload all the same:
+    the teacher can tell by the bytes whose page moved)."""
     out = str(tmp_path)
     r = record('Ann', folder='Ann_5_assignsubmission_file_')
     graded_class(out, [r])

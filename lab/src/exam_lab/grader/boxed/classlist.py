@@ -14,7 +14,7 @@ from exam_lab.grader.boxed import archives
 from exam_lab.grader.boxed.archives import (ARCHIVE_ENDINGS, SKIPPED_DIRS, UNREADABLE, Plan, UnpackError, open_archive,
                                             shown_name, tar_entries, unreadable_why, without_ending, write_plan,
                                             zip_entries)
-from exam_lab.grader.score.identity import student_name
+from exam_lab.grader.score.identity import participant_number, student_name
 
 #: A class archive ("download all submissions") holds every student's uploads: its bounds as a whole
 #: (entries, bytes of the students it unpacks); each student's files are paid from MAX_FILES / MAX_BYTES.
@@ -38,13 +38,21 @@ def list_students(class_path, scratch, refused=None):
     students = []
     for entry in sorted(os.listdir(class_path)):
         full = os.path.join(class_path, entry)
-        if entry.startswith('.') or entry in SKIPPED_DIRS or os.path.islink(full):
+        if _hidden(entry) or entry in SKIPPED_DIRS or os.path.islink(full):
             continue
         if os.path.isdir(full):
             students.append((student_name(entry), full))
         elif entry.lower().endswith(ARCHIVE_ENDINGS):
             students.append((student_name(without_ending(entry)), full))
     return students
+
+
+def _hidden(entry):
+    """A hidden name the listing passes over (``.DS_Store``, ``.git``, the ``._`` copies macOS leaves
+    beside each file), but never a folder Moodle named after a student whose full name starts with a dot:
+    ``.Anna Roy_77_assignsubmission_file_`` (Moodle's name never starts with ``._``: it writes ``_`` as
+    a space)."""
+    return entry.startswith('.') and (entry.startswith('._') or participant_number(entry) is None)
 
 
 def _class_entries(kind, opened, label):
