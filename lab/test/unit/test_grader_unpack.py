@@ -10,6 +10,7 @@ import pytest
 
 from exam_lab.grader.boxed import archives, classlist, package, source
 from exam_lab.grader.host import staging
+from exam_lab.grader.score import identity
 
 PACKAGE_XML = '<package format="2"><name>exam</name></package>'
 
@@ -177,6 +178,32 @@ def test_a_class_zip_judges_each_student_by_its_own_bounds(tmp_path, monkeypatch
         "beyond the 3 a submission may unpack"
     assert os.path.getsize(os.path.join(paths['Ann Lee'], 'screenshot.bmp')) == 5 << 20
     assert os.path.isfile(os.path.join(paths['Cy Fine'], 'exam.zip'))
+
+
+def test_a_name_longer_than_a_folder_name_stops_no_one(tmp_path):
+    """Moodle allows 100 characters each for a first and a last name: in Cyrillic or Chinese, with the
+    participant number and the plugin, a folder name of 300 bytes or more, longer than this machine's
+    255. That student is unpacked in a folder whose name lost characters from the middle of the name
+    (its participant number kept), and graded; a class archive of uploads at the top with such a name
+    refuses that upload alone; the others are unpacked."""
+    upload = [('exam.zip', open(make_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML)]), 'rb').read())]
+    long_folder = 'Жанна %s_4711_assignsubmission_file_' % ('Ш' * 140)
+    archive = moodle_class(tmp_path / 'class.zip', {long_folder: upload, 'Cy Fine_13_assignsubmission_file_': upload})
+    refused = {}
+    students = classlist.list_students(archive, str(tmp_path / 'scratch'), refused)
+    assert refused == {}
+    assert len(students) == 2 and students[0][0] == 'Cy Fine'
+    name, folder = students[1]
+    assert os.path.isfile(os.path.join(folder, 'exam.zip'))
+    assert len(os.path.basename(folder).encode('utf-8')) <= archives.NAME_MAX
+    assert os.path.basename(folder).startswith('Жанна ШШ') and os.path.basename(folder).endswith(
+        'Ш_4711_assignsubmission_file_')
+    assert identity.participant_number(os.path.basename(folder)) == 4711
+    at_top = make_zip(tmp_path / 'tops.zip', [('%s.zip' % ('Ш' * 140), upload[0][1]), ('Cy Fine.zip', upload[0][1])])
+    refused = {}
+    students = classlist.list_students(at_top, str(tmp_path / 'tops'), refused)
+    assert [name for name, _ in students][0] == 'Cy Fine' and len(students) == 2
+    assert list(refused.values()) == ['entry %s has a name of more than 255 bytes' % archives.shown_name('Ш' * 140 + '.zip')]
 
 
 def test_a_class_zip_is_bounded_as_a_whole(tmp_path, monkeypatch):

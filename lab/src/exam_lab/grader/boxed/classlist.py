@@ -20,6 +20,9 @@ from exam_lab.grader.score.identity import participant_number, student_name
 #: (entries, bytes of the students it unpacks); each student's files are paid from MAX_FILES / MAX_BYTES.
 CLASS_FILES = 100000
 CLASS_BYTES = 4 * 1024 * 1024 * 1024
+#: Characters kept at the end of a student's name too long to be a folder's (:func:`_fitting`): Moodle's
+#: ``_<participant>_assignsubmission_file_`` and more, at most 240 bytes in any script.
+_KEPT_END = 60
 
 
 def list_students(class_path, scratch, refused=None):
@@ -103,7 +106,7 @@ def unpack_class(archive, target, refused):
         top = os.path.join(target, base) if base else target
         plans, total = [], 0
         for key, members in sorted(groups.items()):
-            place = os.path.join(top, key)
+            place = os.path.join(top, _fitting(key))
             try:
                 plan = _student_plan(key, members)
             except UnpackError as err:
@@ -134,6 +137,21 @@ def unpack_class(archive, target, refused):
             except OSError as err:
                 raise UnpackError('%s of the class archive cannot be written: %s' % (shown_name(key), err.strerror))
     return top
+
+
+def _fitting(key):
+    """A student's top entry as a name this file system takes: one of more than NAME_MAX bytes (Moodle
+    allows 100 characters each for a first and a last name: 300 bytes and more in Cyrillic or Chinese)
+    loses characters from its middle, its start and its end (the participant number, the plugin, an
+    archive's ending) kept, so that one long name stops no one else."""
+    def fits(name):
+        return len(name.encode('utf-8', 'surrogateescape')) <= archives.NAME_MAX
+    if fits(key):
+        return key
+    head, tail = key[:-_KEPT_END], key[-_KEPT_END:]
+    while not fits(head + '-' + tail):
+        head = head[:-1]
+    return head + '-' + tail
 
 
 def _students_of(entries):
