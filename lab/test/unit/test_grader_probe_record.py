@@ -33,6 +33,21 @@ def real_session(probe=None):
             'survivors': 0, 'budget_used': None}
 
 
+def keep_runs(folder, runs, checked=True):
+    """The measurements a grading keeps in ``folder`` (what the flight plot draws), whose session
+    measured ``runs`` (``[(tag, probe)]``, each probe over the real one), made a SessionRecord as the
+    runner does (checked, its text made safe); with ``checked`` False, written as they are (a file as
+    another grader, or a hand, left it)."""
+    run = real_session()['runs'][0]
+    session = dict(real_session(), runs=[dict(run, tag=tag, probe=dict(real_probe(), **probe) if checked else probe)
+                                         for tag, probe in runs])
+    if checked:
+        session = SessionRecord.make(session).value
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, records.MEASUREMENTS), 'w') as f:
+        json.dump({'session': session}, f)
+
+
 def refused(value, record_type=ProbeRecord):
     with pytest.raises(RecordError) as err:
         record_type.make(value)

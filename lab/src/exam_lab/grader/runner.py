@@ -420,7 +420,7 @@ def _box_binds(underlay):
 
 #: What a run measured, kept beside grade.json: all the rubric reads, so a grade can be made again
 #: from it with today's rubric (:func:`rescore`) without running the package again.
-MEASUREMENTS = 'measurements.json'
+MEASUREMENTS = records.MEASUREMENTS
 
 
 def score(measured, how='run'):

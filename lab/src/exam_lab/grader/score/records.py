@@ -20,6 +20,9 @@ import re
 from exam_lab.grader.score.safe_text import cleaned
 from exam_lab.grader.score.sheets import SHEETS
 
+#: What a grading measured, kept beside grade.json by the runner (its session a :class:`SessionRecord`):
+#: a rescore scores it again, the flight plot draws from it.
+MEASUREMENTS = 'measurements.json'
 #: Longest string of a record (a note, a path) and most items of one list.
 MAX_TEXT = 2000
 MAX_ITEMS = 500
