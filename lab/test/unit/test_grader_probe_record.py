@@ -89,6 +89,16 @@ def test_a_hostile_probe_result_is_refused_saying_where_and_why():
     assert "probe.json.legs['rest']: unexpected key(s) 'why'" in refused(dict(probe, legs=legs))
 
 
+def test_the_drones_answer_may_quote_the_longest_request():
+    probe = real_probe()
+    request = '\x07' * records.MAX_REQUEST
+    answer = 'refused status %r: accepted values are WARNING, NORMAL; alarm LED stays GREEN' % request
+    record = ProbeRecord.make(dict(probe, calls=[[probe['t0'], request]], answers=[[probe['t0'], request, False, answer]]))
+    assert record.calls == [[probe['t0'], '']] and record.answers[0][3].startswith("refused status '\\x07\\x07")
+    assert 'calls[0][1]: a string of %d characters' % (records.MAX_REQUEST + 1) in refused(
+        dict(probe, calls=[[probe['t0'], request + 'x']]))
+
+
 def test_a_students_control_characters_are_gone_once_the_record_is_made():
     probe = real_probe()
     probe['calls'] = [[probe['t0'] + 1, '"WARNING"\x07<b>\x1b[2J']]
@@ -156,3 +166,25 @@ def test_the_runner_reads_the_sessions_record_capped_and_checked(tmp_path):
     assert runner.session_outcome(log_dir, None, '', 100.0, 0)['outcome'] == 'session_killed'
     got = runner.session_outcome(log_dir, 1, 'Traceback\nboom\x1b[2J', 100.0, 0)
     assert got['outcome'] == 'session_failed' and got['error'] == 'the session failed (exit 1): Traceback\nboom'
+
+
+def test_a_rescore_reads_back_the_session_record_the_run_kept(tmp_path):
+    """measurements.json holds the session's record as the run made it (NaN included); a rescore reads
+    it back to the same record and the same grade."""
+    from test_grader_rubric import STATIC
+    probe = real_probe()
+    probe['formula'][1]['published'] = float('nan')
+    session_ = SessionRecord.make(real_session(probe)).value
+    kept = {'student': 'Ann', 'sheet': 'altitude', 'static': STATIC, 'session': session_, 'notes': [], 'fixes': [],
+            'comments': None, 'isolate': True, 'how_run': 'test', 'extra': {'seconds': 40.0}}
+    folder = tmp_path / 'Ann'
+    folder.mkdir()
+    (folder / records.MEASUREMENTS).write_text(json.dumps(kept))
+    graded = runner.score(kept)
+    (folder / 'grade.json').write_text(json.dumps(graded))
+    with open(str(folder / records.MEASUREMENTS), 'rb') as f:
+        again = SessionRecord.from_json(json.dumps(json.load(f)['session']).encode(), SessionRecord.MAX_BYTES)
+    assert math.isnan(again.runs[0]['probe']['formula'][1]['published'])
+    assert again.to_json() == SessionRecord.make(session_).to_json()
+    rescored, changes = runner.rescore(str(tmp_path))
+    assert changes == [] and [i['points'] for i in rescored[0]['items']] == [i['points'] for i in graded['items']]

@@ -360,6 +360,11 @@ _COUNT = Number(0, 1e12, integer=True)
 MAX_CALLS = 200000
 #: Most node deaths the judge's watch lists in one run (a node respawned in a loop).
 MAX_DEATHS = 20000
+#: Longest request of a service call the node made; the drone's answer quotes it (repr: each
+#: character at most 4), with its own words around.
+MAX_REQUEST = MAX_TEXT
+_REQUEST = Text(MAX_REQUEST)
+_ANSWER = Text(4 * MAX_REQUEST + 500)
 
 #: One leg of the flight checked on the node's own values (:func:`exam_lab.grader.judge.probe.leg_check`).
 LEG = {'side': OneOf('above', 'below'), 'reached': Maybe(_TIME), 'stays': Maybe(_TIME), 'off_side': _COUNT,
@@ -397,8 +402,8 @@ class ProbeRecord(Record):
                           'non_finite': Optional(_COUNT)}),
         'node_watch': {'deaths': Items({'node': _NAME, 't': Maybe(_TIME), 'detail': Text()}, MAX_DEATHS),
                        'nodes': [_NAME]},
-        'calls': Items(Row(_TIME, Text()), MAX_CALLS),
-        'answers': Items(Row(_TIME, Text(), bool, Text()), MAX_CALLS),
+        'calls': Items(Row(_TIME, _REQUEST), MAX_CALLS),
+        'answers': Items(Row(_TIME, _REQUEST, bool, _ANSWER), MAX_CALLS),
         'graph': Map(_NAME, {'publishes': Items(Row(_NAME, _NAME)), 'subscribes': Items(Row(_NAME, _NAME)),
                              'services': [_NAME]}),
         'alive_at_end': bool, 't0': _TIME,
