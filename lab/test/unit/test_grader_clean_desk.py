@@ -24,6 +24,7 @@ from exam_lab.grader.publish import desk, flightplot, gradescope, moodle, page, 
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 from test_grader_desk import probe_result
+from test_grader_probe_record import keep_runs
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
 #: What may not reach the teacher, written out here rather than taken from the module under test.
@@ -221,10 +222,8 @@ def test_extreme_values_are_drawn_clamped_and_said(tmp_path):
 
 def test_a_student_with_extreme_values_gets_its_plot_on_the_page(tmp_path):
     out = tmp_path / 'out'
-    logs = out / 'Eve' / 'logs'
-    os.makedirs(str(logs))
-    with open(str(logs / 'probe-main.json'), 'w') as f:
-        json.dump(extreme_probe(), f)  # Infinity, NaN: what json writes of them, and reads back
+    # Infinity, NaN: what json writes of them, and reads back; kept as they are (no record would take them)
+    keep_runs(str(out / 'Eve'), [('main', extreme_probe())], checked=False)
     record = report.grade_record('Eve', 'altitude', hostile_record()['items'], [], {})
     lines = desk.finish(str(out), [record])
     assert os.path.isfile(str(out / 'Eve' / 'flight.png'))
@@ -239,9 +238,7 @@ def class_desk(tmp_path):
     for number, name in enumerate(('Ada', 'Bob', 'Eve'), 101):
         items = [{'id': item, 'points': top, 'max': top, 'evidence': 'ok'} for item, (top, _) in ITEMS.items()]
         record = report.grade_record(name, 'altitude', items, ['hint'], {'participant': number})
-        os.makedirs(str(out / name / 'logs'))
-        with open(str(out / name / 'logs' / 'probe-main.json'), 'w') as f:
-            json.dump(probe_result(), f)
+        keep_runs(str(out / name), [('main', probe_result())])
         report.write_grade(str(out / name), record)
         records.append(record)
     worksheet = tmp_path / 'ws.csv'

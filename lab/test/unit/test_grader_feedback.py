@@ -7,6 +7,7 @@ import html
 import json
 import os
 import re
+import warnings
 import zipfile
 from html.parser import HTMLParser
 
@@ -17,6 +18,7 @@ from exam_lab.grader.score import identity
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 from test_grader_desk import probe_result as desk_probe_result
 from test_grader_moodle_names import download_path, moodle_import
+from test_grader_probe_record import keep_runs
 
 #: The value the threshold run flew at: in the teacher's files, never in a student's.
 HIDDEN = '1040'
@@ -114,13 +116,12 @@ def graded_class(out, records, threshold_run=True, requests=('WARNING', 'NORMAL'
     for r in records:
         logs = os.path.join(out, r['student'], 'logs')
         os.makedirs(logs)
-        with open(os.path.join(logs, 'probe-main.json'), 'w') as f:
-            json.dump(probe_result(requests=requests), f)
+        runs = [('main', probe_result(requests=requests))]
         if threshold_run:
             with open(os.path.join(logs, 'plan-threshold.json'), 'w') as f:
                 json.dump({'threshold': float(HIDDEN)}, f)
-            with open(os.path.join(logs, 'probe-threshold.json'), 'w') as f:
-                json.dump(probe_result('threshold', threshold=float(HIDDEN)), f)
+            runs.append(('threshold', probe_result('threshold', threshold=float(HIDDEN))))
+        keep_runs(os.path.join(out, r['student']), runs)
         report.write_grade(os.path.join(out, r['student']), r)
 
 
@@ -308,7 +309,10 @@ def test_a_students_text_is_escaped(tmp_path):
                evidence={'Q11': 'publisher: %s std_msgs/Float32' % topic, 'runs': 'builds; but: main run: %s' % log},
                reason='the node printed %s' % log, status='graded with fixes')
     graded_class(out, [r], requests=('"WARNING"\x07<b>', 'NORMAL'))
-    feedback.write(out, [r], show='evidence')
+    with warnings.catch_warnings(record=True) as caught:  # a control character the plot cannot draw
+        warnings.simplefilter('always')
+        feedback.write(out, [r], show='evidence')
+    assert [str(w.message) for w in caught if 'Glyph' in str(w.message)] == []
     got = pages(out)
     assert list(got) == ['Eve b_9_assignfeedback_file_/feedback.html']  # Moodle's rule drops < >
     text = got['Eve b_9_assignfeedback_file_/feedback.html']
@@ -318,7 +322,7 @@ def test_a_students_text_is_escaped(tmp_path):
     shown = ''.join(parsed.text)
     assert topic in shown and '\'single\' "double" </td></tr><img src=x onerror=alert(1)> end' in shown
     assert '&lt;script&gt;alert(&quot;x&quot;)' in text
-    assert 'REFUSED ""WARNING"<b" call (1)' in shown  # its first 12 characters, the bell gone  # the plot's label, a student's request, as text
+    assert 'REFUSED ""WARNING"<b>" call (1)' in shown  # the plot's label, a student's request, as text: its first 12 characters once the bell was gone (the probe's record made it safe)
 
 
 def test_hand_points_merged_or_left_out(tmp_path):

@@ -301,17 +301,36 @@ def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BU
         status, output, _ = sup.run('session', argv, timeout=left + SESSION_KILL_S, env=dict(os.environ, HOME=judge_home))
     end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
     survivors = box.end()  # the box's uid: nothing may be left once its PID namespaces are gone
-    path = os.path.join(log_dir, 'session.json')
-    if status == 0 and os.path.isfile(path):
-        with open(path) as f:
-            result = json.load(f)
+    return session_outcome(log_dir, status, output, left, survivors)
+
+
+def session_outcome(log_dir, status, output, left, survivors):
+    """The session's record (a :class:`~exam_lab.grader.score.records.SessionRecord`'s value): the one
+    it wrote in ``log_dir`` when it ended well (``status`` 0), read through
+    :func:`~exam_lab.grader.host.egress.read_record` (capped, checked), else why there is none;
+    ``survivors`` (processes of the box's uid found after it) added to its count."""
+    if status == 0:
+        try:
+            result = egress.read_record(os.path.join(log_dir, records.SessionRecord.FILE), records.SessionRecord,
+                                        records.SessionRecord.MAX_BYTES).value
+        except records.RecordError as err:
+            return no_session('session_failed', 'the session\'s record was refused: %s' % err, survivors=survivors)
         result['survivors'] = result.get('survivors', 0) + survivors
         return result
     if status is None:
         why = budget_sentence(STUDENT_BUDGET, 'the session was killed after %.0f s' % (left + SESSION_KILL_S))
-        return {'build': None, 'runs': [], 'error': why, 'budget_used': why, 'survivors': survivors}
-    why = 'the session failed (exit %s): %s' % (status, session_tail(output))
-    return {'build': None, 'runs': [], 'error': why, 'survivors': survivors}
+        return no_session('session_killed', why, budget_used=why, survivors=survivors)
+    return no_session('session_failed', 'the session failed (exit %s): %s' % (status, session_tail(output)),
+                      survivors=survivors)
+
+
+def no_session(outcome, error, **more):
+    """The session's record (:class:`~exam_lab.grader.score.records.SessionRecord`'s value) of a grading
+    whose session did not run or failed: its ``outcome`` (one of
+    :data:`~exam_lab.grader.score.records.OUTCOMES`), ``error`` (why, for the teacher) and ``more``
+    (``refused``, ``no_node``, ``budget_used``, ``survivors``)."""
+    return records.SessionRecord.make(dict(more, outcome=outcome, build=None, runs=[],
+                                           error=error[:records.MAX_LOG_TEXT])).value
 
 
 def session_tail(output):
@@ -401,7 +420,7 @@ def _box_binds(underlay):
 
 #: What a run measured, kept beside grade.json: all the rubric reads, so a grade can be made again
 #: from it with today's rubric (:func:`rescore`) without running the package again.
-MEASUREMENTS = 'measurements.json'
+MEASUREMENTS = records.MEASUREMENTS
 
 
 def score(measured, how='run'):
@@ -464,7 +483,7 @@ def rescore(out):
 def could_not_grade(student, sheet, why, notes=()):
     """The record of a submission the grader could not grade: every item 0, and why."""
     sheet = sheet or 'altitude'
-    session = {'build': None, 'runs': [], 'error': 'could not grade: %s' % why}
+    session = no_session('grader_failed', 'could not grade: %s' % why)
     return report.grade_record(student, sheet, rubric.score(sheet, {}, session),
                                list(notes) + [session['error']], {'seconds': 0.0, 'provenance': provenance.stamp()},
                                rubric.status({}, session))
@@ -517,22 +536,21 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                 chosen_sheet, static = found.sheet, found.static
                 job = plan_job(found)
                 if job is None:
-                    session = {'build': None, 'runs': [], 'no_node': True,
-                               'error': 'no script of the package starts a ROS node'}
+                    session = no_session('no_node', 'no script of the package starts a ROS node', no_node=True)
                 elif deadline - time.monotonic() < START_TIMEOUT:
                     why = budget_sentence(STUDENT_BUDGET, 'nothing was run (%.0f s left after the inspection)'
                                           % (deadline - time.monotonic()))
-                    session = {'build': None, 'runs': [], 'error': why, 'budget_used': why}
+                    session = no_session('not_run', why, budget_used=why)
                 else:
                     how_run = _how_run(box)
                     session = run_session(job, work, underlay, isolate, box, on_step,
                                           left=deadline - time.monotonic())
         except (archives.UnpackError, staging.UploadRefused) as err:
-            session = {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % err}
+            session = no_session('refused', 'submission refused: %s' % err, refused=True)
         except InspectionFailed as err:
-            session = {'build': None, 'runs': [], 'error': 'the inspection of the upload failed: %s' % err}
+            session = no_session('inspection_failed', 'the inspection of the upload failed: %s' % err)
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
-            session = {'build': None, 'runs': [], 'error': 'the grader failed on this submission: %r' % err}
+            session = no_session('grader_failed', 'the grader failed on this submission: %r' % err)
             notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
         logs = os.path.join(out_dir, 'logs')
         shutil.rmtree(logs, ignore_errors=True)
@@ -704,7 +722,7 @@ def _refused_at_intake(name, folder, out_dir, sheet, why):
     folder_name = os.path.basename(folder)
     measured = {'student': name, 'sheet': sheet or 'altitude', 'static': {}, 'notes': [], 'fixes': [],
                 'comments': None, 'isolate': None, 'how_run': None,
-                'session': {'build': None, 'runs': [], 'refused': True, 'error': 'submission refused: %s' % why},
+                'session': no_session('refused', 'submission refused: %s' % why, refused=True),
                 'extra': {'participant': identity.participant_number(folder_name), 'folder': folder_name,
                           'documents': [], 'seconds': 0.0}}
     os.makedirs(out_dir, exist_ok=True)

@@ -112,7 +112,7 @@ def threshold_ran(folder):
 def plot_svg(folder):
     """The main run's flight plot as inline SVG text, or None when there is nothing to draw. Only the
     main run: the threshold run's panel names its hidden value."""
-    runs = [(tag, probe) for tag, probe in flightplot.load_runs(os.path.join(folder, 'logs')) if tag == 'main']
+    runs = [(tag, probe) for tag, probe in flightplot.load_runs(folder) if tag == 'main']
     import matplotlib
     with tempfile.TemporaryDirectory(prefix='exam-feedback-') as scratch:
         path = os.path.join(scratch, 'flight.svg')
