@@ -5,7 +5,7 @@
 
 The answers (lab/src/exam_lab/fairness/generator.py): ``--correct`` correct answers to both sheets, a
 pairwise covering sample of the styles students write, and one one-mistake variant per rule of the
-rubric. They are graded in ONE class run by the grader (runner.grade_class, JOBS side by side), each
+rubric. They are graded in ONE class run by the grader (class_run.grade_class, JOBS side by side), each
 grade held to what the answer must get. The report goes between its markers in docs/grading.md (with
 the date and commit) and into OUT/fairness.md; OUT keeps the class, the grades and fairness.json.
 
@@ -24,7 +24,7 @@ import tempfile
 import time
 
 from exam_lab.fairness import generator
-from exam_lab.grader import runner
+from exam_lab.grader import class_run
 
 REPO = os.path.realpath(os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..'))
 BEGIN = '<!-- fairness: written by `make fairness` (lab/scripts/fairness.py); do not edit -->'
@@ -141,7 +141,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     out = args.out or tempfile.mkdtemp(prefix='fairness-')
     answers = generator.answers(args.correct, args.seed)
-    jobs = args.jobs or runner.default_jobs()
+    jobs = args.jobs or class_run.default_jobs()
     start = time.time()
     run = {'commit': commit(), 'date': datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M'), 'jobs': jobs,
            'seed': args.seed}
@@ -155,7 +155,7 @@ def main(argv=None):
               % (len(answers), len([a for a in answers if a.mistake is None]),
                  len([a for a in answers if a.mistake is not None]), klass, jobs), flush=True)
         try:
-            records = runner.grade_class(klass, os.path.join(out, 'grades'), jobs=jobs)
+            records = class_run.grade_class(klass, os.path.join(out, 'grades'), jobs=jobs)
         except Exception as err:  # the grader could not run at all: no verdict on fairness
             print('fairness: the grader could not run: %s' % err, file=sys.stderr)
             return 2

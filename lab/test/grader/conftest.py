@@ -22,9 +22,9 @@ def main_class(tmp_path_factory):
     records, test_page_browser opens its pages. ``{'out', 'klass', 'records' (graded order), 'by_name',
     'lines' (what the desk printed)}``."""
     import test_grade
-    from exam_lab.grader import runner
+    from exam_lab.grader import class_run
     from exam_lab.grader.publish import desk
     out, records, klass = test_grade.grade_main_class(tmp_path_factory.mktemp('grader'))
-    lines = desk.finish(str(out), records, similar=runner.class_similarity(str(klass), str(out), records))
+    lines = desk.finish(str(out), records, similar=class_run.class_similarity(str(klass), str(out), records))
     return {'out': str(out), 'klass': str(klass), 'records': records, 'by_name': {r['student']: r for r in records},
             'lines': lines}

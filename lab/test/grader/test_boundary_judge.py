@@ -22,7 +22,7 @@ import time
 import pytest
 
 from exam_lab.grader import runner
-from exam_lab.grader.host import limits, session, uids
+from exam_lab.grader.host import limits, session, uids, underlay
 from exam_lab.grader.score import rubric
 from exam_lab.grader.score.sheets import ITEMS
 from hostile_run import HOSTILE, NAMES, VICTIM_NAME
@@ -133,7 +133,7 @@ def test_a_grading_past_its_budget_ends_at_it_and_says_so(tmp_path, monkeypatch)
     what follows it, the build stopped, and its row says which budget, how large, and what it stopped."""
     if os.geteuid() != 0:
         pytest.skip('the sandbox is made by root (docs/grading.md, "Isolation")')
-    runner.ensure_underlay(runner.default_underlay())  # built before the student's time starts
+    underlay.ensure_underlay(underlay.default_underlay())  # built before the student's time starts
     monkeypatch.setattr(runner, 'STUDENT_BUDGET', BUDGET_S)
     start = time.monotonic()
     record = runner.grade_submission(os.path.join(HOSTILE, 'sleeper', 'exam'), str(tmp_path / 'out'), student='sleeper')

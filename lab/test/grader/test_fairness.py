@@ -11,7 +11,7 @@ must go), not strict where today's grade sits at a tolerance's edge. About 2.5 m
 import pytest
 
 from exam_lab.fairness import generator
-from exam_lab.grader import runner
+from exam_lab.grader import class_run
 
 SAMPLE = generator.sample(10)
 
@@ -27,7 +27,7 @@ GRADED_WRONG_TODAY = {}
 def graded(tmp_path_factory):
     root = tmp_path_factory.mktemp('fairness')
     klass = generator.write_class(SAMPLE, str(root / 'class'))
-    records = runner.grade_class(klass, str(root / 'out'), jobs=runner.default_jobs())
+    records = class_run.grade_class(klass, str(root / 'out'), jobs=class_run.default_jobs())
     return {r['student']: r for r in records}
 
 

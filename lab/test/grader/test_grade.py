@@ -13,7 +13,8 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run, runner
+from exam_lab.grader.publish import grades
 from exam_lab.grader.score.sheets import ITEMS
 
 HERE = os.path.dirname(os.path.realpath(__file__))
@@ -131,7 +132,7 @@ def grade_main_class(root):
                             ignore=shutil.ignore_patterns('__pycache__', '.grader-*'))
     out = root / 'out'
     # The default JOBS (two per core): what a teacher's class run uses, held to the same points here.
-    records = runner.grade_class(str(klass), str(out), jobs=runner.default_jobs())
+    records = class_run.grade_class(str(klass), str(out), jobs=class_run.default_jobs())
     return out, records, klass
 
 
@@ -281,7 +282,7 @@ def fair(tmp_path_factory):
             shutil.copytree(os.path.join(SUBMISSIONS, name, 'exam'), str(folder / 'exam'),
                             ignore=shutil.ignore_patterns('__pycache__', '.grader-*'))
     out = root / 'out'
-    records = runner.grade_class(str(klass), str(out), jobs=runner.default_jobs())
+    records = class_run.grade_class(str(klass), str(out), jobs=class_run.default_jobs())
     desk.finish(str(out), records, title='ROS-Exam altitude')
     return out, {r['student']: r for r in records}
 
@@ -365,7 +366,7 @@ def test_rescoring_the_class_from_its_measurements_moves_nothing_and_a_rubric_ch
     from exam_lab.grader.score import rubric
     out, records = graded
     started = time.monotonic()
-    again, changes = runner.rescore(str(out))
+    again, changes = grades.rescore(str(out))
     assert time.monotonic() - started < 30.0
     assert changes == []
     by_name = {r['student']: r for r in again}
@@ -375,7 +376,7 @@ def test_rescoring_the_class_from_its_measurements_moves_nothing_and_a_rubric_ch
             [(i['id'], i['points']) for i in record['items']], name
         assert by_name[name]['provenance']['how'] == 'rescore' and by_name[name]['previous']['total'] == record['total']
     monkeypatch.setattr(rubric, 'WARNING_LATE_S', -0.5)  # WARNING due before the delay: nobody's on time
-    again, changes = runner.rescore(str(out))
+    again, changes = grades.rescore(str(out))
     moved = [line for line in changes if 'Q14b' in line]
     assert moved and all('Q14b' in line for line in changes), changes
     for line in changes:
@@ -384,4 +385,4 @@ def test_rescoring_the_class_from_its_measurements_moves_nothing_and_a_rubric_ch
     with open(os.path.join(str(out), 'grades.csv')) as f:
         assert any(row.startswith('good_student') for row in f)
     monkeypatch.undo()
-    runner.rescore(str(out))  # leave the class as graded, for the tests after this one
+    grades.rescore(str(out))  # leave the class as graded, for the tests after this one

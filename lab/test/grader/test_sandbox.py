@@ -21,7 +21,8 @@ import time
 
 import pytest
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run, runner
+from exam_lab.grader.host import boxed_run
 
 from exam_lab.grader.host import egress, limits, sandbox, staging, uids
 from exam_lab.grader.score.sheets import ITEMS
@@ -151,8 +152,8 @@ def test_reading_student_bytes_is_bounded(tmp_path):
                 os.mkdir(os.path.join(work, sub), 0o755)
             start = time.monotonic()
             with sandbox.Box(work) as box:
-                boxed = runner.Boxed(box, work)
-                with pytest.raises(runner.InspectionFailed) as failed:
+                boxed = boxed_run.Boxed(box, work)
+                with pytest.raises(boxed_run.InspectionFailed) as failed:
                     boxed.run('timeit', ['-n', '1', '-r', '1', '-s', 'import os, time', statement],
                               records.InspectRecord, bounds)
                 assert not box.leftovers()
@@ -175,7 +176,7 @@ def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
             zf.writestr('%s/exam/package.xml' % folder, '<package><name>exam</name></package>')
     work_dirs = []
     try:
-        students = runner.class_students(archive, work_dirs)
+        students = class_run.class_students(archive, work_dirs)
         assert [name for name, _ in students] == ['Bob', 'Jane Doe']
         for _, folder in students:
             assert folder.startswith(work_dirs[0] + '/') and os.stat(folder).st_uid >= uids.BOX_UID_BASE
@@ -183,7 +184,7 @@ def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
         with zipfile.ZipFile(archive, 'a') as zf:
             zf.writestr('../outside.txt', 'x')
         with pytest.raises(archives.UnpackError, match='unpacking it in its box failed'):
-            runner.class_students(archive, work_dirs)
+            class_run.class_students(archive, work_dirs)
     finally:
         for work in work_dirs:
             shutil.rmtree(work, ignore_errors=True)
@@ -240,7 +241,7 @@ def test_no_sandbox_no_grading_unless_the_risk_is_named(monkeypatch, tmp_path):
     assert 'bubblewrap is missing' in str(refused.value)
     assert '--unsandboxed-student-code-can-read-and-damage-my-files' in str(refused.value)
     assert not os.path.exists(str(tmp_path / 'out'))
-    assert runner.sandbox_refusal(unsandboxed=True) is None
+    assert sandbox.sandbox_refusal(unsandboxed=True) is None
 
 
 def test_probe_results_must_belong_to_the_run():

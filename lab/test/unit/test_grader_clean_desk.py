@@ -17,7 +17,9 @@ import re
 
 import pytest
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run
+from exam_lab.grader.publish import grades, teacher
+from exam_lab.grader.score.records import MEASUREMENTS
 from exam_lab.grader.host import session
 
 from exam_lab.grader.publish import desk, flightplot, gradescope, moodle, page, progress, report
@@ -125,8 +127,8 @@ def out_grade_script(tmp_path, record, monkeypatch, capsys):
     """What ``grade.py --class`` prints, the grading itself replaced by the record."""
     (tmp_path / 'class').mkdir()
     os.makedirs(str(tmp_path / 'out' / record['student']))
-    monkeypatch.setattr(runner, 'grade_class', lambda *args, **kwargs: [record])
-    monkeypatch.setattr(runner, 'class_similarity', lambda *args: {'pairs': [], 'students': 1})
+    monkeypatch.setattr(class_run, 'grade_class', lambda *args, **kwargs: [record])
+    monkeypatch.setattr(class_run, 'class_similarity', lambda *args: {'pairs': [], 'students': 1})
     assert _grade_script().main(['--class', str(tmp_path / 'class'), '--out', str(tmp_path / 'out')]) == 0
     printed = capsys.readouterr()
     assert 'need the teacher' in printed.out and 'Eve' in printed.out
@@ -154,7 +156,7 @@ def test_the_record_is_clean_where_it_is_made():
                                      % HOSTILE)
     assert CONTROL.findall(outcome['tail']) == [] and '17/17 graded' in outcome['tail']
     run = {'tag': 'main', 'launch': {'tail': HOSTILE}}
-    notes = runner.hints({}, {'build': None, 'runs': [run]}, [], None, True)
+    notes = teacher.hints({}, {'build': None, 'runs': [run]}, [], None, True)
     record = report.grade_record('Eve', 'altitude', hostile_record()['items'], notes,
                                  {'documents': hostile_record()['documents']}, ('needs a hand grade', HOSTILE))
     assert [s for s in strings(record) if CONTROL.search(s)] == []
@@ -332,12 +334,12 @@ def test_a_name_in_any_bytes_is_kept_exactly_by_a_rescore(tmp_path):
                 'isolate': True, 'how_run': None, 'session': {'build': None, 'runs': [], 'error': 'x'},
                 'extra': {'participant': 3, 'folder': 'Cy_3_assignsubmission_file_', 'documents': [], 'seconds': 1.0}}
     os.makedirs(str(out / 'Cy'))
-    with open(str(out / 'Cy' / runner.MEASUREMENTS), 'w') as f:
+    with open(str(out / 'Cy' / MEASUREMENTS), 'w') as f:
         json.dump(measured, f)
     for _ in range(2):
-        records, _ = runner.rescore(str(out))
+        records, _ = grades.rescore(str(out))
         assert desk.finish(str(out), records)[-1].startswith('page: ')
-    with open(str(out / 'Cy' / runner.MEASUREMENTS)) as f:
+    with open(str(out / 'Cy' / MEASUREMENTS)) as f:
         assert json.load(f)['comments']['files'] == ['scripts/' + NOT_UTF8]
     assert 'scripts/notes\\xff\\xe9.py' in _read(str(out / 'Cy' / 'grade.md'))
     assert 'scripts/notes\\xff\\xe9.py' in _read(str(out / 'index.html'))

@@ -213,12 +213,12 @@ def test_reports_say_the_status():
 def test_jobs_default_two_per_core_within_memory():
     """JOBS when the teacher gives none: two gradings per core (make bench's grader stage measured that
     no point moves), fewer when the memory cannot hold them, never 0."""
-    from exam_lab.grader import runner
+    from exam_lab.grader import class_run
     gib = 1 << 30
-    assert runner.default_jobs(cores=2, memory=24 * gib) == 4
-    assert runner.default_jobs(cores=16, memory=8 * gib) == 8
-    assert runner.default_jobs(cores=1, memory=gib // 2) == 1
-    assert runner.default_jobs() >= 1
+    assert class_run.default_jobs(cores=2, memory=24 * gib) == 4
+    assert class_run.default_jobs(cores=16, memory=8 * gib) == 8
+    assert class_run.default_jobs(cores=1, memory=gib // 2) == 1
+    assert class_run.default_jobs() >= 1
 
 
 def test_grade_refuses_jobs_below_one(capsys):

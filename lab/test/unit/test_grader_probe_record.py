@@ -8,6 +8,7 @@ import os
 import pytest
 
 from exam_lab.grader import runner
+from exam_lab.grader.publish import grades
 from exam_lab.grader.host import session
 from exam_lab.grader.score import records
 from exam_lab.grader.score.records import ProbeRecord, RecordError, SessionRecord
@@ -119,7 +120,7 @@ def test_the_outcome_is_one_of_fixed_values():
     assert 'session.json: outcome is missing' in refused({k: v for k, v in real_session().items() if k != 'outcome'},
                                                         SessionRecord)
     for outcome in records.OUTCOMES:
-        assert runner.no_session(outcome, 'why')['outcome'] == outcome
+        assert grades.no_session(outcome, 'why')['outcome'] == outcome
 
 
 def write(path, text):
@@ -180,11 +181,11 @@ def test_a_rescore_reads_back_the_session_record_the_run_kept(tmp_path):
     folder = tmp_path / 'Ann'
     folder.mkdir()
     (folder / records.MEASUREMENTS).write_text(json.dumps(kept))
-    graded = runner.score(kept)
+    graded = grades.score(kept)
     (folder / 'grade.json').write_text(json.dumps(graded))
     with open(str(folder / records.MEASUREMENTS), 'rb') as f:
         again = SessionRecord.from_json(json.dumps(json.load(f)['session']).encode(), SessionRecord.MAX_BYTES)
     assert math.isnan(again.runs[0]['probe']['formula'][1]['published'])
     assert again.to_json() == SessionRecord.make(session_).to_json()
-    rescored, changes = runner.rescore(str(tmp_path))
+    rescored, changes = grades.rescore(str(tmp_path))
     assert changes == [] and [i['points'] for i in rescored[0]['items']] == [i['points'] for i in graded['items']]

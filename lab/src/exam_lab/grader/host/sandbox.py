@@ -272,6 +272,19 @@ def check():
         return _checked['why']
 
 
+
+def sandbox_refusal(unsandboxed=False):
+    """None when student code may run here: boxes can be made, or the teacher passed the flag that
+    names the risk (``unsandboxed``); otherwise the refusal, for the teacher."""
+    why = check()
+    if why is None or unsandboxed:
+        return None
+    return ('refusing to run student code without its sandbox: %s. Run the grader on a machine with '
+            'bubblewrap and unprivileged user namespaces, as root or as yourself (docs/grading.md, '
+            '"Isolation" and "Without root"), or pass --unsandboxed-student-code-can-read-and-damage-my-files '
+            'to accept that risk' % why)
+
+
 #: Why a rootless box may fail, for the teacher.
 USERNS_HINT = ('without root, the kernel must let ordinary users make user namespaces: user.max_user_namespaces '
                'above 0, kernel.unprivileged_userns_clone=1 where it exists (Debian 10, 11), and on Ubuntu '
