@@ -244,7 +244,7 @@ def render(results):
             'Every student got the points of its package alone (the largest difference of a total: 0).' if not differ else
             'Points that differed: %s. The largest difference of a total: %s point(s).' % (
                 '; '.join(differ), _total({'': largest})))), '',
-        '`JOBS` defaults to %d per core (`exam_lab.grader.runner.default_jobs`: %d on this machine).%s' % (
+        '`JOBS` defaults to %d per core (`exam_lab.grader.class_run.default_jobs`: %d on this machine).%s' % (
             class_run.JOBS_PER_CORE, default, verdict), '',
         'Why side by side stays fair: each student has a master, a network namespace and processes of its own, '
         'so the only thing shared is the CPU, and the rubric\'s timings need little of it: each box is held to '

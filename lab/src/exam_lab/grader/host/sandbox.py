@@ -55,8 +55,8 @@ user and network namespace of its own (:func:`~exam_lab.grader.host.bwrap.networ
 session gets a network namespace of its own (only loopback: not even the host's abstract sockets,
 X11's or D-Bus's).
 
-:func:`check` says whether boxes can be made here at all; the runner refuses to grade when they
-cannot unless the teacher accepts the risk by name.
+:func:`check` says whether boxes can be made here at all; the grader refuses to grade when they
+cannot (:func:`sandbox_refusal`) unless the teacher accepts the risk by name.
 """
 import os
 import shutil
