@@ -374,7 +374,8 @@ def test_rescoring_the_class_from_its_measurements_moves_nothing_and_a_rubric_ch
         assert [(i['id'], i['points']) for i in by_name[name]['items']] == \
             [(i['id'], i['points']) for i in record['items']], name
         assert by_name[name]['provenance']['how'] == 'rescore' and by_name[name]['previous']['total'] == record['total']
-    monkeypatch.setattr(rubric, 'WARNING_LATE_S', -0.5)  # WARNING due before the delay: nobody's on time
+    # WARNING due before the delay: nobody's on time
+    monkeypatch.setattr(rubric, 'warning_window', lambda probe: (probe['delay'] - 0.3, probe['delay'] - 0.5))
     again, changes = runner.rescore(str(out))
     moved = [line for line in changes if 'Q14b' in line]
     assert moved and all('Q14b' in line for line in changes), changes
