@@ -348,7 +348,7 @@ def test_fair_evidence_is_what_happened(fair):
     assert 'no NORMAL while its own value was back just below the threshold (1299.90, 0.10 below)' in margin, margin
     assert 'further below: it waits for a margin' in margin, margin
     short = evidence['delay_minus_period']['Q14b']
-    assert 'WARNING 4.' in short and '(outside: 4.7-5.5 s)' in short, short
+    assert 'WARNING 4.' in short and '(outside: 4.70-6.39 s)' in short, short
 
 
 def test_our_node_on_the_depth_sheet(tmp_path):
