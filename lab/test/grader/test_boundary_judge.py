@@ -94,9 +94,10 @@ def test_the_judge_is_neither_root_nor_the_box(judged_class):
     assert probe['judge_uid'] >= uids.JUDGE_UID_BASE and probe['clock']['ros_time_is_wall'] is True
 
 
-def test_no_judge_process_is_left(judged_class):
+def test_no_judge_process_is_left(judged_class, all_class_runs_done):
     """Of the judge's uids (only this grader uses them; a box's uid may already be another grading's,
-    test_sandbox checks those), no process is left once the class is graded."""
+    test_sandbox checks those), no process is left once the class is graded (and the session's other
+    class runs, graded meanwhile: conftest.py)."""
     assert [uid for uid in range(uids.JUDGE_UID_BASE, uids.JUDGE_UID_BASE + uids.SLOTS)
             if uids.pids_of_uid(uid)] == []
 
