@@ -56,9 +56,13 @@ SINGLES = {
 }
 
 
+#: How many of SINGLES are graded side by side.
+SINGLES_JOBS = 2
+
+
 def singles(root):
-    """Each of SINGLES graded alone (``grade_submission``, as ``make grade SUBMISSION=...`` does), side by
-    side: ``{name: record}``."""
+    """Each of SINGLES graded alone (``grade_submission``, as ``make grade SUBMISSION=...`` does),
+    SINGLES_JOBS side by side: ``{name: record}``."""
     import test_grade
     import test_simple_answer
     from exam_lab.grader import runner
@@ -67,9 +71,9 @@ def singles(root):
     def one(name):
         package, sheet = SINGLES[name]
         return name, runner.grade_submission(packages[package], os.path.join(root, name), sheet=sheet,
-                                             jobs=len(SINGLES))
+                                             jobs=SINGLES_JOBS)
     runner.ensure_underlay(runner.default_underlay())  # once, before three gradings wait on its lock
-    with concurrent.futures.ThreadPoolExecutor(max_workers=len(SINGLES)) as pool:
+    with concurrent.futures.ThreadPoolExecutor(max_workers=SINGLES_JOBS) as pool:
         return dict(pool.map(one, sorted(SINGLES)))
 
 
@@ -81,9 +85,9 @@ def _class_jobs():
 #: ``run: (function, its weight)``; the weight is a callable (the default JOBS is this machine's).
 RUNS = {
     'main_class': (main_class, _class_jobs),
+    'singles': (singles, lambda: SINGLES_JOBS),
     'fair_class': (fair_class, _class_jobs),
     'fairness_sample': (fairness_sample, _class_jobs),
-    'singles': (singles, lambda: len(SINGLES)),
 }
 
 

@@ -20,6 +20,7 @@ import pytest
 
 import class_runs
 import hostile_run
+from exam_lab.harness.wait import wait_until
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 #: Modules run first: each grades for itself a chain of steps (a workspace built as another user, a
@@ -34,7 +35,10 @@ def budget():
 
 
 class Runs(object):
-    """The session's class runs, started in order as the budget frees (one thread each, waiting)."""
+    """The session's class runs (one thread each, waiting), each started as soon as its weight fits in
+    the budget, in the listed order. The hostile class comes first, with a head start: the others (and
+    the tests that grade for themselves, :func:`_hostile_head_start`) wait until its victim, graded
+    beside the burner, is graded, so that the victim's timing measures the burner, not the session."""
 
     def __init__(self, factory, runs, limit):
         self.factory, self.limit, self.used = factory, limit, 0
@@ -42,11 +46,15 @@ class Runs(object):
         self.results, self.errors, self.cleanups, self.threads = {}, {}, [], []
         self.running, self.closing = set(), False
         self.order = list(runs)
+        self.head_start = threading.Event()
+        if 'hostile_class' not in [name for name, _ in self.order]:
+            self.head_start.set()
         for name, weight in runs:
             thread = threading.Thread(target=self._run, args=(name, min(limit, weight)), name=name, daemon=True)
             self.threads.append(thread)
 
     def start(self):
+        self.factory.getbasetemp()  # made here, once: threads making it at once would make one each
         if any(name == 'main_class' for name, _ in self.order):
             # Before any run: the similarity check's venv, made by one process (nothing locks its making).
             from exam_lab.grader.boxed import similarity
@@ -54,12 +62,17 @@ class Runs(object):
         for thread in self.threads:
             thread.start()
 
+    def _done(self, name):
+        return name in self.results or name in self.errors
+
     def _run(self, name, weight):
-        with self.cond:  # first come first served, in the listed order: a big run is never starved
+        if name != 'hostile_class':
+            self.head_start.wait(900.0)  # the head start's own bound, should it hang
+        with self.cond:
             turn = [n for n, _ in self.order].index(name)
-            self.cond.wait_for(lambda: self.closing or (self.used + weight <= self.limit and
-                               all(n in self.results or n in self.errors or n in self.running
-                                   for n, _ in self.order[:turn])))
+            # first fit: a run waits for the runs before it that fit no better than it does
+            self._wait(lambda: self.closing or (self.used + weight <= self.limit and
+                       all(self._done(n) or n in self.running or w > weight for n, w in self.order[:turn])))
             if self.closing:
                 self.errors[name] = 'not started: the session ended first'
                 self.cond.notify_all()
@@ -75,6 +88,7 @@ class Runs(object):
             with self.cond:
                 self.errors[name] = '%s: %s' % (type(err).__name__, err)
         finally:
+            self.head_start.set()
             with self.cond:
                 self.used -= weight
                 self.running.discard(name)
@@ -84,6 +98,9 @@ class Runs(object):
     def _grade(self, name):
         root = str(self.factory.mktemp(name))
         if name == 'hostile_class':  # grade.py in a child process already; its cleanup at the session's end
+            victim = os.path.join(root, 'out', hostile_run.VICTIM_NAME, 'grade.json')
+            threading.Thread(target=lambda: (wait_until(lambda: os.path.isfile(victim) or self._done(name), 900.0,
+                                                        period=0.5), self.head_start.set()), daemon=True).start()
             run = hostile_run.grade(root)
             self.cleanups.append(run)
             return next(run)
@@ -105,18 +122,19 @@ class Runs(object):
 
     def result(self, name):
         with self.cond:
-            self._wait(lambda: name in self.results or name in self.errors)
+            self._wait(lambda: self._done(name))
             if name in self.errors:
                 pytest.fail('the class run %s failed: %s' % (name, self.errors[name]), pytrace=False)
             return self.results[name]
 
     def wait_all(self):
         with self.cond:
-            self._wait(lambda: all(n in self.results or n in self.errors for n, _ in self.order))
+            self._wait(lambda: all(self._done(n) for n, _ in self.order))
 
     def close(self):
         """Start no more runs, wait for those going (each grading ends within its budget; a class killed
         would leave its boxes running), then the hostile class's cleanup."""
+        self.head_start.set()
         with self.cond:
             self.closing = True
             self.cond.notify_all()
@@ -127,8 +145,7 @@ class Runs(object):
 
 #: ``fixture name: its weight`` of the background runs, in the order they start.
 def _runs():
-    runs = [(name, weight()) for name, (_, weight) in class_runs.RUNS.items()]
-    return runs[:1] + [('hostile_class', 2)] + runs[1:]  # the main class first: two modules read it
+    return [('hostile_class', 2)] + [(name, weight()) for name, (_, weight) in class_runs.RUNS.items()]
 
 
 _session = {'runs': None}
@@ -152,6 +169,14 @@ def pytest_collection_finish(session):
 def pytest_sessionfinish(session):
     if _session['runs'] is not None:
         _session['runs'].close()  # nothing graded after the session
+
+
+@pytest.fixture(scope='session', autouse=True)
+def _hostile_head_start():
+    """The session's first test waits for the hostile class's head start (:class:`Runs`)."""
+    if _session['runs'] is not None:
+        while not _session['runs'].head_start.wait(1.0):  # in steps: Ctrl-C reaches it
+            pass
 
 
 def _result(name):

@@ -26,7 +26,8 @@ from exam_lab.grader import runner
 from exam_lab.grader.host import egress, limits, sandbox, staging, uids
 from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
-from hostile_run import GOOD as VICTIM, HOSTILE, NAMES, SECRET_DIR, VICTIM_NAME, files_under, write_secrets
+from hostile_run import (GOOD as VICTIM, HOSTILE, NAMES, SECRET_DIR, VICTIM_NAME, files_under, left_in_free_slots,
+                         write_secrets)
 
 FULL = {item: points for item, (points, _) in ITEMS.items()}
 #: This module's students of the hostile class (the saboteur's victim is the class's one victim).
@@ -84,10 +85,11 @@ def test_a_forged_probe_file_changes_nothing(hostile_class):
         assert 'FORGER usercustomize ran' not in text, path
 
 
-def test_no_detached_child_survives(hostile_class):
+def test_no_detached_child_survives(hostile_class, all_class_runs_done):
+    """Nor any process of a box's uid once the session's classes are graded (of a slot no grading holds:
+    another grader on this machine may be running)."""
     assert hostile_class['survivors'] == []
-    assert [uid for uid in range(uids.BOX_UID_BASE, uids.BOX_UID_BASE + uids.SLOTS)
-            if uids.pids_of_uid(uid)] == []
+    assert left_in_free_slots(uids.BOX_UID_BASE) == []
 
 
 def test_secrets_never_reach_the_results(hostile_class):
@@ -296,3 +298,25 @@ def test_a_box_is_another_user_and_sees_only_its_own():
     assert seen['Max address space'][0] == str(limits.ADDRESS_SPACE_BYTES)
     for bad in ('ROOT_VISIBLE', 'HOST_TMP_VISIBLE', 'PACKAGE_WRITABLE', 'GRADER_SECRET', 'EXAM_LAB'):
         assert bad not in output
+
+
+def test_a_process_left_in_a_free_slot_is_found():
+    """The check of the two tests of what is left (here and test_boundary_judge, ``left_in_free_slots``)
+    can fail: a process of a box's uid is found once no grading holds its slot, and not while one does."""
+    if os.geteuid() != 0:
+        pytest.skip('the boxes\' uids are root\'s to use')
+    taken = uids.take_slot()
+    assert taken is not None, 'no free slot'
+    slot, lock = taken
+    uid = uids.BOX_UID_BASE + slot
+    sleeper = subprocess.Popen(uids.as_user(uid) + ['sleep', '120'])
+    try:
+        assert wait_until(lambda: uids.pids_of_uid(uid), 10.0), 'the process never ran as uid %d' % uid
+        assert uid not in left_in_free_slots(uids.BOX_UID_BASE), 'a grading holds the slot: its process'
+        lock.close()
+        assert uid in left_in_free_slots(uids.BOX_UID_BASE)
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+        uids.end_uid(uid)
+        lock.close()
