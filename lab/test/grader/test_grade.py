@@ -2,7 +2,8 @@
 loses exactly the points the rubric takes for its flaw, and each upload form students really produce
 (a Windows zip, a whole workspace as exam.tar.gz, a package named otherwise) costs nothing. Two class
 runs (the packages below, then the third kind of class), each at the default JOBS, and one submission
-run.
+run (our node on the depth sheet), each graded once a session in the background with the session's
+other class runs (conftest.py, class_runs.py).
 """
 import csv
 import json
