@@ -28,7 +28,8 @@ import sys
 import tempfile
 import time
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run
+from exam_lab.grader.host import underlay
 from exam_lab.grader.publish.provenance import grader_version
 
 HERE = os.path.dirname(os.path.realpath(__file__))
@@ -93,7 +94,7 @@ def children_cpu():
 def grade(folder, out, jobs):
     """Grade the class in ``folder``: ``(wall s, CPU s of the whole class, {student: record})``."""
     start, cpu = time.monotonic(), children_cpu()
-    records = runner.grade_class(folder, out, jobs=jobs)
+    records = class_run.grade_class(folder, out, jobs=jobs)
     return time.monotonic() - start, children_cpu() - cpu, {r['student']: r for r in records}
 
 
@@ -116,7 +117,7 @@ def main(argv=None):
     started = time.monotonic()
     out = args.out or tempfile.mkdtemp(prefix='grader-bench-')
     kinds = packages()
-    runner.ensure_underlay(runner.default_underlay())
+    underlay.ensure_underlay(underlay.default_underlay())
     results = {'alone': {}, 'classes': [], 'date': datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M'),
                'commit': grader_version(),
                'load_start': list(os.getloadavg()), 'command': 'python3 lab/bench/grader_bench.py '
@@ -199,7 +200,7 @@ def render(results):
         load = ' Load average (1, 5, 15 min) at start %s, at end %s: the machine (2 cores) is shared.' % (
             ', '.join('%.2f' % x for x in results['load_start']),
             ', '.join('%.2f' % x for x in results.get('load_end', [])))
-    default = runner.default_jobs()
+    default = class_run.default_jobs()
     at_default = [k for k in results['classes'] if k['jobs'] == default]
     verdict = ''
     if at_default:
@@ -243,8 +244,8 @@ def render(results):
             'Every student got the points of its package alone (the largest difference of a total: 0).' if not differ else
             'Points that differed: %s. The largest difference of a total: %s point(s).' % (
                 '; '.join(differ), _total({'': largest})))), '',
-        '`JOBS` defaults to %d per core (`exam_lab.grader.runner.default_jobs`: %d on this machine).%s' % (
-            runner.JOBS_PER_CORE, default, verdict), '',
+        '`JOBS` defaults to %d per core (`exam_lab.grader.class_run.default_jobs`: %d on this machine).%s' % (
+            class_run.JOBS_PER_CORE, default, verdict), '',
         'Why side by side stays fair: each student has a master, a network namespace and processes of its own, '
         'so the only thing shared is the CPU, and the rubric\'s timings need little of it: each box is held to '
         'its part of the machine (cores/JOBS, at least half a core), the judge\'s master and probe weigh four '

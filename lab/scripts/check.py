@@ -24,8 +24,8 @@ import sys
 import tempfile
 
 from exam_lab.grader import runner
-
 from exam_lab.grader.host import sandbox
+from exam_lab.grader.host.underlay import default_underlay, ensure_underlay
 
 from exam_lab.grader.publish import progress, student_view
 from exam_lab.grader.score.sheets import SHEETS
@@ -56,7 +56,7 @@ def main(argv=None):
     out = tempfile.mkdtemp(prefix='exam-check-')
     try:
         print('check: building the simulators (once: about a minute the first time)...')
-        underlay = runner.ensure_underlay(runner.default_underlay())
+        underlay = ensure_underlay(default_underlay())
         print('check: grading %s (about a minute)...' % args.package)
         record = runner.grade_submission(args.package, out, args.sheet, student='your package', underlay=underlay,
                                          on_step=progress.StepProgress(), unsandboxed=why is not None)

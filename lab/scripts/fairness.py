@@ -2,15 +2,18 @@
 """`make fairness`: grade generated student answers as one class and say which were graded unfairly.
 
     fairness.py [--out DIR] [--jobs N] [--correct N] [--seed S] [--docs docs/grading.md | --no-docs]
+                [--only NAME[,NAME...]]
 
 The answers (lab/src/exam_lab/fairness/generator.py): ``--correct`` correct answers to both sheets, a
 pairwise covering sample of the styles students write, and one one-mistake variant per rule of the
-rubric. They are graded in ONE class run by the grader (runner.grade_class, JOBS side by side), each
+rubric. They are graded in ONE class run by the grader (class_run.grade_class, JOBS side by side), each
 grade held to what the answer must get. The report goes between its markers in docs/grading.md (with
 the date and commit) and into OUT/fairness.md; OUT keeps the class, the grades and fairness.json.
 
 The last line reads ``fairness: A of B correct answers got 17/17; C of D one-mistake answers lost their
-item only``; exits 1 when A < B or C < D, 2 when the grader could not run.
+item only``; exits 1 when A < B or C < D, 2 when the grader could not run. ``--only`` grades the answers
+of the matrix whose names start with one of the given names (``--only c18,m17``), as they are in the
+whole run, to check a change on them; such a partial run never writes the docs.
 """
 import argparse
 import collections
@@ -24,7 +27,7 @@ import tempfile
 import time
 
 from exam_lab.fairness import generator
-from exam_lab.grader import runner
+from exam_lab.grader import class_run
 
 REPO = os.path.realpath(os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..'))
 BEGIN = '<!-- fairness: written by `make fairness` (lab/scripts/fairness.py); do not edit -->'
@@ -105,6 +108,12 @@ def report(judged, header):
     return '\n'.join(lines) + '\n'
 
 
+def selected(answers, prefixes):
+    """The answers whose names start with one of ``prefixes`` (empty ones ignored), in the matrix's order."""
+    prefixes = tuple(p.strip() for p in prefixes if p.strip())
+    return [a for a in answers if prefixes and a.name.startswith(prefixes)]
+
+
 def read_grades(grades):
     records = []
     for name in sorted(os.listdir(grades)):
@@ -138,10 +147,17 @@ def main(argv=None):
     parser.add_argument('--no-docs', action='store_true', help='leave the docs alone')
     parser.add_argument('--judge-only', action='store_true',
                         help='judge the grades already in OUT/grades again (after a change of the expectations)')
+    parser.add_argument('--only', help='grade only the answers whose names start with one of these (comma '
+                        'separated: c18,m17); the docs are then left alone')
     args = parser.parse_args(argv)
     out = args.out or tempfile.mkdtemp(prefix='fairness-')
     answers = generator.answers(args.correct, args.seed)
-    jobs = args.jobs or runner.default_jobs()
+    if args.only:
+        answers = selected(answers, args.only.split(','))
+        if not answers:
+            parser.error('--only %s: no answer of the matrix has such a name' % args.only)
+        args.no_docs = True
+    jobs = args.jobs or class_run.default_jobs()
     start = time.time()
     run = {'commit': commit(), 'date': datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M'), 'jobs': jobs,
            'seed': args.seed}
@@ -155,7 +171,7 @@ def main(argv=None):
               % (len(answers), len([a for a in answers if a.mistake is None]),
                  len([a for a in answers if a.mistake is not None]), klass, jobs), flush=True)
         try:
-            records = runner.grade_class(klass, os.path.join(out, 'grades'), jobs=jobs)
+            records = class_run.grade_class(klass, os.path.join(out, 'grades'), jobs=jobs)
         except Exception as err:  # the grader could not run at all: no verdict on fairness
             print('fairness: the grader could not run: %s' % err, file=sys.stderr)
             return 2

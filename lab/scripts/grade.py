@@ -19,7 +19,7 @@ import os
 import shlex
 import sys
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run, runner, workspace
 
 from exam_lab.grader.boxed import archives
 from exam_lab.grader.engine import slurm
@@ -44,7 +44,7 @@ def main(argv=None):
     parser.add_argument('--out', help='output folder (default: $EXAM_WS/grades/<name>)')
     parser.add_argument('--jobs', type=int, default=None,
                         help='students graded side by side (class; default: %d per core, %d here)'
-                        % (runner.JOBS_PER_CORE, runner.default_jobs()))
+                        % (class_run.JOBS_PER_CORE, class_run.default_jobs()))
     parser.add_argument('--unsandboxed-student-code-can-read-and-damage-my-files', dest='unsandboxed',
                         action='store_true', help='grade even where no sandbox can be made (never as root: '
                         'as root the code runs as a user of its own, with limits)')
@@ -67,7 +67,7 @@ def main(argv=None):
         say('grade: %s does not exist' % target, sys.stderr)
         return 1
     name = os.path.basename(os.path.abspath(target).rstrip('/'))
-    out = os.path.abspath(args.out or os.path.join(runner.workspace(), 'grades', name))
+    out = os.path.abspath(args.out or os.path.join(workspace(), 'grades', name))
     try:
         if args.submission:
             record = runner.grade_submission(args.submission, out, args.sheet, on_step=progress.StepProgress(),
@@ -84,14 +84,14 @@ def main(argv=None):
                                     scale=args.worksheet_scale):
                 say(line)
         else:
-            jobs = args.jobs or runner.default_jobs()
+            jobs = args.jobs or class_run.default_jobs()
             shown = progress.ClassProgress(jobs)
             try:
                 if args.engine == 'slurm':
                     records = slurm.grade_class(args.klass, out, args.sheet, progress=shown,
                                                 unsandboxed=args.unsandboxed, sbatch_args=shlex.split(args.slurm_args))
                 else:
-                    records = runner.grade_class(args.klass, out, args.sheet, jobs, progress=shown,
+                    records = class_run.grade_class(args.klass, out, args.sheet, jobs, progress=shown,
                                                  unsandboxed=args.unsandboxed)
             finally:
                 shown.close()
@@ -103,7 +103,7 @@ def main(argv=None):
                     say('  ' + line)
             say('grades.csv and one folder per student in %s' % out)
             for line in desk.finish(out, records, similar=None if args.no_similarity else
-                                    runner.class_similarity(args.klass, out, records), worksheet=args.worksheet,
+                                    class_run.class_similarity(args.klass, out, records), worksheet=args.worksheet,
                                     scale=args.worksheet_scale, title=moodle.class_name(args.klass)):
                 say(line)
     except RuntimeError as err:

@@ -15,8 +15,7 @@ import json
 import os
 import sys
 
-from exam_lab.grader import runner
-from exam_lab.grader.publish import desk, report
+from exam_lab.grader.publish import desk, grades, report
 from exam_lab.grader.score import safe_text
 
 
@@ -27,17 +26,17 @@ def main(argv=None):
     parser.add_argument('--worksheet-scale', action='store_true', help="scale to the worksheet's maximum grade")
     args = parser.parse_args(argv)
     out = os.path.abspath(args.out)
-    if not os.path.isdir(out) or not runner.graded_folders(out):
+    if not os.path.isdir(out) or not grades.graded_folders(out):
         print('rescore: no measurements.json in %s (graded before measurements were kept? run make grade '
               'again)' % out, file=sys.stderr)
         return 1
-    records, changes = runner.rescore(out)
+    records, changes = grades.rescore(out)
     print(report.table(records))
     print('%d of %d student(s) changed:' % (len(changes), len(records)) if changes else
           'no point changed for any of the %d student(s)' % len(records))
     for line in changes:
         print('  ' + safe_text.one_line(line))
-    single = runner.graded_folders(out) == [out]
+    single = grades.graded_folders(out) == [out]
     similar = None
     if not single and os.path.isfile(os.path.join(out, 'similarity.json')):
         with open(os.path.join(out, 'similarity.json')) as f:

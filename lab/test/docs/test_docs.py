@@ -378,18 +378,19 @@ def test_grading_examples_splice_replaces_only_the_block_between_its_markers():
 def test_the_worst_case_in_the_docs_is_the_codes():
     """"The worst case" paragraph states the budget, the steps' limits and the class's worst case with
     the runner's constants: a change of one is a change of the docs."""
-    from exam_lab.grader import runner
+    from exam_lab.grader import class_run, runner
+    from exam_lab.grader.host import boxed_run
     text = ' '.join(read(os.path.join(REPO, 'docs', 'grading.md')).split())
     paragraph = re.search(r'\*\*The worst case\.\*\*(.*?)nothing was run"', text).group(1)
-    jobs = runner.default_jobs(cores=2, memory=64 << 30)
+    jobs = class_run.default_jobs(cores=2, memory=64 << 30)
     student = runner.STUDENT_BUDGET + runner.AFTER_BUDGET_S
     said = ['`STUDENT_BUDGET` = %g s' % runner.STUDENT_BUDGET, '`AFTER_BUDGET_S` = %g s' % runner.AFTER_BUDGET_S,
             'build %g s' % runner.BUILD_TIMEOUT, 'node start %g s' % runner.START_TIMEOUT,
-            'a run %g s' % runner.RUN_TIMEOUT, 'the inspection %g s' % runner.INSPECT_BOUNDS[0],
+            'a run %g s' % runner.RUN_TIMEOUT, 'the inspection %g s' % boxed_run.INSPECT_BOUNDS[0],
             '%g s a student' % student, 'JOBS` on two cores (%d)' % jobs,
-            'ceil(60 / %d) × %g s = %g s (%g minutes)' % (jobs, student, runner.worst_case(60, jobs),
-                                                         runner.worst_case(60, jobs) / 60),
-            'intake %g s' % runner.INTAKE_BOUNDS[0], 'similarity check %g s' % runner.SIMILARITY_BOUNDS[0],
+            'ceil(60 / %d) × %g s = %g s (%g minutes)' % (jobs, student, class_run.worst_case(60, jobs),
+                                                         class_run.worst_case(60, jobs) / 60),
+            'intake %g s' % boxed_run.INTAKE_BOUNDS[0], 'similarity check %g s' % boxed_run.SIMILARITY_BOUNDS[0],
             'budget of %g s' % runner.STUDENT_BUDGET]
     assert [words for words in said if words not in paragraph] == []
-    assert runner.worst_case(60, jobs) <= 75 * 60
+    assert class_run.worst_case(60, jobs) <= 75 * 60

@@ -15,7 +15,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run, runner
+from exam_lab.grader.host import boxed_run
 from exam_lab.grader.publish import provenance
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
@@ -81,7 +82,7 @@ def bounds_quoted(text):
 
 def test_grading_quotes_the_bounds_of_the_boxes_that_read_student_bytes():
     expected = []
-    for wall, cpu, memory in (runner.INSPECT_BOUNDS, runner.INTAKE_BOUNDS, runner.SIMILARITY_BOUNDS):
+    for wall, cpu, memory in (boxed_run.INSPECT_BOUNDS, boxed_run.INTAKE_BOUNDS, boxed_run.SIMILARITY_BOUNDS):
         expected += [seconds(wall), seconds(cpu), gigabytes(memory)]
     assert bounds_quoted(prose(read(GRADING))) == tuple(expected)
 
@@ -93,12 +94,12 @@ def test_the_bounds_check_catches_a_stale_value():
 
 
 def test_default_jobs_is_quoted_as_the_code_computes_it():
-    # "two per core" in the docs is runner.JOBS_PER_CORE; 4 on this two-core machine with its memory.
-    assert runner.JOBS_PER_CORE == 2
+    # "two per core" in the docs is class_run.JOBS_PER_CORE; 4 on this two-core machine with its memory.
+    assert class_run.JOBS_PER_CORE == 2
     text = prose(read(GRADING) + read(os.path.join(REPO, 'docs', 'benchmarks.md')))
     assert 'two per core' in text or '2 per core' in text
     quoted = re.findall(r'`JOBS=(\d+)`?,? the default', text) + re.findall(r'the default JOBS=(\d+)', text)
-    assert all(int(q) == runner.default_jobs(cores=2, memory=24 << 30) for q in quoted), quoted
+    assert all(int(q) == class_run.default_jobs(cores=2, memory=24 << 30) for q in quoted), quoted
 
 
 # --- the test packages -----------------------------------------------------------------------------
@@ -598,11 +599,11 @@ def format_literal(path, literal):
 
 
 def rescore_change_problems(text=None):
-    """The rescore's line quoted (``late: 17 -> 15.5 (Q14b 3 -> 1.5)``) against runner.rescore_class's
+    """The rescore's line quoted (``late: 17 -> 15.5 (Q14b 3 -> 1.5)``) against grades.rescore's
     two formats, and its arithmetic: the total moves by what the items moved."""
     quote = quoted_output(r'`(\w+: [\d.]+ -> [\d.]+ \([^`]*\))`', text)
-    line = format_literal('lab/src/exam_lab/grader/runner.py', "'%s: %s -> %s (%s)'").strip("'")
-    item = format_literal('lab/src/exam_lab/grader/runner.py', "'%s %s -> %s'").strip("'")
+    line = format_literal('lab/src/exam_lab/grader/publish/grades.py', "'%s: %s -> %s (%s)'").strip("'")
+    item = format_literal('lab/src/exam_lab/grader/publish/grades.py', "'%s %s -> %s'").strip("'")
     student, old, new, moved = re.match(r'(\w+): ([\d.]+) -> ([\d.]+) \((.*)\)$', quote).groups()
     items = [re.match(r'(\w+) ([\d.]+) -> ([\d.]+)$', m).groups() for m in moved.split('; ')]
     problems = []
@@ -647,7 +648,7 @@ def test_the_missing_hand_points_check_catches_a_wrong_item():
 
 
 def slurm_problems(text=None):
-    from exam_lab.grader import runner
+    from exam_lab.grader.publish import grades
     from exam_lab.grader.engine import slurm
     problems = []
     state = quoted_output(r'`(slurm job [^`]+)`', text)
@@ -663,7 +664,7 @@ def slurm_problems(text=None):
     if words is None:
         return problems + ['not the engine\'s reason: %s' % said]
     fields = {'JobState': words.group(1), 'NodeList': words.group(2) or '(null)', 'ExitCode': words.group(3)}
-    reason = runner.could_not_grade('x', 'altitude', 'Slurm said: %s' % slurm.slurm_said(fields))['status_reason']
+    reason = grades.could_not_grade('x', 'altitude', 'Slurm said: %s' % slurm.slurm_said(fields))['status_reason']
     if reason != said:
         problems.append('not the engine\'s reason: %s (it says %s)' % (said, reason))
     return problems
@@ -703,7 +704,7 @@ def class_of_60_problems(quick):
     """What the quick start's "a class of 60 took N s (M minutes) at the default JOBS=J ... run of DATE"
     says that the benchmark's grader section did not measure."""
     measured = grader_bench_quoted(read(os.path.join(BENCH, 'grader.md')))
-    default = str(runner.default_jobs(cores=2, memory=24 << 30))
+    default = str(class_run.default_jobs(cores=2, memory=24 << 30))
     wall = measured['classes'][default][1]
     quoted = re.search(r'a class of 60 took (\d+) s \(([\d.]+) minutes\) at the default JOBS=(\d+) .*?run of '
                        r'(\d{4}-\d\d-\d\d \d\d:\d\d) UTC', quick)

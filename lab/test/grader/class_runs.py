@@ -26,10 +26,10 @@ def main_class(root):
     writes it (the page, the feedback zip, the similarity check): ``{'out', 'klass', 'records' (graded
     order), 'lines' (what the desk printed)}``."""
     import test_grade
-    from exam_lab.grader import runner
+    from exam_lab.grader import class_run
     from exam_lab.grader.publish import desk
     out, records, klass = test_grade.grade_main_class(pathlib.Path(root))
-    lines = desk.finish(str(out), records, similar=runner.class_similarity(str(klass), str(out), records))
+    lines = desk.finish(str(out), records, similar=class_run.class_similarity(str(klass), str(out), records))
     return {'out': str(out), 'klass': str(klass), 'records': records, 'lines': lines}
 
 
@@ -43,9 +43,9 @@ def fair_class(root):
 def fairness_sample(root):
     """test_fairness's sample of generated answers graded as one class: ``{'records'}``."""
     import test_fairness
-    from exam_lab.grader import runner
+    from exam_lab.grader import class_run
     klass = test_fairness.generator.write_class(test_fairness.SAMPLE, os.path.join(root, 'class'))
-    return {'records': runner.grade_class(klass, os.path.join(root, 'out'), jobs=runner.default_jobs())}
+    return {'records': class_run.grade_class(klass, os.path.join(root, 'out'), jobs=class_run.default_jobs())}
 
 
 #: The single submissions graded on a sheet named, not detected: ``name: (package, sheet)``.
@@ -66,20 +66,21 @@ def singles(root):
     import test_grade
     import test_simple_answer
     from exam_lab.grader import runner
+    from exam_lab.grader.host import underlay
     packages = {'simple_answer': test_simple_answer.SIMPLE, 'ours': test_grade.OUR_EXAM}
 
     def one(name):
         package, sheet = SINGLES[name]
         return name, runner.grade_submission(packages[package], os.path.join(root, name), sheet=sheet,
                                              jobs=SINGLES_JOBS)
-    runner.ensure_underlay(runner.default_underlay())  # once, before three gradings wait on its lock
+    underlay.ensure_underlay(underlay.default_underlay())  # once, before three gradings wait on its lock
     with concurrent.futures.ThreadPoolExecutor(max_workers=SINGLES_JOBS) as pool:
         return dict(pool.map(one, sorted(SINGLES)))
 
 
 def _class_jobs():
-    from exam_lab.grader import runner
-    return runner.default_jobs()
+    from exam_lab.grader import class_run
+    return class_run.default_jobs()
 
 
 #: ``run: (function, its weight)``; the weight is a callable (the default JOBS is this machine's).

@@ -30,8 +30,8 @@ FIRST = ('test_slurm', 'test_nonroot')
 
 def budget():
     """How many gradings the background runs hold at once: EXAM_TEST_GRADINGS, else two default JOBS."""
-    from exam_lab.grader import runner
-    return max(1, int(os.environ.get('EXAM_TEST_GRADINGS') or 2 * runner.default_jobs()))
+    from exam_lab.grader import class_run
+    return max(1, int(os.environ.get('EXAM_TEST_GRADINGS') or 2 * class_run.default_jobs()))
 
 
 class Runs(object):

@@ -13,7 +13,6 @@ test_boundary_judge, test_boundary_parsers, test_boundary_publish (issue 26). To
 student: a package in hostile/, a line in CLASS (its place in the order says who it is graded
 beside), its setup in :func:`grade` if it needs one, its tests in the module of its kind.
 """
-import fcntl
 import json
 import os
 import secrets
@@ -21,8 +20,6 @@ import shutil
 import signal
 import subprocess
 import sys
-
-from exam_lab.grader.host import uids
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
@@ -120,25 +117,6 @@ def detached_children():
         except (OSError, ValueError):
             continue
     return [pid for pid in found if pid != os.getpid()]
-
-
-def left_in_free_slots(base):
-    """The uids ``base + slot`` (a box's or a judge's, :mod:`~exam_lab.grader.host.uids`) with a process
-    while no grading holds their slot: its lock taken here (briefly; a grading then takes another slot),
-    so a process found is one left behind, whatever else grades on this machine meanwhile."""
-    left = []
-    for slot in range(uids.SLOTS):
-        path = os.path.join(uids.LOCK_DIR, 'box-%d' % slot)
-        if not os.path.exists(path):
-            continue
-        with open(path, 'a') as lock:
-            try:
-                fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError:
-                continue  # a grading holds it: its processes are its own
-            if uids.pids_of_uid(base + slot):
-                left.append(base + slot)
-    return left
 
 
 def files_under(folder):

@@ -22,10 +22,10 @@ import time
 import pytest
 
 from exam_lab.grader import runner
-from exam_lab.grader.host import limits, session, uids
+from exam_lab.grader.host import limits, session, uids, underlay
 from exam_lab.grader.score import rubric
 from exam_lab.grader.score.sheets import ITEMS
-from hostile_run import HOSTILE, NAMES, VICTIM_NAME, left_in_free_slots
+from hostile_run import HOSTILE, NAMES, VICTIM_NAME
 
 FULL = {item: points for item, (points, _) in ITEMS.items()}
 BURNER, CLOCK, PARAM_FLOOD, HOOKED, RESPAWNER = 'a_burner', 'g_clock', 'h_param_flood', 'l_hooked', 'm_respawner'
@@ -95,11 +95,9 @@ def test_the_judge_is_neither_root_nor_the_box(judged_class):
 
 
 def test_no_judge_process_is_left(judged_class, all_class_runs_done):
-    """Of the judge's uids (only this grader uses them; a box's uid may already be another grading's,
-    test_sandbox checks those), no process is left once the class is graded (and the session's other
-    class runs, graded meanwhile: conftest.py); of a slot no grading holds (another grader on this
-    machine may be running)."""
-    assert left_in_free_slots(uids.JUDGE_UID_BASE) == []
+    """Of the judge's uids (test_sandbox checks the boxes'), none whose slot no grader holds has a
+    process left once the class is graded (and the session's other class runs: conftest.py)."""
+    assert uids.left_behind(uids.JUDGE_UID_BASE) == []
 
 
 def points_of(record):
@@ -135,7 +133,7 @@ def test_a_grading_past_its_budget_ends_at_it_and_says_so(tmp_path, monkeypatch)
     what follows it, the build stopped, and its row says which budget, how large, and what it stopped."""
     if os.geteuid() != 0:
         pytest.skip('the sandbox is made by root (docs/grading.md, "Isolation")')
-    runner.ensure_underlay(runner.default_underlay())  # built before the student's time starts
+    underlay.ensure_underlay(underlay.default_underlay())  # built before the student's time starts
     monkeypatch.setattr(runner, 'STUDENT_BUDGET', BUDGET_S)
     start = time.monotonic()
     record = runner.grade_submission(os.path.join(HOSTILE, 'sleeper', 'exam'), str(tmp_path / 'out'), student='sleeper')

@@ -31,7 +31,8 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run
+from exam_lab.grader.score.records import MEASUREMENTS
 from exam_lab.grader.boxed import archives, classlist, similarity
 from exam_lab.grader.host import sandbox, staging
 from exam_lab.grader.publish import desk
@@ -115,8 +116,8 @@ def graded(tmp_path_factory):
         return stage_upload(source, target, *bounds)
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(staging, 'stage_upload', spy)
-        records = runner.grade_class(klass, out, jobs=2)
-        similar = runner.class_similarity(klass, out, records)
+        records = class_run.grade_class(klass, out, jobs=2)
+        similar = class_run.class_similarity(klass, out, records)
     lines = desk.finish(out, records, similar=similar, title='Intake class')
     before = {r['student']: r for r in records}
     rescore = runpy.run_path(os.path.join(REPO, 'lab', 'scripts', 'rescore.py'))
@@ -168,7 +169,7 @@ def test_a_name_in_any_bytes_is_shown_escaped_everywhere(graded):
     assert "'exam/lien\\xfe' -> '/tmp/cible\\xfd'" in hints, hints
     assert 'scripts/notes\\xff\\xe9.py' in read(os.path.join(graded['out'], 'Cy Bytes', 'grade.md'))
     assert 'notes\\xff\\xe9.py' in read(os.path.join(graded['out'], 'index.html'))
-    with open(os.path.join(graded['out'], 'Cy Bytes', runner.MEASUREMENTS)) as f:  # kept exactly
+    with open(os.path.join(graded['out'], 'Cy Bytes', MEASUREMENTS)) as f:  # kept exactly
         assert 'scripts/notes\udcff\udce9.py' in json.load(f)['comments']['files']
 
 

@@ -260,10 +260,10 @@ def test_a_box_without_root_reaches_nothing_of_the_teacher(user):
 def test_unsandboxed_as_a_uid_without_an_account_says_so(monkeypatch):
     """The check runs a student's package unsandboxed where no box can be made; the grade's note names
     the user even when its uid has no account (a container's, this module's): it used to raise."""
-    from exam_lab.grader import runner
+    from exam_lab.grader.publish import teacher
     uid = UIDS[-1]
     monkeypatch.setattr(os, 'geteuid', lambda: uid)
     with pytest.raises(KeyError):
         pwd.getpwuid(uid)
-    note = runner._how_run(sandbox.Box('/nonexistent', bwrap=False))
+    note = teacher.how_run(sandbox.Box('/nonexistent', bwrap=False))
     assert note.startswith('ran WITHOUT its sandbox') and 'uid %d' % uid in note

@@ -21,13 +21,13 @@ import time
 
 import pytest
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run, runner
+from exam_lab.grader.host import boxed_run
 
 from exam_lab.grader.host import egress, limits, sandbox, staging, uids
 from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
-from hostile_run import (GOOD as VICTIM, HOSTILE, NAMES, SECRET_DIR, VICTIM_NAME, files_under, left_in_free_slots,
-                         write_secrets)
+from hostile_run import GOOD as VICTIM, HOSTILE, NAMES, SECRET_DIR, VICTIM_NAME, files_under, write_secrets
 
 FULL = {item: points for item, (points, _) in ITEMS.items()}
 #: This module's students of the hostile class (the saboteur's victim is the class's one victim).
@@ -86,10 +86,9 @@ def test_a_forged_probe_file_changes_nothing(hostile_class):
 
 
 def test_no_detached_child_survives(hostile_class, all_class_runs_done):
-    """Nor any process of a box's uid once the session's classes are graded (of a slot no grading holds:
-    another grader on this machine may be running)."""
+    """Nor any process of a box's uid, of a slot no grader holds, once the session's classes are graded."""
     assert hostile_class['survivors'] == []
-    assert left_in_free_slots(uids.BOX_UID_BASE) == []
+    assert uids.left_behind(uids.BOX_UID_BASE) == []
 
 
 def test_secrets_never_reach_the_results(hostile_class):
@@ -154,8 +153,8 @@ def test_reading_student_bytes_is_bounded(tmp_path):
                 os.mkdir(os.path.join(work, sub), 0o755)
             start = time.monotonic()
             with sandbox.Box(work) as box:
-                boxed = runner.Boxed(box, work)
-                with pytest.raises(runner.InspectionFailed) as failed:
+                boxed = boxed_run.Boxed(box, work)
+                with pytest.raises(boxed_run.InspectionFailed) as failed:
                     boxed.run('timeit', ['-n', '1', '-r', '1', '-s', 'import os, time', statement],
                               records.InspectRecord, bounds)
                 assert not box.leftovers()
@@ -178,7 +177,7 @@ def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
             zf.writestr('%s/exam/package.xml' % folder, '<package><name>exam</name></package>')
     work_dirs = []
     try:
-        students = runner.class_students(archive, work_dirs)
+        students = class_run.class_students(archive, work_dirs)
         assert [name for name, _ in students] == ['Bob', 'Jane Doe']
         for _, folder in students:
             assert folder.startswith(work_dirs[0] + '/') and os.stat(folder).st_uid >= uids.BOX_UID_BASE
@@ -186,7 +185,7 @@ def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
         with zipfile.ZipFile(archive, 'a') as zf:
             zf.writestr('../outside.txt', 'x')
         with pytest.raises(archives.UnpackError, match='unpacking it in its box failed'):
-            runner.class_students(archive, work_dirs)
+            class_run.class_students(archive, work_dirs)
     finally:
         for work in work_dirs:
             shutil.rmtree(work, ignore_errors=True)
@@ -243,7 +242,7 @@ def test_no_sandbox_no_grading_unless_the_risk_is_named(monkeypatch, tmp_path):
     assert 'bubblewrap is missing' in str(refused.value)
     assert '--unsandboxed-student-code-can-read-and-damage-my-files' in str(refused.value)
     assert not os.path.exists(str(tmp_path / 'out'))
-    assert runner.sandbox_refusal(unsandboxed=True) is None
+    assert sandbox.sandbox_refusal(unsandboxed=True) is None
 
 
 def test_probe_results_must_belong_to_the_run():
@@ -299,24 +298,3 @@ def test_a_box_is_another_user_and_sees_only_its_own():
     for bad in ('ROOT_VISIBLE', 'HOST_TMP_VISIBLE', 'PACKAGE_WRITABLE', 'GRADER_SECRET', 'EXAM_LAB'):
         assert bad not in output
 
-
-def test_a_process_left_in_a_free_slot_is_found():
-    """The check of the two tests of what is left (here and test_boundary_judge, ``left_in_free_slots``)
-    can fail: a process of a box's uid is found once no grading holds its slot, and not while one does."""
-    if os.geteuid() != 0:
-        pytest.skip('the boxes\' uids are root\'s to use')
-    taken = uids.take_slot()
-    assert taken is not None, 'no free slot'
-    slot, lock = taken
-    uid = uids.BOX_UID_BASE + slot
-    sleeper = subprocess.Popen(uids.as_user(uid) + ['sleep', '120'])
-    try:
-        assert wait_until(lambda: uids.pids_of_uid(uid), 10.0), 'the process never ran as uid %d' % uid
-        assert uid not in left_in_free_slots(uids.BOX_UID_BASE), 'a grading holds the slot: its process'
-        lock.close()
-        assert uid in left_in_free_slots(uids.BOX_UID_BASE)
-    finally:
-        sleeper.kill()
-        sleeper.wait()
-        uids.end_uid(uid)
-        lock.close()

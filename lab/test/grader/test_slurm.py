@@ -365,9 +365,6 @@ def _record(out, name):
         return json.load(f)
 
 
-@pytest.mark.xfail(strict=False, reason='after the merges of 2026-11-26 one Slurm-graded student is "graded with '
-                   'fixes" where its local run is "graded", with the same points; not yet understood (issue 38 '
-                   'stays open): the assertion names the student and the fix')
 def test_each_student_gets_the_points_of_a_local_run(graded, local):
     out, code, output, _ = graded
     assert code == 0, output

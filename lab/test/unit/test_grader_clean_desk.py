@@ -17,13 +17,16 @@ import re
 
 import pytest
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run
+from exam_lab.grader.publish import grades, teacher
+from exam_lab.grader.score.records import MEASUREMENTS
 from exam_lab.grader.host import session
 
 from exam_lab.grader.publish import desk, flightplot, gradescope, moodle, page, progress, report
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 from test_grader_desk import probe_result
+from test_grader_probe_record import keep_runs
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__)))))
 #: What may not reach the teacher, written out here rather than taken from the module under test.
@@ -124,8 +127,8 @@ def out_grade_script(tmp_path, record, monkeypatch, capsys):
     """What ``grade.py --class`` prints, the grading itself replaced by the record."""
     (tmp_path / 'class').mkdir()
     os.makedirs(str(tmp_path / 'out' / record['student']))
-    monkeypatch.setattr(runner, 'grade_class', lambda *args, **kwargs: [record])
-    monkeypatch.setattr(runner, 'class_similarity', lambda *args: {'pairs': [], 'students': 1})
+    monkeypatch.setattr(class_run, 'grade_class', lambda *args, **kwargs: [record])
+    monkeypatch.setattr(class_run, 'class_similarity', lambda *args: {'pairs': [], 'students': 1})
     assert _grade_script().main(['--class', str(tmp_path / 'class'), '--out', str(tmp_path / 'out')]) == 0
     printed = capsys.readouterr()
     assert 'need the teacher' in printed.out and 'Eve' in printed.out
@@ -153,7 +156,7 @@ def test_the_record_is_clean_where_it_is_made():
                                      % HOSTILE)
     assert CONTROL.findall(outcome['tail']) == [] and '17/17 graded' in outcome['tail']
     run = {'tag': 'main', 'launch': {'tail': HOSTILE}}
-    notes = runner.hints({}, {'build': None, 'runs': [run]}, [], None, True)
+    notes = teacher.hints({}, {'build': None, 'runs': [run]}, [], None, True)
     record = report.grade_record('Eve', 'altitude', hostile_record()['items'], notes,
                                  {'documents': hostile_record()['documents']}, ('needs a hand grade', HOSTILE))
     assert [s for s in strings(record) if CONTROL.search(s)] == []
@@ -221,10 +224,8 @@ def test_extreme_values_are_drawn_clamped_and_said(tmp_path):
 
 def test_a_student_with_extreme_values_gets_its_plot_on_the_page(tmp_path):
     out = tmp_path / 'out'
-    logs = out / 'Eve' / 'logs'
-    os.makedirs(str(logs))
-    with open(str(logs / 'probe-main.json'), 'w') as f:
-        json.dump(extreme_probe(), f)  # Infinity, NaN: what json writes of them, and reads back
+    # Infinity, NaN: what json writes of them, and reads back; kept as they are (no record would take them)
+    keep_runs(str(out / 'Eve'), [('main', extreme_probe())], checked=False)
     record = report.grade_record('Eve', 'altitude', hostile_record()['items'], [], {})
     lines = desk.finish(str(out), [record])
     assert os.path.isfile(str(out / 'Eve' / 'flight.png'))
@@ -239,9 +240,7 @@ def class_desk(tmp_path):
     for number, name in enumerate(('Ada', 'Bob', 'Eve'), 101):
         items = [{'id': item, 'points': top, 'max': top, 'evidence': 'ok'} for item, (top, _) in ITEMS.items()]
         record = report.grade_record(name, 'altitude', items, ['hint'], {'participant': number})
-        os.makedirs(str(out / name / 'logs'))
-        with open(str(out / name / 'logs' / 'probe-main.json'), 'w') as f:
-            json.dump(probe_result(), f)
+        keep_runs(str(out / name), [('main', probe_result())])
         report.write_grade(str(out / name), record)
         records.append(record)
     worksheet = tmp_path / 'ws.csv'
@@ -335,12 +334,12 @@ def test_a_name_in_any_bytes_is_kept_exactly_by_a_rescore(tmp_path):
                 'isolate': True, 'how_run': None, 'session': {'build': None, 'runs': [], 'error': 'x'},
                 'extra': {'participant': 3, 'folder': 'Cy_3_assignsubmission_file_', 'documents': [], 'seconds': 1.0}}
     os.makedirs(str(out / 'Cy'))
-    with open(str(out / 'Cy' / runner.MEASUREMENTS), 'w') as f:
+    with open(str(out / 'Cy' / MEASUREMENTS), 'w') as f:
         json.dump(measured, f)
     for _ in range(2):
-        records, _ = runner.rescore(str(out))
+        records, _ = grades.rescore(str(out))
         assert desk.finish(str(out), records)[-1].startswith('page: ')
-    with open(str(out / 'Cy' / runner.MEASUREMENTS)) as f:
+    with open(str(out / 'Cy' / MEASUREMENTS)) as f:
         assert json.load(f)['comments']['files'] == ['scripts/' + NOT_UTF8]
     assert 'scripts/notes\\xff\\xe9.py' in _read(str(out / 'Cy' / 'grade.md'))
     assert 'scripts/notes\\xff\\xe9.py' in _read(str(out / 'index.html'))

@@ -14,6 +14,7 @@ from exam_lab.grader.boxed import documents
 
 from exam_lab.grader.publish import desk, flightplot, gradescope, hand, page, progress, report
 from exam_lab.grader.score.sheets import ITEMS
+from test_grader_probe_record import keep_runs
 
 T0 = 1000.0
 
@@ -152,10 +153,7 @@ def test_finish_writes_the_desk_for_a_class(tmp_path):
     out = str(tmp_path)
     records = [record('Jane Doe', participant=101), record('Paul', {'Q11': 1.5}, participant=102)]
     for r in records:
-        logs = os.path.join(out, r['student'], 'logs')
-        os.makedirs(logs)
-        with open(os.path.join(logs, 'probe-main.json'), 'w') as f:
-            json.dump(probe_result(), f)
+        keep_runs(os.path.join(out, r['student']), [('main', probe_result())])
         report.write_grade(os.path.join(out, r['student']), r)
     worksheet = tmp_path / 'ws.csv'
     worksheet.write_text('\ufeffIdentifier,Full name,Grade,Maximum grade,Last modified (grade),Feedback comments\n'
@@ -175,6 +173,39 @@ def test_finish_writes_the_desk_for_a_class(tmp_path):
     assert any(l.startswith('hand points: %s' % os.path.join(out, 'hand.csv')) for l in lines)
     assert sorted((h.student, h.participant) for h in hand.read(os.path.join(out, 'hand.csv')).values()) == \
         [('Jane Doe', 101), ('Paul', 102)]
+
+
+def test_the_plot_draws_the_kept_measurements_never_a_file_in_the_logs(tmp_path):
+    """The flight plot reads the session's record in measurements.json: a probe-main.json in logs/ (a
+    forged one, a stale one) is not what it draws; a run whose result was refused for its times is."""
+    folder = str(tmp_path / 'Jane')
+    os.makedirs(os.path.join(folder, 'logs'))
+    with open(os.path.join(folder, 'logs', 'probe-main.json'), 'w') as f:
+        json.dump(dict(probe_result(), threshold=999.0), f)
+    assert flightplot.load_runs(folder) == []
+    keep_runs(folder, [('main', probe_result())])
+    runs = flightplot.load_runs(folder)
+    assert [(tag, probe['threshold'], probe['calls']) for tag, probe in runs] == [
+        ('main', 1300.0, probe_result()['calls'])]
+    with open(os.path.join(folder, 'measurements.json')) as f:
+        kept = json.load(f)
+    kept['session']['runs'][0]['refused_probe'] = kept['session']['runs'][0].pop('probe')
+    kept['session']['runs'][0]['probe'] = None
+    with open(os.path.join(folder, 'measurements.json'), 'w') as f:
+        json.dump(kept, f)
+    assert [(tag, probe['threshold']) for tag, probe in flightplot.load_runs(folder)] == [('main', 1300.0)]
+
+
+def test_the_page_shows_the_grade_record_it_was_given_not_grade_md_read_back(tmp_path):
+    out = str(tmp_path)
+    jane = record('Jane Doe', participant=101)
+    report.write_grade(os.path.join(out, 'Jane Doe'), jane)
+    with open(os.path.join(out, 'Jane Doe', 'grade.md'), 'w') as f:
+        f.write('# Jane Doe\n\nSTALE words of an older grading\n')
+    desk.finish(out, [jane])
+    with open(os.path.join(out, 'index.html')) as f:
+        text = f.read()
+    assert 'STALE' not in text and 'what is checked' in text
 
 
 def test_pdf_pages(tmp_path):

@@ -5,7 +5,7 @@ import os
 
 import pytest
 
-from exam_lab.grader.boxed import launch, source
+from exam_lab.grader.boxed import derive, launch, source
 
 from exam_lab.grader.host import session
 from exam_lab.grader.judge import probe
@@ -14,7 +14,7 @@ from exam_lab.grader.score import rubric
 
 from exam_lab.grader.publish import report
 
-from test_grader_rubric import STATIC, SCHEDULE, lost, measured, points
+from test_grader_rubric import STATIC, SCHEDULE, flown, lost, measured, points
 
 
 def main_of(session_record):
@@ -132,7 +132,7 @@ def test_launch_comments_and_a_package_named_otherwise(tmp_path):
     analysis = launch.analyse(str(pkg / 'launch' / 'a.launch'), str(pkg), 'exam_pkg')
     assert [n.type for n in analysis.exam_nodes] == ['n.py'] and analysis.starts_drone('altitude')
     assert analysis.comments() == 1
-    assert launch.threshold_param(analysis, 'altitude')[0].name == '/n/seuil'
+    assert derive.threshold_param(analysis, 'altitude')[0].name == '/n/seuil'
     assert launch.analyse(str(pkg / 'launch' / 'a.launch'), str(pkg)).exam_nodes == []
 
 
@@ -213,12 +213,12 @@ def test_reports_say_the_status():
 def test_jobs_default_two_per_core_within_memory():
     """JOBS when the teacher gives none: two gradings per core (make bench's grader stage measured that
     no point moves), fewer when the memory cannot hold them, never 0."""
-    from exam_lab.grader import runner
+    from exam_lab.grader import class_run
     gib = 1 << 30
-    assert runner.default_jobs(cores=2, memory=24 * gib) == 4
-    assert runner.default_jobs(cores=16, memory=8 * gib) == 8
-    assert runner.default_jobs(cores=1, memory=gib // 2) == 1
-    assert runner.default_jobs() >= 1
+    assert class_run.default_jobs(cores=2, memory=24 * gib) == 4
+    assert class_run.default_jobs(cores=16, memory=8 * gib) == 8
+    assert class_run.default_jobs(cores=1, memory=gib // 2) == 1
+    assert class_run.default_jobs() >= 1
 
 
 def test_grade_refuses_jobs_below_one(capsys):
@@ -230,3 +230,187 @@ def test_grade_refuses_jobs_below_one(capsys):
         grade.main(['--class', '/nonexistent', '--jobs', '0'])
     assert stopped.value.code == 2
     assert '--jobs (JOBS) must be 1 or more, not 0' in capsys.readouterr().err
+
+
+# --- issue 35: a late NORMAL, and a WARNING at the next reading of the slowest input ------------------
+
+class SyntheticClock(object):
+    """The wall clock of the probe and of ``wait_until``, advanced only by their sleeps: a flight of
+    100 s runs in a moment, and the same every time."""
+
+    def __init__(self, now=1000.0):
+        self.now = now
+
+    def time(self):
+        return self.now
+
+    monotonic = time
+
+    def sleep(self, seconds):
+        self.now += max(0.0, seconds)
+
+
+class ScriptedNode(object):
+    """A student's node on the synthetic clock: its own value follows the flown value ``lag`` s later,
+    published at 10 Hz; at each tick it warns after ``DELAY`` s above, and goes back to NORMAL after
+    ``normal_after`` s below (0: at once; None: never)."""
+
+    DELAY = 5.0
+
+    def __init__(self, clock, threshold=1300.0, normal_after=0.0, lag=0.1):
+        self.clock, self.threshold, self.normal_after, self.lag = clock, threshold, normal_after, lag
+        self.flown = [(clock.now, threshold - 130.0)]
+        self.tick = clock.now
+        self.above_since = self.below_since = None
+        self.warning = False
+        self.made = []
+
+    def fly(self, x):
+        self.flown.append((self.clock.now, x))
+        return self.clock.now
+
+    def value(self, t):
+        return [x for at, x in self.flown if at <= t - self.lag][-1] if t - self.lag >= self.flown[0][0] else None
+
+    def samples(self, since, until=None):
+        end = min(self.clock.now, until if until is not None else self.clock.now)
+        first = self.flown[0][0] + 0.1 * max(0, int((since - self.flown[0][0]) / 0.1))
+        out = []
+        t = first
+        while t <= end + 1e-9:
+            v = self.value(t)
+            if v is not None and t >= since:
+                out.append((t, v))
+            t += 0.1
+        return out
+
+    def calls(self):
+        while self.tick + 0.1 <= self.clock.now:
+            self.tick += 0.1
+            v = self.value(self.tick)
+            if v is None:
+                continue
+            if v > self.threshold:
+                self.below_since = None
+                self.above_since = self.tick if self.above_since is None else self.above_since
+                if self.tick - self.above_since >= self.DELAY - 1e-9 and not self.warning:
+                    self.made.append((self.tick, 'WARNING'))
+                    self.warning = True
+            else:
+                self.above_since = None
+                self.below_since = self.tick if self.below_since is None else self.below_since
+                if self.warning and self.normal_after is not None and \
+                        self.tick - self.below_since >= self.normal_after - 1e-9:
+                    self.made.append((self.tick, 'NORMAL'))
+                    self.warning = False
+        return list(self.made)
+
+
+def synthetic_flight(monkeypatch, node, clock, rates, warned_before=False):
+    """The probe's flight (probe.Probe.flight, unchanged) around a scripted node on the synthetic
+    clock; ``warned_before``: its value was above for 6 s just before (the calibration's high point),
+    so it gave a WARNING there. Returns the main run's session record, scored as the grader does."""
+    from exam_lab.harness import wait
+    monkeypatch.setattr(probe, 'time', clock)
+    monkeypatch.setattr(wait, 'time', clock)
+    flying = object.__new__(probe.Probe)
+    flying.plan = {'threshold': 1300.0, 'delay': 5.0, 'late_warning': 60.0}
+    flying.recorder = node
+    flying.drone = type('Drone', (), {'rates': rates, 'service': type('Service', (), {'calls': node.calls})()})()
+    flying.graph = type('Graph', (), {'student_nodes': lambda self: ['/exam']})()
+    flying.result = {}
+    flying.fly = node.fly
+    if warned_before:
+        node.fly(1430.0)
+        clock.sleep(6.0)
+        node.fly(1299.9)
+        clock.sleep(1.0)
+    flying.flight(1170.0, 1430.0, 1299.9)
+    record = measured(calls=[[t, s] for t, s in node.calls()])
+    main = main_of(record)
+    main.update(schedule=flying.result['schedule'], legs=flying.result['legs'], threshold=1300.0,
+                input_rates=dict(rates))
+    main['calibration']['near'] = {'x': 1299.9, 'value': 1299.9, 'target': 1299.9}
+    return record
+
+
+ALTITUDE_RATES = {'temperature': 0.778, 'pressure': 2.0}
+
+
+def test_a_node_back_to_normal_after_the_delay_loses_at_once_only(monkeypatch):
+    """NORMAL only after 5 s below (a time, not a margin): the last leg waits for it, so the node loses
+    Q14b's "at once" (0.5) only, not Q13's NORMAL as well."""
+    clock = SyntheticClock()
+    record = synthetic_flight(monkeypatch, ScriptedNode(clock, normal_after=5.0), clock, ALTITUDE_RATES)
+    assert lost(record) == {'Q14b': 0.5}
+    q14b = [i for i in rubric.score('altitude', STATIC, record) if i['id'] == 'Q14b'][0]['evidence']
+    assert 'it waits for a time, not at once' in q14b and 'margin' not in q14b, q14b
+    q13 = [i for i in rubric.score('altitude', STATIC, record) if i['id'] == 'Q13'][0]['evidence']
+    assert 'the NORMAL came late, 5.0 s after the value came back below' in q13, q13
+
+
+def test_a_warning_left_from_the_calibration_does_not_hide_the_flights(monkeypatch):
+    """The same node warned during the calibration (its value above for 6 s): the rest waits for its
+    NORMAL, so the long excursion sees its WARNING; it loses the 0.5 alone."""
+    clock = SyntheticClock()
+    node = ScriptedNode(clock, normal_after=5.0)
+    record = synthetic_flight(monkeypatch, node, clock, ALTITUDE_RATES, warned_before=True)
+    schedule = main_of(record)['schedule']
+    assert [s for t, s in node.calls() if t < schedule['short_up']] == ['WARNING', 'NORMAL']
+    assert lost(record) == {'Q14b': 0.5}
+
+
+def test_a_right_node_flies_as_long_as_before_and_the_wait_is_bounded(monkeypatch):
+    """A right node (NORMAL at once) owes nothing: no leg waits, whether it warned before or not. One
+    that never goes back to NORMAL makes the rest (it warned before) and the last leg wait, each up to
+    normal_wait after its own value came back below."""
+    rests, lasts = {}, {}
+    for name, normal_after, before in (('right', 0.0, False), ('right, warned before', 0.0, True),
+                                       ('never', None, False), ('never, warned before', None, True)):
+        clock = SyntheticClock()
+        record = synthetic_flight(monkeypatch, ScriptedNode(clock, normal_after=normal_after), clock,
+                                  ALTITUDE_RATES, warned_before=before)
+        schedule = main_of(record)['schedule']
+        rests[name] = schedule['short_up'] - schedule['rest']
+        lasts[name] = schedule['end'] - schedule['long_down']
+        if normal_after == 0.0:
+            assert lost(record) == {}, name
+        else:
+            assert lost(record) == {'Q13': 2.0, 'Q14b': 0.5} or before, name
+    wait = probe.normal_wait(5.0, ALTITUDE_RATES)
+    assert wait == pytest.approx(5.0 + probe.AFTER_S + 1 / 0.778)
+    # (a value already below when the rest begins reaches it at once, not a tick later)
+    assert rests['right, warned before'] == pytest.approx(rests['right'], abs=0.15)
+    assert rests['never'] == pytest.approx(rests['right'])
+    assert lasts['right, warned before'] == pytest.approx(lasts['right'], abs=0.15)
+    assert rests['never, warned before'] - rests['right'] == pytest.approx(wait - probe.REST_S, abs=0.15)
+    assert lasts['never'] - lasts['right'] == pytest.approx(wait - probe.BACK_S - probe.DEEP_S, abs=0.3)
+
+
+def test_owes():
+    calls = [(1.0, 'WARNING'), (2.0, 'NORMAL'), (3.0, 'WARNING')]
+    assert probe.owes(calls, 'below', 0.0) and not probe.owes(calls[:2], 'below', 0.0)
+    assert not probe.owes([], 'below', 0.0) and not probe.owes([(1.0, 'whatever')], 'below', 0.0)
+    assert probe.owes(calls, 'above', 3.5) and not probe.owes(calls, 'above', 2.5)
+
+
+def _sheets_drones():
+    from exam_lab.harness import fake_drone
+    return [(sheet, fake_drone.SHEETS[sheet]['rates']) for sheet in ('altitude', 'depth')]
+
+
+@pytest.mark.parametrize('sheet, rates', _sheets_drones())
+def test_a_warning_at_the_next_reading_of_the_slowest_input_is_on_time(sheet, rates):
+    """A node that checks its time stamps at each synchronised pair warns at the first pair at or after
+    5 s: up to one period of the slowest input later (c18: 5.98 s on the depth drone's 1 Hz). On time up
+    to that and a tick, from the sheet's drone's own rates; the long excursion lasts past it."""
+    period = 1.0 / min(rates.values())
+    late = 5.0 + max(rubric.WARNING_LATE_S, period + 1.0 / rubric.RATE_HZ)
+    early = 5.0 - rubric.WARNING_EARLY_S
+    assert late < 5.0 + probe.AFTER_S, 'the long excursion must outlast the window'
+    for latency, ok in ((early - 0.01, False), (early + 0.01, True), (5.0 + period - 0.02, True),
+                        (late - 0.01, True), (late + 0.01, False)):
+        record = flown([[7.6 + latency, 'WARNING'], [14.6 + 0.05, 'NORMAL']])
+        main_of(record)['input_rates'] = dict(rates)
+        assert lost(record) == ({} if ok else {'Q14b': 1.5}), (sheet, latency)
+        assert rubric.warning_window(main_of(record)) == pytest.approx((early, late))

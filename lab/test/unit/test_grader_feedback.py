@@ -7,6 +7,7 @@ import html
 import json
 import os
 import re
+import warnings
 import zipfile
 from html.parser import HTMLParser
 
@@ -16,6 +17,8 @@ from exam_lab.grader.publish import feedback, hand, report, student_view
 from exam_lab.grader.score import identity
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 from test_grader_desk import probe_result as desk_probe_result
+from test_grader_moodle_names import download_path, moodle_import
+from test_grader_probe_record import keep_runs
 
 #: The value the threshold run flew at: in the teacher's files, never in a student's.
 HIDDEN = '1040'
@@ -40,31 +43,9 @@ DOWNLOADS = [
 ]
 
 
-def moodle_import(path, participants):
-    """What Moodle's importer does with one file of the zip (mod/assign/feedback/file/importziplib.php,
-    is_valid_filename_for_import, ported line by line): ``(participant, subtype, type, filename)``, or
-    None when it skips the file. ``participants``: the assignment's unique ids."""
-    directory, _, name = path.rpartition('/')
-    if not name or name.startswith('.') or name.startswith('~'):
-        return None
-    parts = ('/import/%s/%s' % (directory, name) if directory else '/import/' + name).split('/')
-    while parts:
-        info = parts.pop(0).split('_', 4)
-        if len(info) < 4 or not re.match(r'^\s*[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\s*$', info[1]):
-            continue
-        number = int(float(info[1]))
-        if number not in participants or (info[2], info[3]) not in (('assignfeedback', 'file'),
-                                                                     ('assignsubmission', 'file')):
-            continue
-        parts.insert(0, info[4] if len(info) == 5 else '')
-        return number, info[2], info[3], '/'.join(parts)
-    return None
-
-
 def download_folder(fullname, number, last):
-    """A download folder by Moodle's rule: the feedback folder's rule with the submission plugin."""
-    prefix = feedback.clean_filename('%s_%d' % (fullname.replace('_', ' '), number))
-    return feedback.clean_filename('%s_assignsubmission_file%s' % (prefix, last))
+    """A download folder by Moodle's rule (test_grader_moodle_names' port, not the product's)."""
+    return download_path(fullname, number, '', '3.1' if last else '4.1').rstrip('/')
 
 
 @pytest.mark.parametrize('folder, fullname, number', DOWNLOADS)
@@ -135,13 +116,12 @@ def graded_class(out, records, threshold_run=True, requests=('WARNING', 'NORMAL'
     for r in records:
         logs = os.path.join(out, r['student'], 'logs')
         os.makedirs(logs)
-        with open(os.path.join(logs, 'probe-main.json'), 'w') as f:
-            json.dump(probe_result(requests=requests), f)
+        runs = [('main', probe_result(requests=requests))]
         if threshold_run:
             with open(os.path.join(logs, 'plan-threshold.json'), 'w') as f:
                 json.dump({'threshold': float(HIDDEN)}, f)
-            with open(os.path.join(logs, 'probe-threshold.json'), 'w') as f:
-                json.dump(probe_result('threshold', threshold=float(HIDDEN)), f)
+            runs.append(('threshold', probe_result('threshold', threshold=float(HIDDEN))))
+        keep_runs(os.path.join(out, r['student']), runs)
         report.write_grade(os.path.join(out, r['student']), r)
 
 
@@ -329,7 +309,10 @@ def test_a_students_text_is_escaped(tmp_path):
                evidence={'Q11': 'publisher: %s std_msgs/Float32' % topic, 'runs': 'builds; but: main run: %s' % log},
                reason='the node printed %s' % log, status='graded with fixes')
     graded_class(out, [r], requests=('"WARNING"\x07<b>', 'NORMAL'))
-    feedback.write(out, [r], show='evidence')
+    with warnings.catch_warnings(record=True) as caught:  # a control character the plot cannot draw
+        warnings.simplefilter('always')
+        feedback.write(out, [r], show='evidence')
+    assert [str(w.message) for w in caught if 'Glyph' in str(w.message)] == []
     got = pages(out)
     assert list(got) == ['Eve b_9_assignfeedback_file_/feedback.html']  # Moodle's rule drops < >
     text = got['Eve b_9_assignfeedback_file_/feedback.html']
@@ -339,7 +322,7 @@ def test_a_students_text_is_escaped(tmp_path):
     shown = ''.join(parsed.text)
     assert topic in shown and '\'single\' "double" </td></tr><img src=x onerror=alert(1)> end' in shown
     assert '&lt;script&gt;alert(&quot;x&quot;)' in text
-    assert 'REFUSED ""WARNING"<b" call (1)' in shown  # its first 12 characters, the bell gone  # the plot's label, a student's request, as text
+    assert 'REFUSED ""WARNING"<b>" call (1)' in shown  # the plot's label, a student's request, as text: its first 12 characters once the bell was gone (the probe's record made it safe)
 
 
 def test_hand_points_merged_or_left_out(tmp_path):
@@ -365,7 +348,8 @@ def test_hand_points_merged_or_left_out(tmp_path):
 
 
 def test_the_same_grade_gives_the_same_bytes(tmp_path):
-    """Moodle imports only a new or changed file: a rescore that moves nothing must change no page."""
+    """A rescore that moves nothing changes no page (Moodle replaces every page of an upload all the same:
+    the teacher can tell by the bytes whose page moved)."""
     out = str(tmp_path)
     r = record('Ann', folder='Ann_5_assignsubmission_file_')
     graded_class(out, [r])

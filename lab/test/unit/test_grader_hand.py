@@ -183,10 +183,10 @@ def moodle_record(folder, total):
 
 
 def named_as_a_run_names_them(records):
-    """Each record's name made unique as a class run does (runner._unique, in the folders' order)."""
-    from exam_lab.grader import runner
+    """Each record's name made unique as a class run does (class_run._unique, in the folders' order)."""
+    from exam_lab.grader import class_run
     records = sorted(records, key=lambda r: r['folder'])
-    names = runner._unique([(r['student'], r['folder']) for r in records])
+    names = class_run._unique([(r['student'], r['folder']) for r in records])
     return [dict(r, student=name) for r, (name, _) in zip(records, names)]
 
 
@@ -330,20 +330,21 @@ def test_a_late_classmate_of_the_same_name_never_takes_the_first_ones_folder(tmp
     1002 in OUT/Jane Doe and gives 1001 a folder of her own. A folder of OUT that is a participant's
     not in this run is not given to anyone either."""
     import json
-    from exam_lab.grader import runner
+    from exam_lab.grader import class_run
+    from exam_lab.grader.score.records import MEASUREMENTS
     out = tmp_path / 'out'
     (out / 'Jane Doe').mkdir(parents=True)
-    (out / 'Jane Doe' / runner.MEASUREMENTS).write_text(json.dumps({'extra': {'participant': 1002}}))
+    (out / 'Jane Doe' / MEASUREMENTS).write_text(json.dumps({'extra': {'participant': 1002}}))
     (out / 'Paul').mkdir()
     (out / 'Paul' / 'grade.json').write_text(json.dumps({'folder': 'Paul_7_assignsubmission_file_'}))
     (out / 'Paul' / 'logs').mkdir()
-    assert runner.kept_folders(str(out)) == {1002: 'Jane Doe', 7: 'Paul'}
+    assert class_run.kept_folders(str(out)) == {1002: 'Jane Doe', 7: 'Paul'}
     class_ = [('Jane Doe', '/c/Jane Doe._1001_assignsubmission_file_'),
               ('Jane Doe', '/c/Jane Doe_1002_assignsubmission_file_'), ('Paul', '/c/Paul_8_assignsubmission_file_')]
-    assert runner._unique(class_, runner.kept_folders(str(out))) == [
+    assert class_run._unique(class_, class_run.kept_folders(str(out))) == [
         ('Jane Doe_2', class_[0][1]), ('Jane Doe', class_[1][1]), ('Paul_2', class_[2][1])]
-    assert runner._unique(class_) == [('Jane Doe', class_[0][1]), ('Jane Doe_2', class_[1][1]), ('Paul', class_[2][1])]
+    assert class_run._unique(class_) == [('Jane Doe', class_[0][1]), ('Jane Doe_2', class_[1][1]), ('Paul', class_[2][1])]
     folders = tmp_path / 'class'
     for _, path in class_:
         (folders / path.split('/')[-1]).mkdir(parents=True)
-    assert [name for name, _ in runner.class_students(str(folders), [], out=str(out))] == ['Jane Doe_2', 'Jane Doe', 'Paul_2']
+    assert [name for name, _ in class_run.class_students(str(folders), [], out=str(out))] == ['Jane Doe_2', 'Jane Doe', 'Paul_2']

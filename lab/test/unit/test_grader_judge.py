@@ -117,3 +117,19 @@ def test_the_judges_drone_is_the_sheets_drone():
         assert all(fake_drone.TEST_RATES[sheet][t] > hz for t, hz in drone['rates'].items())
     assert fake_drone.SHEETS['altitude']['rates'] == {'temperature': 0.778, 'pressure': 2.0}
     assert fake_drone.SHEETS['depth']['rates'] == {'pressure_robot': 2.0, 'pressure_remote': 1.0}
+
+
+def test_what_runs_in_a_slot_no_grader_holds_is_left_behind(tmp_path, monkeypatch):
+    """Slot 1 held by a grader (its lock taken, as another grader's would be), slot 2 free: both uids
+    have a process; only the free slot's is a leftover, and looking takes no slot from anyone."""
+    import fcntl
+    monkeypatch.setattr(uids, 'LOCK_DIR', str(tmp_path))
+    running = {uids.BOX_UID_BASE + 1, uids.BOX_UID_BASE + 2}
+    monkeypatch.setattr(uids, 'pids_of_uid', lambda uid: [4242] if uid in running else [])
+    for slot in (1, 2):
+        (tmp_path / ('box-%d' % slot)).write_text('')
+    with open(str(tmp_path / 'box-1')) as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        assert uids.left_behind(uids.BOX_UID_BASE) == [uids.BOX_UID_BASE + 2]
+        assert uids.left_behind(uids.JUDGE_UID_BASE) == []
+    assert uids.left_behind(uids.BOX_UID_BASE) == sorted(running)

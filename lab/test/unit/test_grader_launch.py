@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from exam_lab.grader.boxed import launch
+from exam_lab.grader.boxed import derive, launch
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 SUBMISSIONS = os.path.join(HERE, '..', 'grader', 'submissions')
@@ -48,7 +48,7 @@ def test_threshold_found_however_it_is_set(tmp_path, name, sheet, param, value):
     assert analysis.problems == []
     assert analysis.starts_drone(sheet)
     assert [n.pkg for n in analysis.exam_nodes] == ['exam']
-    found, _ = launch.threshold_param(analysis, sheet)
+    found, _ = derive.threshold_param(analysis, sheet)
     assert found is not None and found.name == param
     assert launch.as_number(found.value) == float(value)
 
@@ -57,24 +57,24 @@ def test_threshold_found_however_it_is_set(tmp_path, name, sheet, param, value):
 def test_derived_launch_has_no_drone_and_the_new_threshold(tmp_path, name):
     pkg = copy_submission(tmp_path, name)
     analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
-    found, _ = launch.threshold_param(analysis, 'depth' if name == 'one_subscriber' else 'altitude')
-    derived = launch.derive(analysis, 'threshold', {found.origin: 1040.0})
+    found, _ = derive.threshold_param(analysis, 'depth' if name == 'one_subscriber' else 'altitude')
+    derived = derive.derive(analysis, 'threshold', {found.origin: 1040.0})
     again = launch.analyse(derived, pkg)
     assert [n.pkg for n in again.nodes] == ['exam'], 'only the exam node runs'
     assert [launch.as_number(p.value) for p in again.params if p.name == found.name] == [1040.0]
     # The student's own file is untouched, and a second derivation starts from it.
-    assert launch.as_number(launch.threshold_param(launch.analyse(analysis.path, pkg), 'altitude')[0].value) != 1040.0
-    main = launch.analyse(launch.derive(analysis, 'main'), pkg)
+    assert launch.as_number(derive.threshold_param(launch.analyse(analysis.path, pkg), 'altitude')[0].value) != 1040.0
+    main = launch.analyse(derive.derive(analysis, 'main'), pkg)
     assert [launch.as_number(p.value) for p in main.params if p.name == found.name] != [1040.0]
 
 
 def test_our_exam_package_per_sheet():
     pkg = os.path.abspath(os.path.join(REPO, 'exam'))
-    analyses = [launch.analyse(p, pkg) for p in launch.launch_files(pkg)]
+    analyses = [launch.analyse(p, pkg) for p in derive.launch_files(pkg)]
     for sheet, expected in (('altitude', 'exam.launch'), ('depth', 'exam_submarine.launch')):
-        chosen = launch.choose(analyses, sheet)
+        chosen = derive.choose(analyses, sheet)
         assert os.path.basename(chosen.path) == expected
-        found, _ = launch.threshold_param(chosen, sheet)
+        found, _ = derive.threshold_param(chosen, sheet)
         assert found.name == '/exam/threshold'
         assert found.origin.element.tag == 'arg', 'the value lives in the <arg> default'
 
@@ -103,10 +103,10 @@ def test_group_namespace_include_and_yaml_file(tmp_path):
     names = {p.name: p.value for p in analysis.params}
     assert names == {'/drone1/exam/threshold': 1400, '/drone1/exam/limits/max_altitude': 1300,
                      '/drone1/exam/rate': 10}
-    found, _ = launch.threshold_param(analysis, 'altitude')
+    found, _ = derive.threshold_param(analysis, 'altitude')
     assert found.name == '/drone1/exam/threshold'
     assert found.origin.path.endswith('exam.launch'), 'followed to the <include>\'s <arg value>'
-    derived = launch.derive(analysis, 'x', {found.origin: 999})
+    derived = derive.derive(analysis, 'x', {found.origin: 999})
     tree = ET.parse(derived)
     include = tree.getroot().find('group/include')
     assert include.get('file') == '$(find exam)/launch/.grader-x-node.launch', 'a path the run box resolves'
@@ -116,7 +116,7 @@ def test_group_namespace_include_and_yaml_file(tmp_path):
     assert node.get('launch-prefix') is None and node.get('output') == 'screen'
     # A YAML file's value is changed in a copy of the file.
     yaml_param = [p for p in analysis.params if p.name.endswith('max_altitude')][0]
-    derived = launch.derive(analysis, 'y', {yaml_param.origin: 1111})
+    derived = derive.derive(analysis, 'y', {yaml_param.origin: 1111})
     node = ET.parse(os.path.join(pkg, 'launch', '.grader-y-node.launch')).getroot().find('node')
     loaded = node.find('rosparam').get('file')
     assert loaded == '$(find exam)/config/.grader-y-params.yaml'
@@ -130,13 +130,13 @@ def test_no_threshold_and_broken_files(tmp_path):
                            '</node></launch>',
         'launch/b.launch': '<launch><node pkg="exam"',
         'launch/c.launch': '<launch><param name="x" value="$(eval 1+1)"/></launch>'})
-    a, b, c = [launch.analyse(p, pkg) for p in launch.launch_files(pkg)]
-    found, why = launch.threshold_param(a, 'altitude')
+    a, b, c = [launch.analyse(p, pkg) for p in derive.launch_files(pkg)]
+    found, why = derive.threshold_param(a, 'altitude')
     assert found is None and '/exam/rate' in why, 'a rate is never taken for a threshold'
     assert b.problems and 'not valid XML' in b.problems[0]
     assert c.problems and 'eval' in c.problems[0]
-    assert launch.choose([b, c], 'altitude') is None
-    assert launch.choose([b, a, c], 'altitude') is a
+    assert derive.choose([b, c], 'altitude') is None
+    assert derive.choose([b, a, c], 'altitude') is a
 
 
 def test_value_alone_identifies_a_threshold(tmp_path):
@@ -144,8 +144,8 @@ def test_value_alone_identifies_a_threshold(tmp_path):
                                                    '<param name="h" value="150"/><param name="k" value="3"/>'
                                                    '</node></launch>'})
     analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
-    assert launch.threshold_param(analysis, 'depth')[0].name == '/exam/h'
-    assert launch.threshold_param(analysis, 'altitude')[0] is None
+    assert derive.threshold_param(analysis, 'depth')[0].name == '/exam/h'
+    assert derive.threshold_param(analysis, 'altitude')[0] is None
 
 
 # --- what the analysis reads: the student's package and the box's environment only (issue 26) ------
@@ -165,7 +165,7 @@ def test_env_substitutions_see_the_box_never_the_grader(tmp_path, monkeypatch):
         analysis = launch.analyse(path, pkg) if env is None else launch.analyse(path, pkg, 'exam', env)
         seen = repr([(p.name, p.value) for p in analysis.params]) + repr(analysis.problems)
         assert 'hunter2' not in seen
-        assert launch.threshold_param(analysis, 'altitude')[0].value == 1300, 'the default: unset in the box'
+        assert derive.threshold_param(analysis, 'altitude')[0].value == 1300, 'the default: unset in the box'
     assert {p.name: p.value for p in analysis.params}['/exam/home'] == boxenv.BOX_HOME
 
 
@@ -199,9 +199,9 @@ def test_files_outside_the_package_are_never_read(tmp_path):
     outside_problems = [p for p in analysis.problems if p.startswith('file outside the package: ')]
     assert len(outside_problems) == 6 and all(p.endswith(' not read') for p in outside_problems), analysis.problems
     assert analysis.starts_drone('altitude'), 'the drone\'s own launch file still counts, unread'
-    found, _ = launch.threshold_param(analysis, 'altitude')
+    found, _ = derive.threshold_param(analysis, 'altitude')
     for tag, changes in (('main', None), ('threshold', {found.origin: 1000})):
-        launch.derive(analysis, tag, changes)
+        derive.derive(analysis, tag, changes)
     assert sorted(os.listdir(str(outside))) == ['other.launch', 'secret.yaml']
     assert os.listdir(str(sibling)) == ['x.yaml']
 
@@ -222,9 +222,9 @@ def test_derived_files_name_paths_the_run_box_sees(tmp_path):
 </launch>''',
         'config/params.yaml': 'threshold: 1300\n'})
     analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
-    found, _ = launch.threshold_param(analysis, 'altitude')
+    found, _ = derive.threshold_param(analysis, 'altitude')
     assert found.name == '/exam/threshold' and analysis.starts_drone('altitude')
-    derived = launch.derive(analysis, 'threshold', {found.origin: 1040.0})
+    derived = derive.derive(analysis, 'threshold', {found.origin: 1040.0})
     written = [os.path.join(d, f) for d, _, files in os.walk(str(tmp_path)) for f in files if f.startswith('.grader-')]
     assert sorted(os.path.relpath(p, pkg) for p in written) == [
         'config/.grader-threshold-params.yaml', 'launch/.grader-threshold-exam.launch',
@@ -245,7 +245,7 @@ def test_derived_file_is_never_written_through_a_link(tmp_path):
     victim = tmp_path / 'victim.txt'
     victim.write_text('untouched')
     os.symlink(str(victim), os.path.join(pkg, 'launch', '.grader-main-exam.launch'))
-    derived = launch.derive(launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg), 'main')
+    derived = derive.derive(launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg), 'main')
     assert victim.read_text() == 'untouched'
     assert not os.path.islink(derived) and ET.parse(derived).getroot().find('node').get('pkg') == 'exam'
 
@@ -346,12 +346,12 @@ def test_every_way_a_launch_file_hands_over_the_threshold(tmp_path, monkeypatch,
     path = os.path.join(pkg, 'launch', 'exam.launch')
     analysis = launch.analyse(path, pkg)
     assert analysis.problems == []
-    found, why = launch.threshold_param(analysis, 'altitude')
+    found, why = derive.threshold_param(analysis, 'altitude')
     assert found is not None and found.name == found_name, why
     assert isinstance(found, launch.NodeArg) == (how == 'args')
     assert launch.as_number(found.value) == 1300.0
     args, params = roslaunch_sees(path, str(tmp_path), monkeypatch)
-    derived = launch.derive(analysis, 'threshold', {found.origin: 1040.0})
+    derived = derive.derive(analysis, 'threshold', {found.origin: 1040.0})
     args2, params2 = roslaunch_sees(derived, str(tmp_path), monkeypatch)
     changed = lambda before, after: {k: (before.get(k), after.get(k)) for k in set(before) | set(after)
                                      if before.get(k) != after.get(k)}
@@ -362,7 +362,7 @@ def test_every_way_a_launch_file_hands_over_the_threshold(tmp_path, monkeypatch,
         assert params == params2
         (node, (before, after)), = changed(args, args2).items()
         assert before.replace('1300', '1040.0') == after, (before, after)
-    again = launch.threshold_param(launch.analyse(derived, pkg), 'altitude')[0]
+    again = derive.threshold_param(launch.analyse(derived, pkg), 'altitude')[0]
     assert (again.name, launch.as_number(again.value)) == (found_name, 1040.0)
 
 
@@ -384,7 +384,7 @@ def test_the_threshold_run_value_is_drawn_once_written_and_planned(tmp_path, dra
     assert found['threshold_run_value'] == found['static']['threshold']['run_value'] == value
     assert found['static']['threshold']['how'] == 'args' and found['static']['args_in_code'] == ['--threshold']
     derived = os.path.join(str(ws), found['threshold_launch'])
-    again = launch.threshold_param(launch.analyse(derived, os.path.join(str(ws), 'src', 'exam')), 'altitude')[0]
+    again = derive.threshold_param(launch.analyse(derived, os.path.join(str(ws), 'src', 'exam')), 'altitude')[0]
     assert (again.name, launch.as_number(again.value)) == ('--threshold', value)
     job = runner.plan_job(records.InspectRecord(records.check(found, records.InspectRecord.SCHEMA)))
     main, threshold = [run['plan'] for run in job['runs']]

@@ -1,7 +1,9 @@
 """make rescore: today's rubric on the measurements a run kept (issue 29 point 2), no ROS, no box."""
 import json
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run, runner
+from exam_lab.grader.publish import grades
+from exam_lab.grader.score.records import MEASUREMENTS
 from exam_lab.grader.score import rubric
 
 from test_grader_rubric import STATIC, measured
@@ -16,12 +18,12 @@ def test_rescore_applies_todays_rubric_to_the_kept_measurements(tmp_path, monkey
         folder.mkdir()
         kept = {'student': name, 'sheet': 'altitude', 'static': STATIC, 'session': session, 'notes': [],
                 'fixes': [], 'comments': None, 'isolate': True, 'how_run': 'test', 'extra': {'seconds': 40.0}}
-        (folder / runner.MEASUREMENTS).write_text(json.dumps(kept))
-        (folder / 'grade.json').write_text(json.dumps(runner.score(kept)))
-    records, changes = runner.rescore(str(tmp_path))
+        (folder / MEASUREMENTS).write_text(json.dumps(kept))
+        (folder / 'grade.json').write_text(json.dumps(grades.score(kept)))
+    records, changes = grades.rescore(str(tmp_path))
     assert changes == [] and [r['total'] for r in records] == [17.0, 17.0]
-    monkeypatch.setattr(rubric, 'WARNING_LATE_S', 0.3)
-    records, changes = runner.rescore(str(tmp_path))
+    monkeypatch.setattr(rubric, 'warning_window', lambda probe: (probe['delay'] - 0.3, probe['delay'] + 0.3))
+    records, changes = grades.rescore(str(tmp_path))
     assert changes == ['late: 17 -> 15.5 (Q14b 3 -> 1.5)']  # the delay's 1.5 of 14b
     late_record = json.loads((tmp_path / 'late' / 'grade.json').read_text())
     assert late_record['previous']['items']['Q14b'] == 3.0 and late_record['provenance']['how'] == 'rescore'
@@ -36,7 +38,7 @@ def test_a_student_the_grader_could_not_grade_keeps_its_participant(tmp_path, mo
     def fails(*args, **kwargs):
         raise RuntimeError('a grader bug')
     monkeypatch.setattr(runner, 'grade_submission', fails)
-    record = runner.grade_student('Jane Doe', str(tmp_path / 'Jane Doe._1001_assignsubmission_file_'), str(tmp_path))
+    record = class_run.grade_student('Jane Doe', str(tmp_path / 'Jane Doe._1001_assignsubmission_file_'), str(tmp_path))
     assert record['status'] == 'not graded' and 'a grader bug' in ' '.join(record['for_the_teacher'])
     assert (record['participant'], record['folder']) == (1001, 'Jane Doe._1001_assignsubmission_file_')
     assert json.loads((tmp_path / 'Jane Doe' / 'grade.json').read_text())['participant'] == 1001

@@ -37,7 +37,7 @@ def test_threshold_run_only_after_a_warning_in_the_long_excursion():
 
 def test_sheet_detection(tmp_path):
     from exam_lab.grader import runner
-    from exam_lab.grader.boxed import inspect, launch
+    from exam_lab.grader.boxed import derive, inspect, launch
     pkg = tmp_path / 'exam'
     (pkg / 'launch').mkdir(parents=True)
     (pkg / 'package.xml').write_text('<package><name>exam</name><depend>mydrone</depend>'
@@ -47,7 +47,7 @@ def test_sheet_detection(tmp_path):
     assert 'SHEET=depth' in inspect.detect_sheet(None, str(pkg), [])[1], 'an ambiguous package says how to choose'
     (pkg / 'launch' / 'exam.launch').write_text('<launch><node pkg="submarinedrone" type="submarine_drone_node.py" '
                                                 'name="d"/><node pkg="exam" type="n.py" name="exam"/></launch>')
-    analyses = [launch.analyse(p, str(pkg)) for p in launch.launch_files(str(pkg))]
+    analyses = [launch.analyse(p, str(pkg)) for p in derive.launch_files(str(pkg))]
     assert inspect.detect_sheet(None, str(pkg), analyses)[0] == 'depth'
     (pkg / 'package.xml').write_text('<package><name>exam</name><exec_depend>mydrone</exec_depend></package>')
     assert inspect.detect_sheet(None, str(pkg), analyses)[0] == 'altitude', 'package.xml first'

@@ -8,7 +8,9 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run
+from exam_lab.grader.host import underlay
+from exam_lab.grader.publish import grades
 from exam_lab.grader.engine import slurm
 
 
@@ -160,7 +162,6 @@ def test_out_of_time_cancels_and_says_where_each_student_was(array, monkeypatch)
 def test_a_task_of_a_student_the_intake_refused_says_why(tmp_path):
     """Issue 36 point 3: the manifest carries the intake's refusal; the task writes that student's
     "not graded" row with it (nothing of the student is run) and its measurements for a rescore."""
-    from exam_lab.grader import runner
     manifest = tmp_path / '.slurm' / 'manifest.jsonl'
     (tmp_path / '.slurm' / 'results').mkdir(parents=True)
     why = "the files of 'Bob_12_assignsubmission_file_': 5001 more files, beyond the 5000 a submission may unpack"
@@ -170,7 +171,7 @@ def test_a_task_of_a_student_the_intake_refused_says_why(tmp_path):
     assert (record['status'], record['status_reason']) == ('not graded', 'submission refused: %s' % why)
     assert record['participant'] == 12
     assert json.loads((tmp_path / '.slurm' / 'results' / '0.json').read_text())['status_reason'] == record['status_reason']
-    assert [r['status_reason'] for r in runner.rescore(str(tmp_path))[0]] == [record['status_reason']]
+    assert [r['status_reason'] for r in grades.rescore(str(tmp_path))[0]] == [record['status_reason']]
 
 
 def test_a_task_says_in_the_grade_which_node_graded_it(tmp_path, monkeypatch):
@@ -178,7 +179,7 @@ def test_a_task_says_in_the_grade_which_node_graded_it(tmp_path, monkeypatch):
     (tmp_path / '.slurm' / 'results').mkdir(parents=True)
     manifest.write_text(json.dumps({'student': 'Ann', 'submission': '/class/Ann'}) + '\n')
     monkeypatch.setenv('SLURMD_NODENAME', 'exam-node2')
-    monkeypatch.setattr(runner, 'grade_student', lambda name, folder, out, sheet, unsandboxed, refused=None: runner.could_not_grade(
+    monkeypatch.setattr(class_run, 'grade_student', lambda name, folder, out, sheet, unsandboxed, refused=None: grades.could_not_grade(
         name, sheet, 'scripted'))
     slurm.run_task(str(manifest), 0, str(tmp_path))
     with open(str(tmp_path / 'Ann' / 'grade.json')) as f:
@@ -189,7 +190,7 @@ def test_a_task_says_in_the_grade_which_node_graded_it(tmp_path, monkeypatch):
 
 def test_a_moodle_class_zip_is_graded_as_a_folder_is(tmp_path, monkeypatch):
     """The zip a teacher downloads from Moodle: its students listed by the function the local engine
-    uses (runner.class_students, the intake in its box), unpacked on the shared OUT for the nodes, and
+    uses (class_run.class_students, the intake in its box), unpacked on the shared OUT for the nodes, and
     removed at the end. It used to raise AttributeError before anything was submitted."""
     klass = tmp_path / 'class.zip'
     with zipfile.ZipFile(str(klass), 'w') as zf:
@@ -210,12 +211,12 @@ def test_a_moodle_class_zip_is_graded_as_a_folder_is(tmp_path, monkeypatch):
                         seen[entry['student']] = entry['submission']
                         assert os.path.isfile(os.path.join(entry['submission'], 'exam', 'package.xml'))
                         with open(os.path.join(self.base, 'results', '%d.json' % index), 'w') as r:
-                            json.dump(runner.could_not_grade(entry['student'], None, 'scripted'), r)
+                            json.dump(grades.could_not_grade(entry['student'], None, 'scripted'), r)
                 return 0, '', ''
             return ScriptedSlurm.__call__(self, argv)
 
     monkeypatch.setattr(slurm, '_call', FromManifest(str(out / '.slurm'), {}))
-    monkeypatch.setattr(runner, 'ensure_underlay', lambda cache: cache)
+    monkeypatch.setattr(underlay, 'ensure_underlay', lambda cache: cache)
     monkeypatch.setattr(slurm.shutil, 'which', lambda command: '/usr/bin/' + command)
     records = slurm.grade_class(str(klass), str(out), unsandboxed=True, poll_s=0.0)
     assert [r['student'] for r in records] == ['Ann Lee', 'Bob Ray']

@@ -67,7 +67,7 @@ def test_a_launched_type_without_its_py_is_run_as_the_script(tmp_path):
     """``type="exam_node"`` beside ``scripts/exam_node.py``: the derived launch file runs the script,
     the fix is named, the student's launch file is left as handed in (question 12 judges it)."""
     import xml.etree.ElementTree as ET
-    from exam_lab.grader.boxed import launch
+    from exam_lab.grader.boxed import derive, launch
     pkg = tmp_path / 'exam'
     write(pkg / 'scripts' / 'exam_node.py', '#!/usr/bin/env python3\nimport rospy\nrospy.init_node("e")\n')
     write(pkg / 'scripts' / 'helper.py', 'x = 1\n')
@@ -79,7 +79,7 @@ def test_a_launched_type_without_its_py_is_run_as_the_script(tmp_path):
     assert sorted(changes.values()) == ['exam_node.py'], 'a type that names a file, or no script, is left'
     assert notes == ['the launch file starts type="exam_node", which is no file of the package: run as '
                      '"exam_node.py" (scripts/exam_node.py), as a teacher would fix it']
-    derived = ET.parse(launch.derive(analysis, 'main', changes)).getroot()
+    derived = ET.parse(derive.derive(analysis, 'main', changes)).getroot()
     assert [n.get('type') for n in derived.findall('node')] == ['exam_node.py', 'helper.py', 'nothing']
     assert path.read_text() == text
 

@@ -1,12 +1,16 @@
 """Unpacking what students upload: unsafe archives refused as a whole, the package found."""
+import io
 import os
 import re
 import stat
+import tarfile
 import zipfile
 
 import pytest
 
-from exam_lab.grader.boxed import archives, classlist, package
+from exam_lab.grader.boxed import archives, classlist, package, source
+from exam_lab.grader.host import staging
+from exam_lab.grader.score import identity
 
 PACKAGE_XML = '<package format="2"><name>exam</name></package>'
 
@@ -176,6 +180,32 @@ def test_a_class_zip_judges_each_student_by_its_own_bounds(tmp_path, monkeypatch
     assert os.path.isfile(os.path.join(paths['Cy Fine'], 'exam.zip'))
 
 
+def test_a_name_longer_than_a_folder_name_stops_no_one(tmp_path):
+    """Moodle allows 100 characters each for a first and a last name: in Cyrillic or Chinese, with the
+    participant number and the plugin, a folder name of 300 bytes or more, longer than this machine's
+    255. That student is unpacked in a folder whose name lost characters from the middle of the name
+    (its participant number kept), and graded; a class archive of uploads at the top with such a name
+    refuses that upload alone; the others are unpacked."""
+    upload = [('exam.zip', open(make_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML)]), 'rb').read())]
+    long_folder = 'Жанна %s_4711_assignsubmission_file_' % ('Ш' * 140)
+    archive = moodle_class(tmp_path / 'class.zip', {long_folder: upload, 'Cy Fine_13_assignsubmission_file_': upload})
+    refused = {}
+    students = classlist.list_students(archive, str(tmp_path / 'scratch'), refused)
+    assert refused == {}
+    assert len(students) == 2 and students[0][0] == 'Cy Fine'
+    name, folder = students[1]
+    assert os.path.isfile(os.path.join(folder, 'exam.zip'))
+    assert len(os.path.basename(folder).encode('utf-8')) <= archives.NAME_MAX
+    assert os.path.basename(folder).startswith('Жанна ШШ') and os.path.basename(folder).endswith(
+        'Ш_4711_assignsubmission_file_')
+    assert identity.participant_number(os.path.basename(folder)) == 4711
+    at_top = make_zip(tmp_path / 'tops.zip', [('%s.zip' % ('Ш' * 140), upload[0][1]), ('Cy Fine.zip', upload[0][1])])
+    refused = {}
+    students = classlist.list_students(at_top, str(tmp_path / 'tops'), refused)
+    assert [name for name, _ in students][0] == 'Cy Fine' and len(students) == 2
+    assert list(refused.values()) == ['entry %s has a name of more than 255 bytes' % archives.shown_name('Ш' * 140 + '.zip')]
+
+
 def test_a_class_zip_is_bounded_as_a_whole(tmp_path, monkeypatch):
     """What no student's bounds can say refuses the class: more entries or bytes than a class holds, an
     entry outside every student's folder."""
@@ -209,3 +239,51 @@ def test_a_name_in_any_bytes_is_shown_as_its_bytes():
     assert archives.shown_name(b'exam/lien\xfe'.decode('utf-8', 'surrogateescape')) == "'exam/lien\\xfe'"
     assert archives.shown_name('a\\udcff') == "'a\\\\udcff'"
     assert archives.shown_name('Größe\n') == "'Größe\\n'"
+
+
+def _class_archive(path, kind, entries):
+    """A class archive of ``(name, bytes, mode)`` entries, each with its Unix mode, as zip or tar."""
+    if kind == 'zip':
+        with zipfile.ZipFile(str(path), 'w', zipfile.ZIP_DEFLATED) as zf:
+            for name, data, mode in entries:
+                info = zipfile.ZipInfo(name, (2026, 6, 12, 14, 0, 0))
+                info.create_system = 3
+                info.external_attr = (stat.S_IFREG | mode) << 16
+                zf.writestr(info, data)
+    else:
+        with tarfile.open(str(path), 'w:gz') as tf:
+            for name, data, mode in entries:
+                info = tarfile.TarInfo(name)
+                info.size, info.mode = len(data), mode
+                tf.addfile(info, io.BytesIO(data))
+    return str(path)
+
+
+@pytest.mark.parametrize('kind', ['zip', 'tar'])
+def test_a_class_archive_keeps_each_script_s_x_bit_through_every_copy(tmp_path, kind):
+    """Issue 38: whether a script is executable is a fact of the grade (the sheet asks for chmod +x), so a
+    script handed in executable in a class archive stays so through every copy the grader makes (the
+    intake's unpacking, the staging for the student's box, the package's copy into the workspace),
+    whatever the umask (077 on a cluster's account), and one handed in without it is still "made
+    executable"."""
+    folder = 'Ann Lee_11_assignsubmission_file_/exam/'
+    archive = _class_archive(tmp_path / ('class.' + kind), kind, [
+        (folder + 'package.xml', PACKAGE_XML.encode(), 0o644),
+        (folder + 'scripts/exam_node.py', b'#!/usr/bin/env python3\nprint(1)\n', 0o755),
+        (folder + 'scripts/helper.py', b'#!/usr/bin/env python3\nprint(2)\n', 0o644)])
+    umask = os.umask(0o077)
+    try:
+        (name, unpacked), = classlist.list_students(archive, str(tmp_path / 'intake'))
+        staged = str(tmp_path / 'upload')
+        staging.stage_upload(unpacked, staged)
+        notes = []
+        pkg = str(tmp_path / 'ws' / 'exam')
+        package.copy_package(package.open_submission(staged, str(tmp_path / 'scratch'), notes), pkg, notes)
+        for at in (os.path.join(unpacked, 'exam'), staged + '/exam', pkg):
+            assert os.stat(os.path.join(at, 'scripts', 'exam_node.py')).st_mode & 0o777 == 0o755, at
+            assert os.stat(os.path.join(at, 'scripts', 'helper.py')).st_mode & 0o111 == 0, at
+        assert source.make_runnable(pkg, ['exam_node.py']) == [
+            'scripts/helper.py was not executable: made executable (chmod +x), as the sheet asks']
+    finally:
+        os.umask(umask)
+    assert name == 'Ann Lee'

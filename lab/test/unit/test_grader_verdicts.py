@@ -3,7 +3,8 @@ the judge sees itself (the probe's NodeWatch), one budget for a student's whole 
 import math
 import os
 
-from exam_lab.grader import runner
+from exam_lab.grader import class_run, runner
+from exam_lab.grader.publish import teacher
 from exam_lab.grader.host import session
 from exam_lab.grader.judge.probe import NodeWatch
 from exam_lab.grader.score import rubric
@@ -127,7 +128,7 @@ def test_a_watched_death_costs_what_a_death_costs():
     assert 'node /chatter died (seen by the judge: started again during the run (pid 11, then 12))' in evidence
     status, reason = rubric.status(STATIC, session_)
     assert status == rubric.HAND_GRADE and 'died' in reason, reason
-    assert session.watched_deaths({'node_watch': 'odd'}) == session.watched_deaths(None) == []
+    # A watch of another shape never reaches the deaths: the probe's record refuses it (test_grader_probe_record).
 
 
 def test_each_step_gets_its_own_limit_or_what_is_left():
@@ -150,14 +151,14 @@ def test_a_used_budget_is_on_the_students_row():
     assert status == rubric.HAND_GRADE and reason.startswith('its grading used up its budget of 270 s'), reason
     runs = [i for i in rubric.score('altitude', STATIC, session_) if i['id'] == 'runs'][0]
     assert runs['points'] == 0 and 'budget of 270 s' in runs['evidence']
-    hints = runner.hints(STATIC, session_, [], None, True)
+    hints = teacher.hints(STATIC, session_, [], None, True)
     assert session_['budget_used'] in hints
 
 
 def test_a_class_of_60_at_the_default_jobs_ends_within_75_minutes():
     """Every student at its budget: ceil(60 / JOBS) gradings in sequence, each at most its budget and
     what follows it."""
-    jobs = runner.default_jobs(cores=2, memory=64 << 30)
+    jobs = class_run.default_jobs(cores=2, memory=64 << 30)
     assert jobs == 4
-    assert runner.worst_case(60, jobs) <= 75 * 60
-    assert runner.worst_case(60, jobs) == math.ceil(60 / 4) * (runner.STUDENT_BUDGET + runner.AFTER_BUDGET_S)
+    assert class_run.worst_case(60, jobs) <= 75 * 60
+    assert class_run.worst_case(60, jobs) == math.ceil(60 / 4) * (runner.STUDENT_BUDGET + runner.AFTER_BUDGET_S)

@@ -9,8 +9,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   archive unpacked after checking every entry), :mod:`~.boxed.package` (the package found in an upload,
   copied), :mod:`~.boxed.uploads` (which of several uploads is the last), :mod:`~.boxed.classlist` (a
   class's students, from a folder or an archive), :mod:`~.boxed.source` (what the sources say;
-  the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it,
-  the derived launch files the grader runs), :mod:`~.boxed.documents` (participant number, PDF
+  the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it),
+  :mod:`~.boxed.derive` (which launch file and threshold are run; the derived launch files the grader
+  runs), :mod:`~.boxed.documents` (participant number, PDF
   reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own).
 - ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`
   (rospy: plays the drone with the harness's fake drone, measures, watches the node's pid).
@@ -19,9 +20,11 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.host.uids` (a slot's box and judge uids, under a lock; what runs as them ended),
   :mod:`~.host.cgroups` (the box's and the judge's cgroups), :mod:`~.host.limits` (their bounds;
   prlimit), :mod:`~.host.bwrap` (bubblewrap's command line; the session's network namespace),
-  :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder) and
+  :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder),
   :mod:`~.host.egress` (the only reader of what a box leaves: its record, capped, never a link, checked
-  against its schema; its logs, capped).
+  against its schema; its logs, capped), :mod:`~.host.boxed_run` (one of the grader's modules run in a
+  box on student bytes, its record read back) and :mod:`~.host.underlay` (the simulators' workspace,
+  built once, under every student's package).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima),
   :mod:`~.score.rubric` (points, evidence and status from the measurements), :mod:`~.score.safe_text`
   (student-derived text without control characters, for every record and output), :mod:`~.score.records`
@@ -36,12 +39,16 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.publish.feedback` (each student's page for Moodle, moodle-feedback.zip), :mod:`~.publish.cells`
   (a CSV cell a spreadsheet cannot run, read back exactly),
   :mod:`~.publish.provenance` (what made a grade), :mod:`~.publish.student_view` (what ``make check``
-  shows a student).
-- :mod:`~exam_lab.grader.runner` -- one submission or a class, top to bottom: stage, inspect (boxed),
-  build and run (box and judge), score (:func:`~exam_lab.grader.runner.score`, also for a rescore),
+  shows a student), :mod:`~.publish.grades` (the grade record from the measurements: the rubric applied,
+  by a run and by a rescore alike; the rescore), :mod:`~.publish.teacher` (the teacher's notes of a
+  grade: what the machine saw but does not score, how the code was read and run).
+- :mod:`~exam_lab.grader.runner` -- one submission, top to bottom: stage, inspect (boxed), plan, build
+  and run (box and judge), score (:func:`~exam_lab.grader.publish.grades.score`, also for a rescore),
   publish.
-- ``engine/`` -- the host, as the teacher: where else a class is graded, each student by the runner
-  (:mod:`~.engine.slurm`: an array job on a Slurm cluster).
+- :mod:`~exam_lab.grader.class_run` -- a class: its students listed (for every engine), each graded by
+  the runner in a local pool; the class's similarity check.
+- ``engine/`` -- the host, as the teacher: where else a class is graded, each student by
+  :func:`~exam_lab.grader.class_run.grade_student` (:mod:`~.engine.slurm`: an array job on a Slurm cluster).
 """
 import os
 

@@ -267,6 +267,11 @@ def _zip_mode(info, mask=0o777):
     return (info.external_attr >> 16) & mask if info.create_system == 3 else 0
 
 
+def _tar_mode(member):
+    """The permission bits of a tar entry."""
+    return member.mode & 0o777
+
+
 def _zip_link_target(zf, info):
     """What a zip's link points to, for the teacher's note; '?' when it is long or cannot be read."""
     if info.file_size > 4096:
@@ -298,10 +303,7 @@ def safe_extract(archive, target, max_files=MAX_FILES, max_bytes=MAX_BYTES, max_
         plan = _plan_zip(opened, label, max_ratio) if kind == 'zip' else _plan_tar(opened, label, budget)
         budget.take(len(plan.files), plan.nbytes, label)
         try:
-            if kind == 'zip':
-                write_plan(plan, target, opened.open, _zip_mode)
-            else:
-                write_plan(plan, target, opened.extractfile, lambda member: member.mode & 0o777)
+            write_plan(plan, target, kind, opened)
         except UNREADABLE as err:
             raise UnpackError('%s cannot be unpacked: %s' % (label, unreadable_why(err)))
     notes.extend(plan.notes())
@@ -342,10 +344,13 @@ def _plan_tar(tf, label, budget):
     return plan
 
 
-def write_plan(plan, target, open_member, mode_of=lambda member: 0):
-    """Write the files of ``plan`` below ``target``, each read with ``open_member(member)`` and capped at
-    the size its entry declares; a file keeps the permission bits ``mode_of(member)`` gives (0: none
-    known), always readable and writable by its owner."""
+def write_plan(plan, target, kind, opened):
+    """Write the files of ``plan`` (entries of ``opened``, the open archive of ``kind``: 'zip' or 'tar')
+    below ``target``, each capped at the size its entry declares. A file keeps the permission bits its
+    entry records, always readable and writable by its owner: whether a script was executable is a
+    fact of the grade, so a class archive keeps them as a student's does (they are set, so no umask
+    takes them away). An entry that records none (a zip made on Windows) is left as the umask makes it."""
+    open_member, mode_of = (opened.open, _zip_mode) if kind == 'zip' else (opened.extractfile, _tar_mode)
     os.makedirs(target, exist_ok=True)
     for parts in plan.dirs:
         _dest(target, parts, make=True)

@@ -14,12 +14,15 @@ from exam_lab.grader.boxed import archives
 from exam_lab.grader.boxed.archives import (ARCHIVE_ENDINGS, SKIPPED_DIRS, UNREADABLE, Plan, UnpackError, open_archive,
                                             shown_name, tar_entries, unreadable_why, without_ending, write_plan,
                                             zip_entries)
-from exam_lab.grader.score.identity import student_name
+from exam_lab.grader.score.identity import participant_number, student_name
 
 #: A class archive ("download all submissions") holds every student's uploads: its bounds as a whole
 #: (entries, bytes of the students it unpacks); each student's files are paid from MAX_FILES / MAX_BYTES.
 CLASS_FILES = 100000
 CLASS_BYTES = 4 * 1024 * 1024 * 1024
+#: Characters kept at the end of a student's name too long to be a folder's (:func:`_fitting`): Moodle's
+#: ``_<participant>_assignsubmission_file_`` and more, at most 240 bytes in any script.
+_KEPT_END = 60
 
 
 def list_students(class_path, scratch, refused=None):
@@ -38,13 +41,21 @@ def list_students(class_path, scratch, refused=None):
     students = []
     for entry in sorted(os.listdir(class_path)):
         full = os.path.join(class_path, entry)
-        if entry.startswith('.') or entry in SKIPPED_DIRS or os.path.islink(full):
+        if _hidden(entry) or entry in SKIPPED_DIRS or os.path.islink(full):
             continue
         if os.path.isdir(full):
             students.append((student_name(entry), full))
         elif entry.lower().endswith(ARCHIVE_ENDINGS):
             students.append((student_name(without_ending(entry)), full))
     return students
+
+
+def _hidden(entry):
+    """A hidden name the listing passes over (``.DS_Store``, ``.git``, the ``._`` copies macOS leaves
+    beside each file), but never a folder Moodle named after a student whose full name starts with a dot:
+    ``.Anna Roy_77_assignsubmission_file_`` (Moodle's name never starts with ``._``: it writes ``_`` as
+    a space)."""
+    return entry.startswith('.') and (entry.startswith('._') or participant_number(entry) is None)
 
 
 def _class_entries(kind, opened, label):
@@ -95,7 +106,7 @@ def unpack_class(archive, target, refused):
         top = os.path.join(target, base) if base else target
         plans, total = [], 0
         for key, members in sorted(groups.items()):
-            place = os.path.join(top, key)
+            place = os.path.join(top, _fitting(key))
             try:
                 plan = _student_plan(key, members)
             except UnpackError as err:
@@ -126,6 +137,21 @@ def unpack_class(archive, target, refused):
             except OSError as err:
                 raise UnpackError('%s of the class archive cannot be written: %s' % (shown_name(key), err.strerror))
     return top
+
+
+def _fitting(key):
+    """A student's top entry as a name this file system takes: one of more than NAME_MAX bytes (Moodle
+    allows 100 characters each for a first and a last name: 300 bytes and more in Cyrillic or Chinese)
+    loses characters from its middle, its start and its end (the participant number, the plugin, an
+    archive's ending) kept, so that one long name stops no one else."""
+    def fits(name):
+        return len(name.encode('utf-8', 'surrogateescape')) <= archives.NAME_MAX
+    if fits(key):
+        return key
+    head, tail = key[:-_KEPT_END], key[-_KEPT_END:]
+    while not fits(head + '-' + tail):
+        head = head[:-1]
+    return head + '-' + tail
 
 
 def _students_of(entries):
@@ -170,6 +196,6 @@ def _write_student(opened, kind, target, plan):
     """Write one student's planned files below ``target`` (the class's folder for an archive at its top:
     the plan's one file is the student's key)."""
     try:
-        write_plan(plan, target, opened.open if kind == 'zip' else opened.extractfile)
+        write_plan(plan, target, kind, opened)
     except UNREADABLE as err:
         raise UnpackError('%s cannot be unpacked: %s' % (shown_name(plan.label), unreadable_why(err)))

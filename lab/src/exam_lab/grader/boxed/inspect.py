@@ -22,7 +22,7 @@ import random
 import re
 import sys
 
-from exam_lab.grader.boxed import archives, documents, launch, package, source
+from exam_lab.grader.boxed import archives, derive, documents, launch, package, source
 from exam_lab.grader.score import boxenv, records
 from exam_lab.grader.score.sheets import PACKAGE, SHEETS, threshold_run_value
 
@@ -78,10 +78,10 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     package.copy_package(pkg_source, pkg, fixes)
     fixes.extend(source.fix_text(pkg))
     box_env = boxenv.box_env({'PATH': '/usr/bin:/bin'})  # what $(env) reads in the run box, nothing of ours
-    analyses = [launch.analyse(path, pkg, name, box_env) for path in launch.launch_files(pkg)]
+    analyses = [launch.analyse(path, pkg, name, box_env) for path in derive.launch_files(pkg)]
     sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
     notes.insert(0, how)
-    chosen = launch.choose(analyses, sheet)
+    chosen = derive.choose(analyses, sheet)
     scripts = source.node_scripts(pkg)
     types, type_fixes = source.node_type_fixes(pkg, chosen.exam_nodes if chosen else [])
     fixes.extend(type_fixes)
@@ -110,7 +110,7 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
         static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),
                             'exam_type': exam.type, 'exam_name': exam.name, 'package': name,
                             'comments': chosen.comments(), 'exam_type_found': _executable_in(pkg, exam.type)}
-        param, why = launch.threshold_param(chosen, sheet)
+        param, why = derive.threshold_param(chosen, sheet)
         static['threshold_reason'] = why
         if param is not None:
             value = launch.as_number(param.value)
@@ -120,14 +120,14 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
                                    'how': 'args' if isinstance(param, launch.NodeArg) else 'param',
                                    'where': param.origin.describe(pkg) if param.origin else '?'}
             notes.append('threshold parameter: %s, set in %s' % (why, static['threshold']['where']))
-        record['main_launch'] = os.path.relpath(launch.derive(chosen, 'main', types), ws)
+        record['main_launch'] = os.path.relpath(derive.derive(chosen, 'main', types), ws)
         record['handed_in_launch'] = os.path.relpath(chosen.path, os.path.join(ws, 'src'))
         record['namespace'] = chosen.drone_namespace(sheet)
         if param is not None and param.origin is not None:
             lowered = threshold_run_value(record['threshold_value'], draw)
             changes = dict(types)
             changes[param.origin] = lowered
-            record['threshold_launch'] = os.path.relpath(launch.derive(chosen, 'threshold', changes), ws)
+            record['threshold_launch'] = os.path.relpath(derive.derive(chosen, 'threshold', changes), ws)
             record['threshold_run_value'] = static['threshold']['run_value'] = lowered
         elif param is not None:
             static['threshold']['not_rewritable'] = 'its value comes from no literal the grader can change'

@@ -1,6 +1,7 @@
 """Unpack a class archive ("download all submissions"), as a box's uid: one folder or archive per student.
 
-The runner starts it in a box of its own, without network, bounded in time and memory::
+The class run (:mod:`exam_lab.grader.class_run`) starts it in a box of its own, without network,
+bounded in time and memory::
 
     python3 -m exam_lab.grader.boxed.intake --class /box/upload/<class.zip> --out /box/out
 

@@ -314,7 +314,7 @@ def compare(job):
 
 
 def main(argv):
-    if len(argv) == 2 and argv[0] == '--class':  # the whole check, in the class's box (the runner's)
+    if len(argv) == 2 and argv[0] == '--class':  # the whole check, in the class's box (class_run's)
         with open(argv[1]) as f:
             job = json.load(f)
         check([tuple(s) for s in job['submissions']], job['out'], job['python'], job['boilerplate'], job['out'])

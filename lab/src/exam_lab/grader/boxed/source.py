@@ -438,7 +438,7 @@ def node_type_fixes(package_dir, nodes):
 
     :param nodes: the launched :class:`~exam_lab.grader.boxed.launch.Node` s of the package.
     :returns: ``({node.type_origin: fixed type}, [a note for each fix])``, the changes for
-        :func:`~exam_lab.grader.boxed.launch.derive`.
+        :func:`~exam_lab.grader.boxed.derive.derive`.
     """
     names = set()
     for dirpath, dirnames, filenames in os.walk(package_dir):

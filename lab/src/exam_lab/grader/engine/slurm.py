@@ -4,7 +4,7 @@ on a Slurm cluster"). No rospy here.
 Two halves, both run as whoever submits (the teacher; root only on a local try-out):
 
 - On the host that submits (a cluster's login node), :func:`grade_class` lists the students with the
-  local run's own function (:func:`~exam_lab.grader.runner.class_students`; a Moodle archive's students
+  local run's own function (:func:`~exam_lab.grader.class_run.class_students`; a Moodle archive's students
   are then copied onto OUT for the nodes: :func:`shared_students`), builds the simulators' underlay
   once, writes into ``OUT/.slurm/`` a manifest (one JSON line per student: name, submission) and the
   task's batch script, submits ``sbatch --array=0-(N-1) --no-requeue`` and follows the array with
@@ -12,9 +12,9 @@ Two halves, both run as whoever submits (the teacher; root only on a local try-o
   queue without a grade (failed, cancelled, timed out, its node lost: NODE_FAIL) is resubmitted once,
   said with Slurm's words and the node; after a second such end, that student's record is "not
   graded" with what ``scontrol show job`` said. Then grades.csv, exactly as
-  :func:`~exam_lab.grader.runner.grade_class` writes it; the caller writes the rest of OUT (the desk).
+  :func:`~exam_lab.grader.class_run.grade_class` writes it; the caller writes the rest of OUT (the desk).
 - On the node, each task runs ``python3 -m exam_lab.grader.engine.slurm task ...``: :func:`run_task`
-  grades its manifest line with :func:`~exam_lab.grader.runner.grade_student`, the local run's own code
+  grades its manifest line with :func:`~exam_lab.grader.class_run.grade_student`, the local run's own code
   path, names the node in the record (``graded_on``) and leaves it in ``OUT/.slurm/results/<index>.json``
   (written whole, then renamed: the host never reads half a record).
 
@@ -35,9 +35,9 @@ import subprocess
 import sys
 import time
 
-from exam_lab.grader import runner, workspace
-from exam_lab.grader.host import sandbox, staging
-from exam_lab.grader.publish import report
+from exam_lab.grader import class_run, workspace
+from exam_lab.grader.host import sandbox, staging, underlay
+from exam_lab.grader.publish import grades, report
 
 #: Seconds between two looks at the queue: light on a shared controller, quick enough for a class.
 POLL_S = 5.0
@@ -185,7 +185,7 @@ def run_task(manifest, index, out_dir, sheet=None, unsandboxed=False):
     # scancel and the time limit send SIGTERM: exit through the finally blocks, which end the
     # session's processes and remove the work folder.
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
-    record = runner.grade_student(entry['student'], entry['submission'], out_dir, sheet, unsandboxed=unsandboxed,
+    record = class_run.grade_student(entry['student'], entry['submission'], out_dir, sheet, unsandboxed=unsandboxed,
                                   refused=entry.get('refused'))
     # Which node graded it (a lost node's students are graded again elsewhere): in grade.json too.
     record['graded_on'] = os.environ.get('SLURMD_NODENAME') or socket.gethostname()
@@ -258,7 +258,7 @@ class _Array(object):
     def give_up(self, index, why):
         name = self.students[index][0]
         log = os.path.join(self.base, 'logs', '%s_%d.out' % (self.where[index], index))
-        record = runner.could_not_grade(name, self.sheet, 'Slurm said: %s' % why,
+        record = grades.could_not_grade(name, self.sheet, 'Slurm said: %s' % why,
                                         ['the task\'s output: %s' % log if os.path.isfile(log) else
                                          'the task left no output'])
         report.write_grade(os.path.join(self.out_dir, name), record)
@@ -328,14 +328,14 @@ class _Array(object):
 def grade_class(class_path, out_dir, sheet=None, progress=None, unsandboxed=False, sbatch_args=(),
                 poll_s=POLL_S, timeout=None):
     """Grade every student of a class on Slurm; write each one's grade and grades.csv as
-    :func:`~exam_lab.grader.runner.grade_class` does; return the records in the same order.
+    :func:`~exam_lab.grader.class_run.grade_class` does; return the records in the same order.
 
     :param progress: a :class:`~exam_lab.grader.publish.progress.ClassProgress`; it is also told the
         array's state and the retries (its ``say``).
     :param sbatch_args: added to sbatch's (``--partition``, ``--account``, ``--mem``: the cluster's own).
     :param timeout: seconds after which what is left is cancelled and not graded (None: wait).
     """
-    refusal = runner.sandbox_refusal(unsandboxed)
+    refusal = sandbox.sandbox_refusal(unsandboxed)
     if refusal:
         raise sandbox.SandboxUnavailable(refusal)
     missing = [c for c in ('sbatch', 'squeue', 'scontrol', 'scancel') if shutil.which(c) is None]
@@ -350,7 +350,7 @@ def grade_class(class_path, out_dir, sheet=None, progress=None, unsandboxed=Fals
     say = progress.say if progress else (lambda line: None)
     work_dirs, refused = [], {}  # refused: students whose files the intake refused by their own bounds
     try:
-        students = runner.class_students(class_path, work_dirs, refused=refused, out=out_dir)
+        students = class_run.class_students(class_path, work_dirs, refused=refused, out=out_dir)
         students, refused = shared_students(students, work_dirs, os.path.join(base, 'class'), refused)
         records, array = _grade(students, refused, base, out_dir, sheet, progress, unsandboxed, sbatch_args,
                                 poll_s, timeout, say)
@@ -397,7 +397,7 @@ def _grade(students, refused, base, out_dir, sheet, progress, unsandboxed, sbatc
     """The array of these students, followed to its end: ``(records, the array or None)``."""
     records, array = [], None
     if students:
-        runner.ensure_underlay(runner.default_underlay())  # here, once, rather than by the first tasks at once
+        underlay.ensure_underlay(underlay.default_underlay())  # here, once, rather than by the first tasks at once
         manifest = os.path.join(base, 'manifest.jsonl')
         with open(manifest, 'w') as f:
             for name, folder in students:

@@ -8,6 +8,8 @@ private size-capped ``/tmp``, ``/var/tmp``, ``/dev/shm`` and HOME. User, PID, IP
 namespaces of its own; the network one is the session's unless the box gets one of its own.
 """
 import os
+import subprocess
+import threading
 
 from exam_lab.grader.host.limits import TMP_BYTES
 from exam_lab.grader.score.boxenv import BOX_HOME
@@ -58,3 +60,24 @@ def network_namespace(argv):
     if os.geteuid() == 0:
         return ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + list(argv)
     return ['bwrap', '--unshare-user', '--unshare-net', '--dev-bind', '/', '/', '--'] + list(argv)
+
+
+_isolation = {}
+_isolation_lock = threading.Lock()
+
+
+def can_isolate():
+    """True when this process may run a session in a network namespace of its own (as root with
+    unshare, otherwise with bubblewrap where ordinary users may make user namespaces)."""
+    with _isolation_lock:
+        return _can_isolate()
+
+
+def _can_isolate():
+    if 'ok' not in _isolation:
+        try:
+            _isolation['ok'] = subprocess.run(network_namespace(['true']), stdout=subprocess.DEVNULL,
+                                              stderr=subprocess.DEVNULL, timeout=10).returncode == 0
+        except (OSError, subprocess.SubprocessError):
+            _isolation['ok'] = False
+    return _isolation['ok']

@@ -55,8 +55,8 @@ user and network namespace of its own (:func:`~exam_lab.grader.host.bwrap.networ
 session gets a network namespace of its own (only loopback: not even the host's abstract sockets,
 X11's or D-Bus's).
 
-:func:`check` says whether boxes can be made here at all; the runner refuses to grade when they
-cannot unless the teacher accepts the risk by name.
+:func:`check` says whether boxes can be made here at all; the grader refuses to grade when they
+cannot (:func:`sandbox_refusal`) unless the teacher accepts the risk by name.
 """
 import os
 import shutil
@@ -270,6 +270,19 @@ def check():
         if 'why' not in _checked:
             _checked['why'] = _try_a_box()
         return _checked['why']
+
+
+
+def sandbox_refusal(unsandboxed=False):
+    """None when student code may run here: boxes can be made, or the teacher passed the flag that
+    names the risk (``unsandboxed``); otherwise the refusal, for the teacher."""
+    why = check()
+    if why is None or unsandboxed:
+        return None
+    return ('refusing to run student code without its sandbox: %s. Run the grader on a machine with '
+            'bubblewrap and unprivileged user namespaces, as root or as yourself (docs/grading.md, '
+            '"Isolation" and "Without root"), or pass --unsandboxed-student-code-can-read-and-damage-my-files '
+            'to accept that risk' % why)
 
 
 #: Why a rootless box may fail, for the teacher.

@@ -27,8 +27,10 @@ file has a threshold the grader can change, the threshold run: each ``{"tag", "l
 file, as the box sees it), "plan" (for the probe)}``. Writes ``<log_dir>/session.json``: ``{"build":
 {...}, "runs": [{"tag", "probe" (the probe's result or None), "probe_refused" (why a result was
 refused), "master" (its memory, its uid), "probe_uid", "launch": {...}}], "survivors": n, "launch_check",
-"budget_used" (the sentence when the budget stopped a step, else None)}``, and each
-probe's result as ``<log_dir>/probe-<tag>.json``.
+"budget_used" (the sentence when the budget stopped a step, else None), "outcome"}``: a
+:class:`~exam_lab.grader.score.records.SessionRecord` (checked, every text in it made safe there), and
+each probe's result as ``<log_dir>/probe-<tag>.json`` (its checked record; a result refused for its
+times or the master is kept in the run as ``refused_probe``).
 """
 import json
 import os
@@ -37,8 +39,9 @@ import sys
 import time
 
 from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
-from exam_lab.grader.host.egress import FILE_CAP, read_capped
+from exam_lab.grader.host.egress import read_capped, read_record
 from exam_lab.grader.host.sandbox import Box
+from exam_lab.grader.score.records import MAX_ENDED, MAX_LOG_TEXT, ProbeRecord, RecordError, SessionRecord
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
@@ -54,12 +57,12 @@ _NOT_STARTED = re.compile(r'^(ERROR: cannot launch node.*|RLException:.*|.*Inval
 _CHATTER = re.compile(r'^(\.\.\. |Checking log|Press Ctrl-C|Done checking|started roslaunch|SUMMARY|=+|PARAMETERS|NODES'
                       r'| \* /|  /|    \S+ \(|auto-starting|setting /run_id|process\[|ROS_MASTER_URI|\[\S+\] killing'
                       r'|shutting down|done$|log file:|Initiating shutdown|all processes on machine|$)')
-#: Lines kept of a log for the teacher.
+#: Lines kept of a log for the teacher (its last MAX_LOG_TEXT characters at most: one line may be long).
 TAIL_LINES = 25
 
 
 def tail(text, lines=TAIL_LINES):
-    return '\n'.join(text.rstrip().splitlines()[-lines:])
+    return '\n'.join(text.rstrip().splitlines()[-lines:])[-MAX_LOG_TEXT:]
 
 
 def clean(output):
@@ -87,7 +90,9 @@ def launch_outcome(output, workspace=None):
         if match:
             ended.append({'node': match.group(1) or required or '?', 'how': match.group(2),
                           'detail': match.group(3) or ''})
-    return {'ended': ended, 'not_started': _NOT_STARTED.findall(text), 'tail': tail(clean(output))}
+    # A node respawned in a loop is reported ended as often: its first MAX_ENDED ends say it.
+    return {'ended': ended[:MAX_ENDED - WATCHED_DEATHS], 'not_started': [line[:500] for line in _NOT_STARTED.findall(text)[:50]],
+            'tail': tail(clean(output))}
 
 
 #: The most deaths of one run the judge's watch reports.
@@ -96,13 +101,11 @@ WATCHED_DEATHS = 20
 
 def watched_deaths(probe):
     """The deaths the probe's :class:`~exam_lab.grader.judge.probe.NodeWatch` saw (a node started again
-    or gone during the run), as entries of :func:`launch_outcome`'s ``ended``: they cost what a death
-    in roslaunch's words costs, and they are the judge's own, whatever roslaunch's log kept."""
-    watch = (probe or {}).get('node_watch')
-    deaths = watch.get('deaths') if isinstance(watch, dict) else None
-    return [{'node': clean_text(str(d.get('node', '?')))[:100], 'how': 'died',
-             'detail': 'seen by the judge: %s' % clean_text(str(d.get('detail', '')))[:200]}
-            for d in (deaths if isinstance(deaths, list) else [])[:WATCHED_DEATHS] if isinstance(d, dict)]
+    or gone during the run) in its record (a :class:`~exam_lab.grader.score.records.ProbeRecord`'s
+    value: checked, its text clean), as entries of :func:`launch_outcome`'s ``ended``: they cost what a
+    death in roslaunch's words costs, and they are the judge's own, whatever roslaunch's log kept."""
+    return [{'node': d['node'][:100], 'how': 'died', 'detail': 'seen by the judge: %s' % d['detail'][:200]}
+            for d in probe['node_watch']['deaths'][:WATCHED_DEATHS]]
 
 
 def warned_in_long_excursion(probe):
@@ -321,23 +324,17 @@ def run_one(sup, job, run, base_env, box, budget):
     record['launch'] = launch_outcome(capped_log(sup, 'launch-%s' % tag), job['workspace'])
     sup.stop(launch)
     record['survivors'] = box.end()
-    text = read_capped(result_path, FILE_CAP) if os.path.isfile(result_path) else None
-    if text is not None:
-        try:
-            record['probe'] = json.loads(text)
-        except ValueError as err:
-            record['probe_error'] = 'result unreadable: %s' % err
-        if not isinstance(record['probe'], dict):
-            record['probe'] = None
-            record.setdefault('probe_error', 'result unreadable: not an object')
-        record['launch']['ended'].extend(watched_deaths(record['probe']))  # whether or not the run is refused
+    if os.path.lexists(result_path):
+        record['probe'], why = probe_record(result_path)
+        if why:
+            record['probe_error'] = why
     if record['probe'] is not None:
+        record['launch']['ended'].extend(watched_deaths(record['probe']))  # whether or not the run is refused
         with open(os.path.join(log_dir, 'probe-%s.json' % tag), 'w') as f:
             json.dump(record['probe'], f, indent=1, sort_keys=True)
         problem = probe_problem(record['probe'], run['plan'], started_wall, time.time())
         if problem:
-            record['probe'], record['probe_error'] = None, 'result refused: %s' % problem
-            record['probe_refused'] = problem
+            refuse(record, problem)
     elif 'probe_error' not in record and record.get('budget'):
         record['probe_error'] = record['budget']
     elif 'probe_error' not in record:
@@ -351,13 +348,34 @@ def run_one(sup, job, run, base_env, box, budget):
         record['master']['memory']['oom_kills'] -= killed_before
     problem = master_problem(record['master'], master_died)
     if problem:
-        record['probe'], record['probe_refused'] = None, problem
-        record['probe_error'] = 'result refused: %s' % problem
+        refuse(record, problem)
     return record
 
 
+def probe_record(path):
+    """``(value, None)``: the probe's result in ``path`` as a checked
+    :class:`~exam_lab.grader.score.records.ProbeRecord`'s value (its text clean); ``(None, why)`` when
+    it is not one (too large, not JSON, a key or value the probe never writes): the run's crash, said
+    so, never data."""
+    try:
+        return read_record(path, ProbeRecord, ProbeRecord.MAX_BYTES).value, None
+    except RecordError as err:
+        return None, 'the probe\'s result was refused (a crash of the run): %s' % err
+
+
+def refuse(record, problem):
+    """A run's result that is not its measurement (``problem``: why): the rubric sees no probe; the
+    result stays in the record as ``refused_probe`` (the teacher's flight plot draws it)."""
+    if record['probe'] is not None:
+        record['refused_probe'] = record['probe']
+    record['probe'], record['probe_refused'] = None, problem
+    record['probe_error'] = 'result refused: %s' % problem
+
+
 def session(job):
-    result = {'build': None, 'runs': [], 'survivors': 0}
+    """Check, build and run one submission (the module's docstring); returns the value of its
+    :class:`~exam_lab.grader.score.records.SessionRecord`."""
+    result = {'outcome': 'ran', 'build': None, 'runs': [], 'survivors': 0}
     box = Box.attached(job['box'])
     # The judge keeps the grader's environment, with a HOME and ROS folders of its own the box cannot
     # see; its folder is its own (0700), where it writes as its uid.
@@ -378,6 +396,7 @@ def session(job):
         if by_budget and (result['launch_check'] or {}).get('status', 0) is None:
             result['budget_used'] = result['error'] = budget.spend(
                 'roslaunch\'s check of the launch file was stopped after %.0f s' % limit)
+            result['outcome'] = 'check_stopped'
             return result
         limit, by_budget = budget.limit(job['build_timeout'], STEP_STOP_S)
         status, _, seconds = sup.run(
@@ -393,6 +412,7 @@ def session(job):
                 if by_budget else 'catkin_make did not finish within the build\'s time limit (%.0f s)' % limit
         if status != 0:
             result['budget_used'] = budget.used
+            result['outcome'] = 'build_stopped' if status is None else 'build_failed'
             return result
         for run in job['runs']:
             if run['tag'] == 'threshold':
@@ -417,9 +437,14 @@ def main(argv):
         return 2
     with open(argv[0]) as f:
         job = json.load(f)
-    result = session(job)
-    with open(os.path.join(job['log_dir'], 'session.json'), 'w') as f:
-        json.dump(result, f, indent=1, sort_keys=True)
+    try:
+        record = SessionRecord.make(session(job))
+    except RecordError as err:  # the grader's own bug: the runner says the session failed, and why
+        sys.stderr.write('the session\'s record is not one: %s\n' % err)
+        return 1
+    with open(os.path.join(job['log_dir'], SessionRecord.FILE + '.part'), 'w') as f:
+        f.write(record.to_json())
+    os.rename(os.path.join(job['log_dir'], SessionRecord.FILE + '.part'), os.path.join(job['log_dir'], SessionRecord.FILE))
     return 0
 
 

@@ -5,6 +5,7 @@ import os
 import shutil
 import stat
 import subprocess
+import tempfile
 
 #: Most bytes and entries of one upload staged for a box (unpacking's own budget applies inside).
 UPLOAD_BYTES = 256 << 20
@@ -102,3 +103,29 @@ def _tmpfs(path, size, uid):
                            % (size, uid, uid), 'exam-box', path],
                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=30)
     return done.returncode == 0
+
+
+def staged_work(prefix, sources, parent=None, bounds=None, refused=None):
+    """A work folder for a box (in ``parent``, by default the system's temp folder: the box's user must
+    reach it), with each ``(name, path)`` of ``sources`` staged read-only as
+    ``<work>/upload/<index>/<name>``, within ``bounds`` (``(bytes, files)``; one upload's when None);
+    returns ``(work, [staged paths])``. With ``refused`` (a dict), a source over its bounds is not
+    staged (None in its place) and ``refused`` receives ``{its path: why}``; otherwise it raises
+    :class:`UploadRefused`."""
+    work = tempfile.mkdtemp(prefix=prefix, dir=parent)
+    os.chmod(work, 0o711)
+    staged = []
+    for sub in ('upload', 'ws', 'ws/src'):
+        os.mkdir(os.path.join(work, sub), 0o755)
+    for index, (name, path) in enumerate(sources):
+        os.mkdir(os.path.join(work, 'upload', str(index)), 0o755)
+        staged.append(os.path.join(work, 'upload', str(index), name if name not in ('', '.', '..') else 'upload'))
+        try:
+            stage_upload(path, staged[-1], *(bounds or ()))
+        except UploadRefused as err:
+            if refused is None:
+                raise
+            refused[path] = str(err)
+            shutil.rmtree(os.path.dirname(staged[-1]), ignore_errors=True)
+            staged[-1] = None
+    return work, staged

@@ -69,6 +69,31 @@ def pids_of_uid(uid):
     return found
 
 
+def left_behind(base):
+    """The uids ``base + N`` (``BOX_UID_BASE`` or ``JUDGE_UID_BASE``) with a living process while no
+    grader holds slot N: what a grading left behind. A slot another grader holds is that grading's
+    business, so two graders on one machine never take each other's boxes for leftovers."""
+    found = []
+    for slot in range(SLOTS):
+        if pids_of_uid(base + slot) and not _held(slot):
+            found.append(base + slot)
+    return found
+
+
+def _held(slot):
+    """Whether a grader holds slot ``slot``'s lock now (tried without waiting, and let go at once)."""
+    try:
+        lock = open(os.path.join(LOCK_DIR, 'box-%d' % slot))
+    except FileNotFoundError:
+        return False
+    with lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            return True
+        return False
+
+
 def end_uid(uid):
     """Kill whatever still runs as ``uid``; returns how many there were."""
     left = pids_of_uid(uid)

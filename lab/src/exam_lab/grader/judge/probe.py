@@ -30,9 +30,10 @@ The main scenario (times are the script's, all recorded as wall-clock times of t
    and above the threshold and ``NEAR_M`` below it, checked by flying there (a wrong formula costs
    question 11 only);
 4. the flight (docs/grading.md's table of legs says which wrong node each leg tells from a right one):
-   rest below (``REST_S``), a short excursion above (``SHORT_S``), just below (``near``, ``GAP_S``), a
-   long excursion (delay + ``AFTER_S``, longer for a late WARNING), just below (``BACK_S``), further
-   below (``DEEP_S``); every service call is recorded with its arrival time. Each leg's hold counts from
+   rest below (``REST_S``, longer for a NORMAL the node owes), a short excursion above (``SHORT_S``),
+   just below (``near``, ``GAP_S``), a long excursion (delay + ``AFTER_S``, longer for a late WARNING),
+   just below (``BACK_S``), further below (``DEEP_S``, longer for a late NORMAL); every service call is
+   recorded with its arrival time. Each leg's hold counts from
    the node's own first value on its side, and every leg is checked on the node's own values (``legs``):
    the rubric times each rule from them and judges nothing on a leg the node's value did not reach.
 """
@@ -77,12 +78,18 @@ REST_S = 2.0
 SHORT_S = 2.5
 #: Just below the threshold after the short excursion: a count that is not reset there shows later.
 GAP_S = 2.0
-#: The long excursion lasts delay + AFTER_S: past the WARNING window's end (delay + 0.5 s).
+#: The long excursion lasts delay + AFTER_S: past the WARNING window's end (the delay and the larger of
+#: 0.5 s and one period of the slowest input and a tick: 1.39 s at most, rubric.warning_window).
 AFTER_S = 1.5
 #: Just below the threshold after the long excursion: NORMAL must come here, at once.
 BACK_S = 1.5
 #: Further below (the rest's value): the NORMAL of a node that waits for a margin, for question 13.
 DEEP_S = 1.5
+#: A NORMAL the node owes (its last call was a WARNING) is waited for on the rest and on the last leg,
+#: up to the delay, AFTER_S and one period of the slowest input after its own value came back below
+#: (:func:`normal_wait`): a node that goes back to NORMAL only after the delay below, checking at each
+#: reading, is seen doing it, so its late NORMAL costs Q14b's "at once" only, not Q13 as well, and a
+#: WARNING it gave during the calibration does not hide the flight's WARNING from it.
 #: The return legs fly the node's own value this far below the threshold (student units), accepted
 #: up to NEAR_MAX_M below: closer than any noise band a student might wait for (mydrone's thermometer
 #: alone moves the altitude by about 0.45 m).
@@ -372,6 +379,23 @@ def on_side(value, threshold, side):
     return value > threshold if side == 'above' else value <= threshold
 
 
+def owes(calls, side, since):
+    """Whether a node whose service calls are ``calls`` (``[(time, request)]``) still owes the call a
+    leg flown on ``side`` since ``since`` waits for: above, a WARNING (none came since); below, a
+    NORMAL (its last WARNING or NORMAL was a WARNING, whenever it came)."""
+    if side == 'above':
+        return not any(t >= since and request_meaning(s) == 'WARNING' for t, s in calls)
+    statuses = [request_meaning(s) for _, s in sorted(calls)]
+    statuses = [s for s in statuses if s in ('WARNING', 'NORMAL')]
+    return bool(statuses) and statuses[-1] == 'WARNING'
+
+
+def normal_wait(delay, rates):
+    """Seconds a NORMAL the node owes is waited for after its own value came back below: the delay,
+    AFTER_S and one period of the slowest input (``rates``: topic -> Hz)."""
+    return delay + AFTER_S + 1.0 / min(rates.values())
+
+
 #: The main flight's legs, in their order.
 FLIGHT_LEGS = ('rest', 'short_up', 'short_down', 'long_up', 'long_down', 'deep_down')
 
@@ -612,10 +636,12 @@ class Probe(object):
         self.result['calibration'] = calibration
         return chosen['lo']['x'], chosen['hi']['x'], chosen['near']['x']
 
-    def leg(self, x, side, hold, late=0.0):
+    def leg(self, x, side, hold, late=0.0, late_from=None):
         """Fly at ``x`` for ``hold`` s counted from the node's own first value on ``side`` (the input's
         change when the output cannot be read, or when that value never comes within REACH_S); with
-        ``late``, keep flying while no WARNING came, up to ``late`` s. Returns the input's change time."""
+        ``late``, keep flying while the node still owes this side's call (:func:`owes`), up to ``late``
+        s after ``late_from`` (default: that first value). Returns ``(the input's change, that first
+        value's time)``."""
         since = self.fly(x)
         start = since
         if self.recorder is not None:
@@ -624,21 +650,23 @@ class Probe(object):
                                                if on_side(v, threshold, side)), None), REACH_S, period=0.05)
             start = reached if reached is not None else since
         time.sleep(max(0.0, start + hold - time.time()))
-        if late > hold:
-            wait_until(lambda: any(t >= since and request_meaning(s) == 'WARNING' for t, s in self.drone.service.calls())
-                       or not self.graph.student_nodes(), start + late - time.time(), period=0.1)
-        return since
+        deadline = (start if late_from is None else late_from) + late
+        if late > 0 and deadline > time.time():
+            wait_until(lambda: not owes(self.drone.service.calls(), side, since) or not self.graph.student_nodes(),
+                       deadline - time.time(), period=0.1)
+        return since, start
 
     def flight(self, lo, hi, near):
         delay = self.plan['delay']
         late = self.plan.get('late_warning', 0.0)
+        late_normal = normal_wait(delay, self.drone.rates)
         schedule = {}
-        schedule['rest'] = self.leg(lo, 'below', REST_S)
-        schedule['short_up'] = self.leg(hi, 'above', SHORT_S)
-        schedule['short_down'] = self.leg(near, 'below', GAP_S)
-        schedule['long_up'] = self.leg(hi, 'above', delay + AFTER_S, late)
-        schedule['long_down'] = self.leg(near, 'below', BACK_S)
-        schedule['deep_down'] = self.leg(lo, 'below', DEEP_S)
+        schedule['rest'] = self.leg(lo, 'below', REST_S, late_normal)[0]
+        schedule['short_up'] = self.leg(hi, 'above', SHORT_S)[0]
+        schedule['short_down'] = self.leg(near, 'below', GAP_S)[0]
+        schedule['long_up'] = self.leg(hi, 'above', delay + AFTER_S, late)[0]
+        schedule['long_down'], back = self.leg(near, 'below', BACK_S)
+        schedule['deep_down'] = self.leg(lo, 'below', DEEP_S, late_normal, late_from=back)[0]
         schedule['end'] = time.time()
         self.result['schedule'] = schedule
         self.result['legs'] = self.legs(schedule, FLIGHT_LEGS)

@@ -14,16 +14,14 @@ import html
 import json
 import os
 
-from exam_lab.grader.publish import feedback, flightplot, gradescope, hand, moodle, page
+from exam_lab.grader.publish import feedback, flightplot, gradescope, hand, moodle, page, report
 from exam_lab.grader.score import safe_text
 
 
-def _grade_md(folder, record):
-    path = os.path.join(folder, 'grade.md')
-    if not os.path.isfile(path):
-        return ''
-    with open(path) as f:
-        return '\n'.join(l for l in f.read().splitlines() if not l.startswith('# '))
+def _grade_md(record):
+    """grade.md's text as the page shows it (its title left out: the section has its own), made from
+    the grade record the desk was given, never from the file read back."""
+    return '\n'.join(l for l in report.markdown(record).splitlines() if not l.startswith('# '))
 
 
 def _failure(err):
@@ -44,16 +42,16 @@ def _student(out, record, single):
     except Exception as err:
         entry['problems'].append('results.json (Gradescope) not written: %s' % _failure(err))
     try:
-        if flightplot.draw(flightplot.load_runs(os.path.join(folder, 'logs')), os.path.join(folder, 'flight.png'),
+        if flightplot.draw(flightplot.load_runs(folder), os.path.join(folder, 'flight.png'),
                            record['student']):
             entry['plot'] = os.path.join(relative, 'flight.png')
     except Exception as err:
         entry['problems'].append('flight plot not drawn: %s' % _failure(err))
         entry['plot_failed'] = True
     try:
-        entry['grade_md'] = _grade_md(folder, record)
-    except Exception as err:  # the page makes it from the record instead
-        entry['problems'].append('grade.md not read: %s' % _failure(err))
+        entry['grade_md'] = _grade_md(record)
+    except Exception as err:  # a bug on one record's text: the page says so and goes on
+        entry['problems'].append('grade.md not shown: %s' % _failure(err))
     return entry
 
 

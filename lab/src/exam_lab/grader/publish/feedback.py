@@ -12,8 +12,9 @@ teacher's setting in lab/check_visibility.ini): the points only, or also the evi
 the main run; never the threshold run (its plot, its value, its words) nor the teacher's notes. Every
 text in it is escaped; it has no script and loads nothing (its Content-Security-Policy says so to the
 browser): the plot is inline SVG. It holds nothing that changes from one run to the next but the grade
-itself (no date, a fixed SVG id salt), so a rescore that moves nothing gives the same bytes and Moodle,
-which imports only new or changed files, notifies no one.
+itself (no date, a fixed SVG id salt): the pages of two runs differ only where a grade or its evidence
+moved. Moodle replaces every page of an uploaded zip all the same: its importer compares content hashes
+only with the files a plugin lists, and the file feedback plugin lists none (see the rule below).
 
 Released, as the worksheet releases a grade (:data:`exam_lab.grader.publish.moodle.GRADED`): a status
 "graded" or "graded with fixes", and either no hand point in hand.csv (the machine's part alone, the page
@@ -47,16 +48,20 @@ PLUGIN = ('assignfeedback', 'file')
 #   download_submissions() in 3.1-4.0 added a last '_').
 # - lib/moodlelib.php clean_filename($string) = clean_param($string, PARAM_FILE); PARAM_FILE
 #   (lib/classes/param.php clean_param_value_file(), lib/moodlelib.php clean_param() before 4.4): fix_utf8,
-#   then remove [[:cntrl:]] and & < > " ` | ' : \ /, and '.' or '..' alone becomes ''.
+#   then preg_replace('~[[:cntrl:]]|[&<>"`\|\':\\\\/]~u', ...) removes control characters and
+#   & < > " ` | ' : \ /, and '.' or '..' alone becomes ''. PHP's /u sets PCRE2_UCP, so [[:cntrl:]] is
+#   Unicode's Cc: the C1 controls U+0080-U+009F too (PHP 8.2 removes U+0085).
 # - mod/assign/feedback/file/importziplib.php is_valid_filename_for_import(): a file whose name starts with
 #   '.' or '~' is ignored; each folder of its path is split explode('_', $part, 5): [1] must be a
 #   participant's unique id, [2] and [3] the plugin's subtype and type; the rest is the file's name. The
 #   name part ([0]) cannot hold a '_' (hence Moodle's str_replace), and 3.x wants a fifth part: the last
-#   '_' is written, which every version reads. is_file_modified(): a file whose content hash is unchanged
-#   is not imported again.
-_PARAM_FILE = re.compile('[\x00-\x1f\x7f\ud800-\udfff]|[&<>"`|\':\\\\/]')
+#   '_' is written, which every version reads (importziplib.php at 0203d8f2; 3.1-4.0's splits the whole
+#   path). is_file_modified() compares a file's content hash with the plugin's get_files(), which
+#   assignfeedback_file leaves as assign_plugin's (mod/assign/assignmentplugin.php: none): each page of
+#   an upload is imported, changed or not. The test oracles: lab/test/unit/test_grader_moodle_names.py.
+_PARAM_FILE = re.compile('[\x00-\x1f\x7f-\x9f\ud800-\udfff]|[&<>"`|\':\\\\/]')
 #: A download folder's (or flat file's) name: Moodle's full name, the participant's id, the plugin.
-_DOWNLOAD = re.compile(r'^(.*?)_(\d+)_assign(?:submission|feedback)_')
+_DOWNLOAD = re.compile(r'^(.*?)_([0-9]+)_assign(?:submission|feedback)_')
 
 
 def clean_filename(text):
@@ -107,7 +112,7 @@ def threshold_ran(folder):
 def plot_svg(folder):
     """The main run's flight plot as inline SVG text, or None when there is nothing to draw. Only the
     main run: the threshold run's panel names its hidden value."""
-    runs = [(tag, probe) for tag, probe in flightplot.load_runs(os.path.join(folder, 'logs')) if tag == 'main']
+    runs = [(tag, probe) for tag, probe in flightplot.load_runs(folder) if tag == 'main']
     import matplotlib
     with tempfile.TemporaryDirectory(prefix='exam-feedback-') as scratch:
         path = os.path.join(scratch, 'flight.svg')

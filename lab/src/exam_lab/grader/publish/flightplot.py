@@ -1,13 +1,15 @@
 """The flight plot of one student: what its node published against the oracle, the threshold, the
 warning service's calls and the legs the grader flew, one panel per run. No rospy here.
 
-Drawn from the probe's results (``logs/probe-main.json``, ``logs/probe-threshold.json``) with
-matplotlib's Agg backend (no display needed); times are seconds from the probe's start.
+Drawn from the probe's results as the grading kept them (:func:`load_runs`: the session's record in
+the student's measurements, never a file of the judge's or a box's read back) with matplotlib's Agg
+backend (no display needed); times are seconds from the probe's start.
 """
 import json
 import math
 import os
 
+from exam_lab.grader.score.records import MEASUREMENTS
 from exam_lab.grader.score.rubric import calls
 from exam_lab.grader.score.safe_text import one_line
 
@@ -26,18 +28,20 @@ _CALL_COLOUR = {'WARNING': '#cc0000', 'NORMAL': '#2a9d2a'}
 LIMIT = 1e6
 
 
-def load_runs(log_dir):
-    """``[(tag, probe result)]`` of the runs whose probe wrote a result."""
-    runs = []
-    for tag in ('main', 'threshold'):
-        path = os.path.join(log_dir, 'probe-%s.json' % tag)
-        if os.path.isfile(path):
-            try:
-                with open(path) as f:
-                    runs.append((tag, json.load(f)))
-            except ValueError:
-                continue
-    return runs
+def load_runs(folder):
+    """``[(tag, probe result)]`` of the runs whose probe gave a result, a result refused for its times or
+    its master too (``refused_probe``), from the measurements the grading kept in ``folder``
+    (:data:`~exam_lab.grader.score.records.MEASUREMENTS`, the grader's own file): their session is the
+    :class:`~exam_lab.grader.score.records.SessionRecord` made when the student was graded, its text
+    made safe there. ``[]`` without measurements. Drawn as they are: a file edited by hand only costs
+    what :class:`Clamp` leaves out."""
+    path = os.path.join(folder, MEASUREMENTS)
+    if not os.path.isfile(path):
+        return []
+    with open(path) as f:
+        session = json.load(f).get('session') or {}
+    runs = [(run.get('tag'), run.get('probe') or run.get('refused_probe')) for run in session.get('runs') or []]
+    return [(tag, probe) for tag, probe in runs if isinstance(probe, dict)]
 
 
 def legs(schedule):

@@ -81,7 +81,7 @@ def duration(seconds):
 
 
 class ClassProgress(object):
-    """The class run's progress, for :func:`exam_lab.grader.runner.grade_class` (thread-safe)."""
+    """The class run's progress, for :func:`exam_lab.grader.class_run.grade_class` (thread-safe)."""
 
     def __init__(self, jobs, stream=None, live=None, clock=time.monotonic):
         self.stream = stream or sys.stdout

@@ -11,10 +11,12 @@ runner (the grade record's ``participant`` and ``folder``), and the outputs sent
 import collections
 import re
 
-#: The participant's number in a "download all submissions" name (folder or flat file).
-_FOLDER_NUMBER = re.compile(r'_(\d+)_assign(?:submission|feedback)_')
-#: The whole prefix Moodle gives a student's folder (or flat file) in that zip.
-_MOODLE_FOLDER = re.compile(r'^(.*?_\d+_assign(?:submission|feedback)_[a-z]+_)')
+#: The participant's number in a "download all submissions" name (folder or flat file): ASCII digits, as
+#: Moodle's importer takes it (PHP's is_numeric: a name with another script's digits is no number).
+_FOLDER_NUMBER = re.compile(r'_([0-9]+)_assign(?:submission|feedback)_')
+#: The whole prefix Moodle gives a student's folder (or flat file) in that zip: the folder of Moodle 3.1 to
+#: 4.0 and a flat file's prefix end in '_', a folder of Moodle 4.1 on ends with the plugin's name.
+_MOODLE_FOLDER = re.compile(r'^(.*?_[0-9]+_assign(?:submission|feedback)_[a-z]+(?:_|$))')
 #: Endings of the files a class's run writes in OUT beside the students' folders (grades.csv, index.html,
 #: hand.csv, similarity.json, the filled worksheet...): a student's folder never has one.
 OUTPUT_ENDINGS = ('.csv', '.html', '.json', '.jsonl', '.md', '.png', '.txt', '.log', '.zip')

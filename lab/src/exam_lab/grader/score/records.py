@@ -9,15 +9,20 @@ on anything unexpected: a record of an unexpected shape is a crash of that box, 
 Schemas are plain values: a type (``str``, ``int``, ``float``, ``bool``), :class:`Text` (a string of at
 most ``n`` characters), :class:`Number` (finite, within bounds), ``[schema]`` (a list of at most
 :data:`MAX_ITEMS`; :class:`Items` for another limit), ``{key: schema}`` (an object; :class:`Optional` keys may be missing), :class:`Maybe`
-(None or the schema), :class:`OneOf` (one of fixed values), a tuple of schemas (any one of them).
+(None or the schema), :class:`OneOf` (one of fixed values), :class:`Map` (an object whose keys are data),
+:class:`Row` (a list of fixed length, each item its own schema), a tuple of schemas (any one of them).
 """
 import json
 import math
 import os
 import re
 
+from exam_lab.grader.score.safe_text import cleaned
 from exam_lab.grader.score.sheets import SHEETS
 
+#: What a grading measured, kept beside grade.json by the runner (its session a :class:`SessionRecord`):
+#: a rescore scores it again, the flight plot draws from it.
+MEASUREMENTS = 'measurements.json'
 #: Longest string of a record (a note, a path) and most items of one list.
 MAX_TEXT = 2000
 MAX_ITEMS = 500
@@ -33,8 +38,11 @@ class Text(object):
 
 
 class Number(object):
-    def __init__(self, low=-1e12, high=1e12, integer=False):
-        self.low, self.high, self.integer = low, high, integer
+    """A number within ``[low, high]``; with ``finite=False`` any float, NaN and infinities too (a value a
+    student's node published, which the rubric judges)."""
+
+    def __init__(self, low=-1e12, high=1e12, integer=False, finite=True):
+        self.low, self.high, self.integer, self.finite = low, high, integer, finite
 
 
 class Items(object):
@@ -42,6 +50,21 @@ class Items(object):
 
     def __init__(self, schema, limit=MAX_ITEMS):
         self.schema, self.limit = schema, limit
+
+
+class Map(object):
+    """An object whose keys are data (node or topic names): at most ``limit`` keys matching ``key``,
+    each value matching ``schema``."""
+
+    def __init__(self, key, schema, limit=MAX_ITEMS):
+        self.key, self.schema, self.limit = key, schema, limit
+
+
+class Row(object):
+    """A list of exactly ``len(schemas)`` items, each matching its own schema (``[t, request]``)."""
+
+    def __init__(self, *schemas):
+        self.schemas = schemas
 
 
 class Maybe(object):
@@ -95,7 +118,7 @@ def check(value, schema, where='record'):
         if isinstance(value, bool) or not isinstance(value, wanted):
             raise RecordError('%s: %s expected, got %s' % (where, 'an integer' if schema.integer else 'a number',
                                                            type(value).__name__))
-        if not (math.isfinite(value) and schema.low <= value <= schema.high):
+        if schema.finite and not (math.isfinite(value) and schema.low <= value <= schema.high):
             raise RecordError('%s: %s is outside [%g, %g]' % (where, _shown(value), schema.low, schema.high))
         return value
     if isinstance(schema, list):
@@ -106,6 +129,18 @@ def check(value, schema, where='record'):
         if len(value) > schema.limit:
             raise RecordError('%s: %d %s (at most %d)' % (where, len(value), _noun(where), schema.limit))
         return [check(item, schema.schema, '%s[%d]' % (where, index)) for index, item in enumerate(value)]
+    if isinstance(schema, Row):
+        if not isinstance(value, list) or len(value) != len(schema.schemas):
+            raise RecordError('%s: a list of %d items expected, got %s' % (where, len(schema.schemas), _shown(value)))
+        return [check(item, inner, '%s[%d]' % (where, index))
+                for index, (item, inner) in enumerate(zip(value, schema.schemas))]
+    if isinstance(schema, Map):
+        if not isinstance(value, dict):
+            raise RecordError('%s: an object expected, got %s' % (where, type(value).__name__))
+        if len(value) > schema.limit:
+            raise RecordError('%s: %d keys (at most %d)' % (where, len(value), schema.limit))
+        return {check(key, schema.key, '%s key' % where): check(inner, schema.schema, '%s[%s]' % (where, _shown(key)))
+                for key, inner in value.items()}
     if isinstance(schema, dict):
         if not isinstance(value, dict):
             raise RecordError('%s: an object expected, got %s' % (where, type(value).__name__))
@@ -134,10 +169,11 @@ def _shown(value):
     return text if len(text) <= 60 else text[:57] + '...'
 
 
-def parse(raw, schema, what):
-    """The JSON object in ``raw`` (bytes), checked against ``schema``."""
+def parse(raw, schema, what, constants=False):
+    """The JSON object in ``raw`` (bytes), checked against ``schema``; with ``constants``, NaN and
+    Infinity are numbers (Python's json writes them for a non-finite float)."""
     try:
-        value = json.loads(raw.decode('utf-8'), parse_constant=_no_constant)
+        value = json.loads(raw.decode('utf-8'), parse_constant=None if constants else _no_constant)
     except (UnicodeDecodeError, ValueError) as err:
         raise RecordError('%s: not JSON: %s' % (what, err))
     return check(value, schema, what)
@@ -157,8 +193,12 @@ def _relative(path, where):
 class Record(object):
     """A record type: its file's name (``FILE``), its cap (``MAX_BYTES``), its ``SCHEMA``; a record's
     attributes are the schema's keys (None when an optional one is missing), ``value`` the whole
-    checked object."""
+    checked object. With ``CLEAN``, every string of the record, keys too, is
+    :func:`~exam_lab.grader.score.safe_text.clean` once it matched its schema: the one place where
+    a student's text (node and topic names, log lines, a request) is made safe, whoever reads the
+    record later. ``NON_FINITE``: NaN and Infinity may be read from its JSON (measured values)."""
     FILE = MAX_BYTES = SCHEMA = None
+    CLEAN = NON_FINITE = False
 
     def __init__(self, value):
         self.value = value
@@ -169,9 +209,23 @@ class Record(object):
         """The record in ``raw`` (bytes); raises :class:`RecordError` on anything unexpected."""
         if len(raw) > max_bytes:
             raise RecordError('%s: %d bytes (at most %d)' % (cls.FILE, len(raw), max_bytes))
-        record = cls(parse(raw, cls.SCHEMA, cls.FILE))
+        return cls._made(parse(raw, cls.SCHEMA, cls.FILE, constants=cls.NON_FINITE))
+
+    @classmethod
+    def make(cls, value):
+        """The record of ``value`` (made by the grader itself from what it read): checked as one read
+        from a file is; raises :class:`RecordError`."""
+        return cls._made(check(value, cls.SCHEMA, cls.FILE))
+
+    @classmethod
+    def _made(cls, value):
+        record = cls(cleaned(value) if cls.CLEAN else value)
         record.validate()
         return record
+
+    def to_json(self):
+        """The record's JSON text: :meth:`from_json` of it gives the same record."""
+        return json.dumps(self.value, indent=1, sort_keys=True)
 
     def validate(self):
         """Checks across fields, beyond the schema's."""
@@ -292,3 +346,116 @@ class SimilarityRecord(Record):
 
 #: The only markup of the detector's HTML (the page shows it as is): its highlight spans.
 _HIGHLIGHT = re.compile(r"<span class='highlight-(?:red|green)'>|</span>")
+
+
+#: A value the student's node published or the flight was computed from: any float (NaN, infinities).
+_VALUE = Number(finite=False)
+#: A ROS name (node, topic, service, type) as the master gave it: the student's node chose it.
+_NAME = Text(1000)
+#: A time (the wall clock's seconds, the judge's own).
+_TIME = Number()
+_COUNT = Number(0, 1e12, integer=True)
+#: Most service calls (and answers) of one run: a node that calls in a loop is judged for it, not
+#: refused (the probe's result is read up to egress.FILE_CAP bytes: fewer than this many calls fit).
+MAX_CALLS = 200000
+#: Most node deaths the judge's watch lists in one run (a node respawned in a loop).
+MAX_DEATHS = 20000
+#: Longest request of a service call the node made; the drone's answer quotes it (repr: each
+#: character at most 4), with its own words around.
+MAX_REQUEST = MAX_TEXT
+_REQUEST = Text(MAX_REQUEST)
+_ANSWER = Text(4 * MAX_REQUEST + 500)
+
+#: One leg of the flight checked on the node's own values (:func:`exam_lab.grader.judge.probe.leg_check`).
+LEG = {'side': OneOf('above', 'below'), 'reached': Maybe(_TIME), 'stays': Maybe(_TIME), 'off_side': _COUNT,
+       'first': Maybe(_VALUE), 'last': Maybe(_VALUE), 'samples': _COUNT}
+
+
+class ProbeRecord(Record):
+    """The probe's result (:mod:`exam_lab.grader.judge.probe`, ``probe-<tag>.json``): what it measured of
+    the student's node in one run, as the rubric reads it. Written by the judge's uid, of names and
+    values the student's node chose (node and topic names, requests, published values): root reads it
+    through :func:`~exam_lab.grader.host.egress.read_record` and takes a result that does not match for
+    the run's crash. The keys after ``start_timeout`` up to ``rate`` are there as far as the flight got
+    (a node that never started has no ``output``); the flight's legs are named by the probe
+    (``schedule`` and ``legs`` keys)."""
+    FILE = 'probe.json'
+    MAX_BYTES = 4 << 20
+    CLEAN = NON_FINITE = True
+    SCHEMA = {
+        'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
+        'margin': Number(), 'delay': Number(), 'start_timeout': Number(),
+        'input_rates': Map(Text(100), Number(0, 1e6), 10),
+        'nodes': Optional([_NAME]), 'node_seen_s': Optional(Maybe(Number())),
+        'subscribed': Optional(Map(_NAME, [_NAME], 10)),
+        'input_types': Optional(Map(_NAME, {'type': Maybe(_NAME), 'connected': bool, 'refused': Maybe(Text()),
+                                            'adapted': Maybe(_NAME), 'published': Optional(_NAME)}, 10)),
+        'output': Optional({'expected': _NAME, 'topic': Maybe(_NAME), 'type': Maybe(_NAME), 'candidates': [_NAME]}),
+        'formula': Optional(Items({'inputs': Map(Text(100), _VALUE, 4), 'expected': _VALUE,
+                                   'published': Maybe(_VALUE), 'samples': _COUNT}, 20)),
+        'calibration': Optional(dict({'by': OneOf('own', 'oracle'), 'reason': Text(), 'fit': Maybe(Row(_VALUE, _VALUE))},
+                                     **{side: {'x': _VALUE, 'target': _VALUE, 'value': Maybe(_VALUE)}
+                                        for side in ('lo', 'hi', 'near')})),
+        'schedule': Optional(Map(Text(50), _TIME, 20)),
+        'legs': Optional(Maybe(Map(Text(50), LEG, 20))),
+        'rate': Optional({'samples': _COUNT, 'hz': Maybe(Number()), 'max_gap': Maybe(Number()),
+                          'non_finite': Optional(_COUNT)}),
+        'node_watch': {'deaths': Items({'node': _NAME, 't': Maybe(_TIME), 'detail': Text()}, MAX_DEATHS),
+                       'nodes': [_NAME]},
+        'calls': Items(Row(_TIME, _REQUEST), MAX_CALLS),
+        'answers': Items(Row(_TIME, _REQUEST, bool, _ANSWER), MAX_CALLS),
+        'graph': Map(_NAME, {'publishes': Items(Row(_NAME, _NAME)), 'subscribes': Items(Row(_NAME, _NAME)),
+                             'services': [_NAME]}),
+        'alive_at_end': bool, 't0': _TIME,
+        'clock': {'use_sim_time': Items(Maybe((bool, _VALUE, Text())), 2), 'messages': _COUNT,
+                  'publishers': [_NAME], 'ros_time_is_wall': bool},
+        'judge_uid': Number(0, 2 ** 32, integer=True),
+        'trace': {'published': Items(Row(_TIME, Maybe(_VALUE)), 100000), 'oracle': Items(Row(_TIME, _VALUE), 1000)},
+    }
+
+
+#: How one grading ended (``outcome`` of :class:`SessionRecord`): the session's own ('ran': built,
+#: the runs tried; 'build_failed', 'build_stopped': by its limit or the budget; 'check_stopped':
+#: roslaunch's check stopped by the budget), and the runner's when no session ran or it failed.
+OUTCOMES = ('ran', 'build_failed', 'build_stopped', 'check_stopped',
+            'session_failed', 'session_killed', 'not_run', 'no_node', 'refused', 'inspection_failed', 'grader_failed')
+#: Most characters of a log excerpt (a build's or roslaunch's last lines) in the session's record.
+MAX_LOG_TEXT = 20000
+#: Most ended nodes roslaunch's output reports in one run (a node respawned in a loop).
+MAX_ENDED = 500
+
+_RUN = {
+    'tag': OneOf('main', 'threshold'), 'probe': Maybe(ProbeRecord.SCHEMA), 'refused_probe': Optional(ProbeRecord.SCHEMA),
+    'probe_error': Optional(Text(MAX_LOG_TEXT)), 'probe_refused': Optional(Text()),
+    'probe_status': Optional(Maybe(Number(-1e6, 1e6, integer=True))),
+    'master': {'uid': Maybe(Number(0, 2 ** 32, integer=True)),
+               'memory': Optional(Maybe({'limit': Maybe(_COUNT), 'peak': Maybe(_COUNT), 'oom_kills': Number(integer=True)}))},
+    'probe_uid': Optional(Maybe(Number(0, 2 ** 32, integer=True))),
+    'launch': {'ended': Items({'node': _NAME, 'how': OneOf('died', 'finished cleanly'), 'detail': Text()}, MAX_ENDED),
+               'not_started': Items(Text(), 50), 'tail': Text(MAX_LOG_TEXT)},
+    'launch_running': Optional(bool), 'seconds': Optional(Number(0)), 'budget': Optional(Text()),
+    'survivors': Optional(_COUNT),
+}
+
+
+class SessionRecord(Record):
+    """How one grading's session went (:mod:`exam_lab.grader.host.session`, ``session.json``): roslaunch's
+    check of the launch file, the build, each run (its probe's :class:`ProbeRecord` or why there is none,
+    roslaunch's words about the nodes), the processes left, the budget; ``outcome``, one of
+    :data:`OUTCOMES`. The runner makes one too when no session ran (``error``, ``refused``,
+    ``no_node``): the measurements a rescore reads hold this record."""
+    FILE = 'session.json'
+    MAX_BYTES = 24 << 20
+    CLEAN = NON_FINITE = True
+    SCHEMA = {
+        'outcome': OneOf(*OUTCOMES),
+        'build': Maybe({'status': Maybe(Number(-1e6, 1e6, integer=True)), 'seconds': Number(0), 'tail': Text(MAX_LOG_TEXT),
+                        'timeout': Number(0), 'stopped': Optional(Text())}),
+        'runs': Items(_RUN, 2),
+        'survivors': Optional(_COUNT),
+        'launch_check': Optional(Maybe({'file': Text(4096), 'status': Maybe(Number(-1e6, 1e6, integer=True)),
+                                        'refused': Text(MAX_LOG_TEXT), 'warnings': Items(Text(), 20),
+                                        'nodes': Items(_NAME, 20)})),
+        'budget_used': Optional(Maybe(Text())), 'error': Optional(Text(MAX_LOG_TEXT)),
+        'threshold_skipped': Optional(Text()), 'refused': Optional(bool), 'no_node': Optional(bool),
+    }

@@ -20,10 +20,14 @@ RATE_TOLERANCE = 0.10
 VALUE_TOLERANCE_M = 0.5
 VALUE_TOLERANCE_REL = 0.001
 #: Question 14b: WARNING accepted from delay - EARLY to delay + LATE s after the node's own value went
-#: beyond the threshold and stayed: 5 s less one reading of the 2 Hz input (4.5 s) falls outside.
+#: beyond the threshold and stayed: 5 s less one reading of the 2 Hz input (4.5 s) falls outside. LATE
+#: is at least one period of the slowest input and a tick of the node's 10 Hz (:func:`warning_window`):
+#: a node that checks its delay at each reading, or at each synchronised pair, warns at the first one
+#: at or after 5 s, up to one reading later.
 WARNING_EARLY_S = 0.3
 WARNING_LATE_S = 0.5
-#: Question 14b: NORMAL accepted up to this many s after the node's own value came back (at once).
+#: Question 14b: NORMAL accepted up to this many s after the node's own value came back (at once); one
+#: that comes later (the flight waits for it) is "not at once", Q14b's 0.5 alone.
 NORMAL_LATE_S = 0.5
 #: Question 13: this many calls repeating the previous status make "called in a loop".
 LOOP_REPEATS = 3
@@ -364,11 +368,25 @@ def _reached(probe, name):
     return leg.get('reached') or probe['schedule'][name]
 
 
+def slowest_period(probe):
+    """Seconds between two readings of the slowest input the judge's drone published: the sheet's drone,
+    at the rates its package's SPEC gives (``input_rates``, recorded by the probe)."""
+    rates = [r for r in ((probe or {}).get('input_rates') or {}).values() if r and r > 0]
+    return 1.0 / min(rates or [OLD_SLOWEST_HZ])
+
+
 def lag_tolerance(probe):
     """Seconds the node's value may take to follow its inputs: one period of the slowest input the
-    drone flew (``input_rates`` of the probe) plus LAG_SLACK_S."""
-    rates = [r for r in ((probe or {}).get('input_rates') or {}).values() if r and r > 0]
-    return 1.0 / min(rates or [OLD_SLOWEST_HZ]) + LAG_SLACK_S
+    drone flew plus LAG_SLACK_S."""
+    return slowest_period(probe) + LAG_SLACK_S
+
+
+def warning_window(probe):
+    """``(earliest, latest)`` s after the node's own value went beyond and stayed, for a WARNING on time:
+    the delay less WARNING_EARLY_S; the delay and the larger of WARNING_LATE_S and one period of the
+    slowest input and one tick of the node's 10 Hz (a node that checks at each reading)."""
+    delay = (probe or {}).get('delay', DELAY)
+    return delay - WARNING_EARLY_S, delay + max(WARNING_LATE_S, slowest_period(probe) + 1.0 / RATE_HZ)
 
 
 def leg_lag(probe, name):
@@ -460,9 +478,12 @@ def score_q13(sheet, session):
         if others:
             evidence += ' (it called with %s, which mean neither WARNING nor NORMAL)' % ', '.join(
                 '"%s"' % r[:40] for r in others[:4])
-    if up and up[0][0] - up_from > probe.get('delay', DELAY) + WARNING_LATE_S:
+    if up and up[0][0] - up_from > warning_window(probe)[1]:
         evidence += ' (the WARNING came late, %.1f s after the value went above: the flight waited for it)' % (
             up[0][0] - up_from)
+    if up and down and down_judged and down[0][0] > _back_end(probe):
+        evidence += ' (the NORMAL came late, %.1f s after the value came back below: the flight waited for it)' % (
+            down[0][0] - timed_from(probe, 'long_down')[0])
     refused = refused_calls(probe, schedule['rest'], schedule['end'])
     if refused and points:
         points /= 2
@@ -566,13 +587,14 @@ def score_q14b(sheet, session):
     if unreached_legs(probe, ['long_up']):
         return item('Q14b', 0, _leg_words(probe, 'long_up'))
     delay = probe.get('delay', DELAY)
+    early, late = warning_window(probe)
     warnings = _calls_between(probe, schedule['long_up'], _up_end(probe), 'WARNING')
     if not warnings:
         return item('Q14b', 0, 'no WARNING in %.1f s above the threshold, so no delay to judge'
                     % (schedule['long_down'] - _reached(probe, 'long_up')))
     up_from, up_words = timed_from(probe, 'long_up', stays=True)
     latency = warnings[0][0] - up_from
-    warn_ok = delay - WARNING_EARLY_S <= latency <= delay + WARNING_LATE_S
+    warn_ok = early <= latency <= late
     short_judged = not unreached_legs(probe, ['short_up'])
     short = _calls_between(probe, schedule['short_up'], schedule['long_up'], 'WARNING')
     short_from = timed_from(probe, 'short_up')[0]
@@ -587,9 +609,8 @@ def score_q14b(sheet, session):
     normal_latency = normals[0][0] - back_from if normals else None
     normal_ok = normal_judged and normal_latency is not None and normal_latency <= NORMAL_LATE_S
     points = 1.5 * warn_ok + 1.0 * short_ok + (0.5 * normal_ok if (warn_ok or short_ok) else 0.0)
-    notes = ['WARNING %.2f s after %s went above the threshold and stayed (%s: %.1f-%.1f s) (%s/1.5)' % (
-        latency, up_words, 'ok' if warn_ok else 'outside', delay - WARNING_EARLY_S,
-        delay + WARNING_LATE_S, 1.5 if warn_ok else 0)]
+    notes = ['WARNING %.2f s after %s went above the threshold and stayed (%s: %.2f-%.2f s) (%s/1.5)' % (
+        latency, up_words, 'ok' if warn_ok else 'outside', early, late, 1.5 if warn_ok else 0)]
     if not short_judged:
         notes.append('short excursion: %s (0/1)' % _leg_words(probe, 'short_up'))
     else:
@@ -605,15 +626,27 @@ def score_q14b(sheet, session):
     if not normal_judged:
         notes.append('NORMAL: %s (0/0.5)' % _leg_words(probe, 'long_down'))
     elif normal_latency is None:
-        later = _calls_between(probe, _back_end(probe), schedule['end'], 'NORMAL')
         notes.append('no NORMAL while %s was back just below the threshold%s%s (0/0.5)' % (
-            back_words, below, '; it came %.2f s later, further below: it waits for a margin' % (
-                later[0][0] - back_from) if later else ''))
+            back_words, below, _later_normal_words(probe, back_from)))
     else:
         notes.append('NORMAL %.2f s after %s came back just below the threshold%s (%s/0.5%s)' % (
             normal_latency, back_words, below, 0.5 if normal_ok and (warn_ok or short_ok) else 0,
             '' if warn_ok or short_ok else ', counted only with a delay'))
     return item('Q14b', points, '; '.join(notes))
+
+
+def _later_normal_words(probe, back_from):
+    """What became of the NORMAL the return just below did not see: it came soon after the value went
+    further below (the node waits for a margin), or later (it waits for a time: not at once), or not."""
+    schedule = probe['schedule']
+    later = _calls_between(probe, _back_end(probe), schedule['end'], 'NORMAL')
+    if not later:
+        return ''
+    deeper = _back_end(probe)
+    if later[0][0] - deeper <= lag_tolerance(probe):  # as soon as its value followed the input further below
+        return '; it came %.2f s later, further below: it waits for a margin' % (later[0][0] - back_from)
+    return '; it came %.2f s after the value came back, %.2f s after the input went further below: it waits for ' \
+           'a time, not at once' % (later[0][0] - back_from, later[0][0] - deeper)
 
 
 def _near_words(probe):

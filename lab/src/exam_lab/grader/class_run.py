@@ -1,0 +1,268 @@
+"""Grading a class: its students listed (for both engines: the local pool here and
+:mod:`~exam_lab.grader.engine.slurm`), each graded by :func:`grade_student` (one submission, by the runner),
+side by side in a pool of threads; the class's similarity check.
+"""
+import concurrent.futures
+import json
+import os
+import re
+import shutil
+import traceback
+
+from exam_lab.grader import runner
+from exam_lab.grader.boxed import archives, classlist, similarity
+from exam_lab.grader.host import sandbox, staging
+from exam_lab.grader.host.boxed_run import INTAKE_BOUNDS, SIMILARITY_BOUNDS, Boxed, InspectionFailed
+from exam_lab.grader.host.underlay import default_underlay, ensure_underlay
+from exam_lab.grader.host.bwrap import can_isolate
+from exam_lab.grader.publish import grades, report
+from exam_lab.grader.score import identity, records
+
+#: Gradings side by side per core when JOBS is not given. A grading mostly waits (its flight is timed),
+#: and each box's CPU is bounded to cores/JOBS, so two per core keep every point: measured by `make
+#: bench`'s grader stage on a class of 60 (docs/benchmarks.md, "The grader").
+JOBS_PER_CORE = 2
+#: Memory one grading is counted for when JOBS is not given: its processes use a few hundred MB (the
+#: bounds are higher: the box 2 GB, the master 384 MB, the probe 512 MB).
+JOB_MEMORY_BYTES = 1 << 30
+
+
+def default_jobs(cores=None, memory=None):
+    """JOBS when the teacher gives none: JOBS_PER_CORE per core this process may run on, no more than
+    the memory holds at JOB_MEMORY_BYTES each, at least 1."""
+    if cores is None:
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, 'sched_getaffinity') else (os.cpu_count() or 1)
+    if memory is None:
+        try:
+            memory = os.sysconf('SC_PAGE_SIZE') * os.sysconf('SC_PHYS_PAGES')
+        except (ValueError, OSError):
+            memory = JOB_MEMORY_BYTES * JOBS_PER_CORE * cores
+    return max(1, min(JOBS_PER_CORE * cores, memory // JOB_MEMORY_BYTES))
+
+
+def worst_case(students, jobs):
+    """Seconds a class of ``students`` takes at most, ``jobs`` side by side, when every grading uses
+    its whole budget: ceil(students / jobs) gradings one after the other, each
+    :data:`~exam_lab.grader.runner.STUDENT_BUDGET` + :data:`~exam_lab.grader.runner.AFTER_BUDGET_S` (the
+    class's own steps, its intake and similarity check, aside: INTAKE_BOUNDS, SIMILARITY_BOUNDS)."""
+    return -(-students // max(1, jobs)) * (runner.STUDENT_BUDGET + runner.AFTER_BUDGET_S)
+
+
+def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
+    """``[(student, folder or archive)]`` of a class, each name unique (``Jane Doe``, ``Jane Doe_2``):
+    the students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`); with
+    ``out``, the folder of an earlier run of the class, each student keeps the name (the folder in OUT)
+    that run gave its participant number (:func:`kept_folders`). A
+    folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.boxed.classlist.list_students`
+    opens no file of a folder); an archive is unpacked by :mod:`exam_lab.grader.boxed.intake` in a box of
+    its own (INTAKE_BOUNDS), in a work folder made in ``scratch`` (default: the system's temp folder) and
+    appended to ``work_dirs`` (the caller removes it once the students are graded). ``refused`` (a
+    dict) receives ``{folder: why}`` of the students whose files the intake refused by their own
+    bounds (:func:`grade_student`'s ``refused``).
+
+    :raises archives.UnpackError: the archive could not be unpacked (why, and the end of the box's log).
+    """
+    class_path = os.path.abspath(class_path)
+    if not os.path.isfile(class_path):
+        return _unique(classlist.list_students(class_path, None), kept_folders(out))
+    if scratch:
+        os.makedirs(scratch, mode=0o711, exist_ok=True)
+    # One file, bounded as a class (a class of 60 with its PDFs is more than one upload may be).
+    work, (staged,) = staging.staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch,
+                                          (classlist.CLASS_BYTES, 1))
+    work_dirs.append(work)
+    with sandbox.Box(work, bwrap=sandbox.check() is None) as box:
+        boxed = Boxed(box, work)
+        try:
+            found = boxed.run('exam_lab.grader.boxed.intake', ['--class', boxed.path(staged), '--out',
+                                                                 boxed.path(boxed.out)], records.IntakeRecord,
+                              INTAKE_BOUNDS)
+        except InspectionFailed as err:
+            raise archives.UnpackError('unpacking it in its box failed: %s' % err)
+    students = []
+    for student in found.students:
+        path = os.path.join(boxed.out, student['path'])
+        if os.path.realpath(path) != os.path.normpath(path) or not os.path.lexists(path):
+            raise archives.UnpackError('the intake named %s, which is a link or missing' % student['path'])
+        if student.get('refused') is not None and refused is not None:
+            refused[path] = student['refused']
+        students.append((student['name'], path))
+    return _unique(students, kept_folders(out))
+
+
+def kept_folders(out):
+    """``{participant number: folder name}`` of the students an earlier run graded into ``out`` (from
+    each folder's measurements.json, else its grade.json; written by the grader, never by a box)."""
+    kept = {}
+    if not out or not os.path.isdir(out):
+        return kept
+    for name in sorted(os.listdir(out)):
+        for kept_file in (records.MEASUREMENTS, 'grade.json'):
+            path = os.path.join(out, name, kept_file)
+            if not os.path.isfile(path):
+                continue
+            try:
+                with open(path) as f:
+                    facts = json.load(f)
+            except (OSError, ValueError):
+                continue
+            facts = facts.get('extra', {}) if kept_file == records.MEASUREMENTS else facts
+            number = facts.get('participant')
+            if number is None:
+                number = identity.participant_number(str(facts.get('folder') or ''))
+            if isinstance(number, int):
+                kept.setdefault(number, name)
+            break
+    return kept
+
+
+def _unique(students, kept=None):
+    """Each student's name made unique (``Jane Doe``, ``Jane Doe_2``): it is the student's folder in
+    OUT, which never ends like one of the class's files (:func:`~exam_lab.grader.score.identity.student_name`).
+    A participant that ``kept`` (:func:`kept_folders`) gives a folder keeps it, and no other
+    student takes a folder of OUT that is a participant's: a classmate whose name cleans to the same
+    (``Jane Doe.``) submitting late never takes the first one's folder, its kept measurements or its
+    row (the rows of hand.csv and the worksheet are keyed by the number anyway)."""
+    kept = kept or {}
+    held = set(kept.values())
+    named, seen = [None] * len(students), set()
+    for index, (name, folder) in enumerate(students):
+        previous = kept.get(identity.participant_number(os.path.basename(folder.rstrip('/'))))
+        if previous is not None and previous not in seen and \
+                (previous == name or re.match(r'^%s_\d+$' % re.escape(name), previous)):
+            named[index] = previous
+            seen.add(previous)
+    for index, (name, _) in enumerate(students):
+        if named[index] is None:
+            unique, n = name, 2
+            while unique in seen or unique in held:
+                unique, n = '%s_%d' % (name, n), n + 1
+            named[index] = unique
+            seen.add(unique)
+    return [(named[index], folder) for index, (_, folder) in enumerate(students)]
+
+
+def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
+                  unsandboxed=False, jobs=1, refused=None):
+    """Grade one student of a class into ``out_dir/name``; return the record. Anything the grader
+    raises is this student's record ("could not grade"), never the class's. Both engines grade a
+    student with it: a local pool's thread and a Slurm task.
+
+    :param refused: why the class's intake did not unpack this student's files (its own bounds): the
+        student is not graded, with that sentence, and its measurements are kept for a rescore.
+    """
+    if refused is not None:
+        return _refused_at_intake(name, folder, os.path.join(out_dir, name), sheet, refused)
+    try:
+        return runner.grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
+                                       on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
+    except Exception as err:  # anything: this student's row says so, the class goes on
+        record = grades.could_not_grade(name, sheet, '%r' % err,
+                                        ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
+        moodle_name = os.path.basename(os.path.abspath(folder).rstrip('/'))
+        record.update(participant=identity.participant_number(moodle_name), folder=moodle_name)  # who, even so
+        try:
+            report.write_grade(os.path.join(out_dir, name), record)
+        except OSError:
+            pass
+        return record
+
+
+def _refused_at_intake(name, folder, out_dir, sheet, why):
+    """The record of a student whose files the class's intake refused: nothing of it ran."""
+    folder_name = os.path.basename(folder)
+    measured = {'student': name, 'sheet': sheet or 'altitude', 'static': {}, 'notes': [], 'fixes': [],
+                'comments': None, 'isolate': None, 'how_run': None,
+                'session': grades.no_session('refused', 'submission refused: %s' % why, refused=True),
+                'extra': {'participant': identity.participant_number(folder_name), 'folder': folder_name,
+                          'documents': [], 'seconds': 0.0}}
+    os.makedirs(out_dir, exist_ok=True)
+    with open(os.path.join(out_dir, records.MEASUREMENTS), 'w') as f:
+        json.dump(measured, f, indent=1, sort_keys=True)
+    record = grades.score(measured)
+    report.write_grade(out_dir, record)
+    return record
+
+
+def class_similarity(klass, out, records_):
+    """The similarity check over a class's submissions, each named as its grade record names it, run in
+    a box (:mod:`exam_lab.grader.boxed.similarity` ``--class``: unpacking and comparing, SIMILARITY_BOUNDS)
+    and read back as a :class:`~exam_lab.grader.score.records.SimilarityRecord`; written to
+    ``out/similarity.json``. ``{"error"}`` when it could not run (the grades stand)."""
+    work_dirs, refused = [], {}
+    try:
+        by_folder = {r.get('folder'): r['student'] for r in records_}
+        listed = [(by_folder.get(os.path.basename(folder), name), folder)
+                  for name, folder in class_students(klass, work_dirs, refused=refused)]
+        intake = [(name, folder) for name, folder in listed if folder not in refused]
+        python = similarity.ensure_venv()  # as root: an installation, from PyPI, of no student's bytes
+        # Each student staged by its own bounds: one over them is not compared, the others are.
+        work, staged = staging.staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in intake],
+                                           refused=refused)
+        work_dirs.append(work)
+        kept = [(student, path) for student, path in zip(intake, staged) if path is not None]
+        submissions, staged = [student for student, _ in kept], [path for _, path in kept]
+        similarity.boilerplate(os.path.join(work, 'upload', 'boilerplate'))
+        venv = os.path.dirname(os.path.dirname(python))
+        with sandbox.Box(work, [venv], bwrap=sandbox.check() is None) as box:
+            # copydetect imports matplotlib, which wants Debian's /etc/matplotlibrc
+            boxed = Boxed(box, work, [(path, None, False) for path in ('/etc/matplotlibrc',) if os.path.isfile(path)])
+            job = {'submissions': [[name, boxed.path(path)] for (name, _), path in zip(submissions, staged)],
+                   'boilerplate': boxed.path(os.path.join(work, 'upload', 'boilerplate')), 'python': python,
+                   'out': boxed.path(boxed.out)}
+            with open(os.path.join(work, 'upload', 'job.json'), 'w') as f:
+                json.dump(job, f)
+            result = boxed.run('exam_lab.grader.boxed.similarity', ['--class', boxed.path(f.name)],
+                               records.SimilarityRecord, SIMILARITY_BOUNDS, python=python).value
+        result['notes'] = ['%s: not compared (its files were refused: %s)' % (name, refused[folder])
+                           for name, folder in listed if folder in refused] + result.get('notes', [])
+    except Exception as err:  # a bug of the check, or its box failing, must not cost the class its page
+        result = {'error': str(err) if isinstance(err, (InspectionFailed, archives.UnpackError)) else repr(err)}
+    finally:
+        for work in work_dirs:
+            shutil.rmtree(work, ignore_errors=True)
+    with open(os.path.join(out, 'similarity.json'), 'w') as f:
+        json.dump(result, f, indent=1, sort_keys=True)
+    return result
+
+
+def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progress=None, unsandboxed=False):
+    """Grade every student of a class, ``jobs`` side by side (default :func:`default_jobs`); write each
+    one's grade and grades.csv. One student the grader cannot grade is that student's row ("could not
+    grade"), never the class's.
+
+    :param progress: told of the run as it goes (:class:`exam_lab.grader.publish.progress.ClassProgress`).
+    """
+    refusal = sandbox.sandbox_refusal(unsandboxed)
+    if refusal:
+        raise sandbox.SandboxUnavailable(refusal)
+    os.makedirs(out_dir, exist_ok=True)
+    jobs = jobs or default_jobs()
+    work_dirs, refused = [], {}
+    try:
+        students = class_students(class_path, work_dirs, refused=refused, out=out_dir)
+        underlay = ensure_underlay(default_underlay())
+        isolate = can_isolate() if isolate is None else isolate
+        records = [None] * len(students)
+        if progress:
+            progress.begin([name for name, _ in students])
+
+        def one(index):
+            name, folder = students[index]
+            if progress:
+                progress.started(name)
+            record = grade_student(name, folder, out_dir, sheet, underlay, isolate,
+                                   (lambda step: progress.step(name, step)) if progress else None, unsandboxed,
+                                   jobs=jobs, refused=refused.get(folder))
+            if progress:
+                progress.finished(record)
+            return record
+
+        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            for index, record in zip(range(len(students)), pool.map(one, range(len(students)))):
+                records[index] = record
+        report.write_csv(os.path.join(out_dir, 'grades.csv'), records)
+        return records
+    finally:
+        for work in work_dirs:
+            shutil.rmtree(work, ignore_errors=True)

@@ -1,0 +1,87 @@
+"""The grade record from what a run measured (:data:`~exam_lab.grader.score.records.MEASUREMENTS`):
+:func:`score`, the one place the rubric is applied, by a run and by a rescore alike; the session's
+record of a grading whose session did not run (:func:`no_session`); the record of a submission that
+could not be graded; and the rescore of a run's OUT with today's rubric.
+"""
+import json
+import os
+
+from exam_lab.grader.publish import provenance, report, teacher
+from exam_lab.grader.score import records, rubric
+
+
+def score(measured, how='run'):
+    """The grade record of one submission from what its run measured
+    (:data:`~exam_lab.grader.score.records.MEASUREMENTS`): the one place the rubric is applied, by a run
+    and by a rescore alike. ``how`` goes into its provenance."""
+    static, session = measured['static'], measured['session']
+    run_value = rubric.threshold_run_value(static, session)
+    extra = dict(measured['extra'], doubts=rubric.doubts(static, session), provenance=provenance.stamp(how),
+                 threshold_run={'value': run_value} if run_value is not None else None)
+    return report.grade_record(measured['student'], measured['sheet'], rubric.score(measured['sheet'], static, session),
+                               teacher.hints(static, session, measured['notes'] + measured['fixes'],
+                                             measured['comments'], measured['isolate'], measured['how_run']),
+                               extra, rubric.status(static, session, measured['fixes']))
+
+
+def graded_folders(out):
+    """The folders of a run's OUT holding a grade made from measurements: OUT itself for one
+    submission, else one per student (in the order of their names)."""
+    if os.path.isfile(os.path.join(out, records.MEASUREMENTS)):
+        return [out]
+    return sorted(os.path.join(out, name) for name in os.listdir(out)
+                  if os.path.isfile(os.path.join(out, name, records.MEASUREMENTS)))
+
+
+def rescore(out):
+    """Apply today's rubric to the measurements a run kept in ``out``: no ROS, no box, seconds for a
+    class. Each grade.json/grade.md is written again, with the points it had (``previous``); a class's
+    grades.csv too.
+
+    :returns: ``(records, changes)``; ``changes``: one line per student whose points or status moved,
+        saying which items moved and from what to what.
+    """
+    graded, changes = [], []
+    folders = graded_folders(out)
+    for folder in folders:
+        with open(os.path.join(folder, records.MEASUREMENTS)) as f:
+            measured = json.load(f)
+        old = {}
+        if os.path.isfile(os.path.join(folder, 'grade.json')):
+            with open(os.path.join(folder, 'grade.json')) as f:
+                old = json.load(f)
+        record = score(measured, how='rescore')
+        before = {i['id']: i['points'] for i in old.get('items', [])}
+        record['previous'] = {'total': old.get('total'), 'status': old.get('status'), 'items': before,
+                              'provenance': old.get('provenance')}
+        moved = ['%s %s -> %s' % (i['id'], report.points_text(before.get(i['id'])), report.points_text(i['points']))
+                 for i in record['items'] if before.get(i['id']) != i['points']]
+        if old.get('status') != record['status']:
+            moved.append('status %s -> %s' % (old.get('status'), record['status']))
+        if moved:
+            changes.append('%s: %s -> %s (%s)' % (record['student'], report.points_text(old.get('total')),
+                                                 report.points_text(record['total']), '; '.join(moved)))
+        report.write_grade(folder, record)
+        graded.append(record)
+    if folders and folders != [out]:
+        report.write_csv(os.path.join(out, 'grades.csv'), graded)
+    return graded, changes
+
+
+def no_session(outcome, error, **more):
+    """The session's record (:class:`~exam_lab.grader.score.records.SessionRecord`'s value) of a grading
+    whose session did not run or failed: its ``outcome`` (one of
+    :data:`~exam_lab.grader.score.records.OUTCOMES`), ``error`` (why, for the teacher) and ``more``
+    (``refused``, ``no_node``, ``budget_used``, ``survivors``)."""
+    return records.SessionRecord.make(dict(more, outcome=outcome, build=None, runs=[],
+                                           error=error[:records.MAX_LOG_TEXT])).value
+
+
+def could_not_grade(student, sheet, why, notes=()):
+    """The record of a submission the grader could not grade: every item 0, and why."""
+    sheet = sheet or 'altitude'
+    session = no_session('grader_failed', 'could not grade: %s' % why)
+    return report.grade_record(student, sheet, rubric.score(sheet, {}, session),
+                               list(notes) + [session['error']], {'seconds': 0.0, 'provenance': provenance.stamp()},
+                               rubric.status({}, session))
+
