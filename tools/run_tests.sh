@@ -7,9 +7,26 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 source "$repo/tools/env.sh"
 targets=("${@:-run_tests}")
 results="$EXAM_WS/build/test_results"
+#: The grader's tests: their class runs mostly wait for flights in real time (issue 37 point 6).
+GRADER=run_tests_exam_lab_pytest_grader
+filter() { grep -E "^\[(ROSTEST|ROSUNIT)\]|^ *\[(PASSED|FAILED)\]|^SUMMARY|^ \* RESULT|^FAILURE|^ERROR|passed|failed" || true; }
 
 rm -rf "$results"
 cd "$EXAM_WS"
-# catkin's run_tests exits 0 even when tests fail: the verdict comes from the JUnit files below.
-catkin_make "${targets[@]}" -j1 2>&1 | tee "$EXAM_WS/test.log" | grep -E "^\[(ROSTEST|ROSUNIT)\]|^ *\[(PASSED|FAILED)\]|^SUMMARY|^ \* RESULT|^FAILURE|^ERROR|passed|failed" || true
+if [ "${targets[*]}" = run_tests ]; then
+  # Every test: the grader's target beside all the others (one make each, -j1 within), not after them:
+  # it waits on flights most of its time. Each catkin target is one leaf of `make help`'s list.
+  catkin_make -j1 >"$EXAM_WS/test.log" 2>&1  # configured and built once, before two makes read the tree
+  mapfile -t others < <(make -C build help | sed -n 's/^\.\.\. \(run_tests_[a-z_]*_\(pytest\|rostest\|gtest\|nosetests\)_.*\)$/\1/p' |
+                        grep -vx "$GRADER")
+  [ "${#others[@]}" -gt 0 ] || { echo "run_tests.sh: no test target in make help" >&2; exit 1; }
+  make -C build -j1 "$GRADER" >"$EXAM_WS/test-grader.log" 2>&1 &
+  grader=$!
+  # catkin's run_tests exits 0 even when tests fail: the verdict comes from the JUnit files below.
+  make -C build -j1 "${others[@]}" 2>&1 | tee -a "$EXAM_WS/test.log" | filter
+  wait "$grader" || true
+  filter <"$EXAM_WS/test-grader.log"
+else
+  catkin_make "${targets[@]}" -j1 2>&1 | tee "$EXAM_WS/test.log" | filter
+fi
 /usr/bin/python3 "$repo/tools/test_summary.py" "$results"

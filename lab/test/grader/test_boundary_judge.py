@@ -94,9 +94,9 @@ def test_the_judge_is_neither_root_nor_the_box(judged_class):
     assert probe['judge_uid'] >= uids.JUDGE_UID_BASE and probe['clock']['ros_time_is_wall'] is True
 
 
-def test_no_judge_process_is_left(judged_class):
+def test_no_judge_process_is_left(judged_class, all_class_runs_done):
     """Of the judge's uids (test_sandbox checks the boxes'), none whose slot no grader holds has a
-    process left once the class is graded."""
+    process left once the class is graded (and the session's other class runs: conftest.py)."""
     assert uids.left_behind(uids.JUDGE_UID_BASE) == []
 
 

@@ -11,7 +11,6 @@ must go), not strict where today's grade sits at a tolerance's edge. About 2.5 m
 import pytest
 
 from exam_lab.fairness import generator
-from exam_lab.grader import class_run
 
 SAMPLE = generator.sample(10)
 
@@ -23,12 +22,10 @@ SAMPLE = generator.sample(10)
 GRADED_WRONG_TODAY = {}
 
 
-@pytest.fixture(scope='module')
-def graded(tmp_path_factory):
-    root = tmp_path_factory.mktemp('fairness')
-    klass = generator.write_class(SAMPLE, str(root / 'class'))
-    records = class_run.grade_class(klass, str(root / 'out'), jobs=class_run.default_jobs())
-    return {r['student']: r for r in records}
+@pytest.fixture
+def graded(fairness_sample):
+    """The sample graded as one class (conftest.py ``fairness_sample``, class_runs.py): ``{student: record}``."""
+    return {r['student']: r for r in fairness_sample['records']}
 
 
 def _cases():

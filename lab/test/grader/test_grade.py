@@ -2,7 +2,8 @@
 loses exactly the points the rubric takes for its flaw, and each upload form students really produce
 (a Windows zip, a whole workspace as exam.tar.gz, a package named otherwise) costs nothing. Two class
 runs (the packages below, then the third kind of class), each at the default JOBS, and one submission
-run.
+run (our node on the depth sheet), each graded once a session in the background with the session's
+other class runs (conftest.py, class_runs.py).
 """
 import csv
 import json
@@ -13,7 +14,7 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader import class_run, runner
+from exam_lab.grader import class_run
 from exam_lab.grader.publish import grades
 from exam_lab.grader.score.sheets import ITEMS
 
@@ -105,8 +106,8 @@ def refused_zip(source, path):
 def grade_main_class(root):
     """Grade the whole class once in ``root`` (a pathlib.Path): the fixture packages, ours (its sheet
     detected: altitude), each in a Moodle folder of its own participant number; return ``(OUT, [records],
-    the class folder)``. Run once a session by conftest.py's ``main_class``, which also writes its desk
-    (the page, the feedback zip) for test_page_browser."""
+    the class folder)``. Run once a session by conftest.py's ``main_class`` (class_runs.py), which also
+    writes its desk (the page, the feedback zip) for test_page_browser."""
     klass = root / 'class'
     for index, name in enumerate(EXPECTED):
         folder = klass / ('%s_%d_assignsubmission_file_' % (name, 101 + index))
@@ -264,11 +265,10 @@ def dated_zip(source, path, when):
                 zf.writestr(info, f.read())
 
 
-@pytest.fixture(scope='module')
-def fair(tmp_path_factory):
-    """A class of ten graded with the default JOBS, and its desk (the page) written."""
+def grade_fair_class(root):
+    """Grade the class of ten in ``root`` (a pathlib.Path) with the default JOBS and write its desk (the
+    page); return ``(OUT, [records])``. Run once a session by conftest.py's ``fair_class``."""
     from exam_lab.grader.publish import desk
-    root = tmp_path_factory.mktemp('fair')
     klass = root / 'class'
     for name in FAIR_EXPECTED:
         folder = klass / ('%s_%d_assignsubmission_file_' % (name, 100 + len(name)))
@@ -284,7 +284,13 @@ def fair(tmp_path_factory):
     out = root / 'out'
     records = class_run.grade_class(str(klass), str(out), jobs=class_run.default_jobs())
     desk.finish(str(out), records, title='ROS-Exam altitude')
-    return out, {r['student']: r for r in records}
+    return out, records
+
+
+@pytest.fixture
+def fair(fair_class):
+    """The class of ten (conftest.py ``fair_class``): ``(OUT, {student: record})``."""
+    return fair_class['out'], {r['student']: r for r in fair_class['records']}
 
 
 @pytest.mark.parametrize('name', sorted(FAIR_EXPECTED))
@@ -352,8 +358,8 @@ def test_fair_evidence_is_what_happened(fair):
     assert 'WARNING 4.' in short and '(outside: 4.70-6.39 s)' in short, short
 
 
-def test_our_node_on_the_depth_sheet(tmp_path):
-    record = runner.grade_submission(OUR_EXAM, str(tmp_path / 'depth'), sheet='depth')
+def test_our_node_on_the_depth_sheet(singles):
+    record = singles['ours_depth']  # graded alone on the depth sheet (class_runs.py SINGLES)
     got = {i['id']: i['points'] for i in record['items']}
     assert got == FULL, '\n'.join(i['evidence'] for i in record['items'])
 

@@ -85,7 +85,8 @@ def test_a_forged_probe_file_changes_nothing(hostile_class):
         assert 'FORGER usercustomize ran' not in text, path
 
 
-def test_no_detached_child_survives(hostile_class):
+def test_no_detached_child_survives(hostile_class, all_class_runs_done):
+    """Nor any process of a box's uid, of a slot no grader holds, once the session's classes are graded."""
     assert hostile_class['survivors'] == []
     assert uids.left_behind(uids.BOX_UID_BASE) == []
 
@@ -296,3 +297,4 @@ def test_a_box_is_another_user_and_sees_only_its_own():
     assert seen['Max address space'][0] == str(limits.ADDRESS_SPACE_BYTES)
     for bad in ('ROOT_VISIBLE', 'HOST_TMP_VISIBLE', 'PACKAGE_WRITABLE', 'GRADER_SECRET', 'EXAM_LAB'):
         assert bad not in output
+

@@ -11,7 +11,6 @@ import subprocess
 import pytest
 from catkin_pkg.packages import find_packages
 
-from exam_lab.grader import runner
 from exam_lab.grader.score.sheets import ITEMS, SHEETS
 from exam_lab.harness.supervisor import Supervisor
 from exam_lab.harness.wait import wait_until
@@ -23,8 +22,8 @@ RUN_SIMPLE = os.path.join(REPO, 'docs', 'simple_answer', 'run.sh')
 
 
 @pytest.mark.parametrize('sheet', ['altitude', 'depth'])
-def test_the_simple_answer_gets_full_marks(tmp_path, sheet):
-    record = runner.grade_submission(SIMPLE, str(tmp_path / sheet), sheet=sheet)
+def test_the_simple_answer_gets_full_marks(singles, sheet):
+    record = singles['simple_' + sheet]  # graded alone on the sheet (conftest.py ``singles``, class_runs.py)
     got = {i['id']: i['points'] for i in record['items']}
     evidence = '\n'.join('%s %s/%s: %s' % (i['id'], i['points'], i['max'], i['evidence']) for i in record['items'])
     assert got == {item: points for item, (points, _) in ITEMS.items()}, evidence
