@@ -160,6 +160,13 @@ def test_status_of_each_case():
     crashed['runs'][0]['launch']['tail'] = TRACEBACK
     assert rubric.status(STATIC, crashed) == (
         rubric.HAND_GRADE, "the node does not start: KeyError: '~threshold' at exam/scripts/exam_node.py:26")
+    seen = measured(died=True)  # the probe saw it register before the KeyError (a quiet machine): the same words
+    main_of(seen)['nodes'], main_of(seen)['trace'] = ['/exam'], {'published': [], 'oracle': []}
+    main_of(seen)['rate'] = {'hz': None, 'samples': 0, 'max_gap': None}
+    seen['runs'][0]['launch']['tail'] = TRACEBACK
+    assert rubric.status(STATIC, seen) == rubric.status(STATIC, crashed)
+    main_of(seen)['trace']['published'] = [[3.0, 1040.0]]  # one value published, then the end: it died
+    assert rubric.status(STATIC, seen)[1].startswith("the node died: KeyError: '~threshold'")
     python2 = dict(STATIC, python2=['scripts/exam_node.py:3: print statement'])
     status, reason = rubric.status(python2, crashed)
     assert status == rubric.HAND_GRADE and reason.startswith('Python 2 code (scripts/exam_node.py:3: print statement)')

@@ -80,6 +80,15 @@ def node_ran(session):
     return bool(probe and probe.get('nodes'))
 
 
+def published(session):
+    """True when the node published a value in the main run. A node that dies before its first value
+    "does not start", whether or not the probe saw it register on the way (a crash just after
+    ``init_node`` is seen or not depending on the machine's load: the words must not)."""
+    probe = main_probe(session)
+    return node_ran(session) and bool((probe.get('trace') or {}).get('published') or
+                                      (probe.get('rate') or {}).get('samples'))
+
+
 def stayed_up(session):
     """True when the node registered in the main run and roslaunch never saw it end."""
     runs = [r for r in (session or {}).get('runs', []) if r['tag'] == 'main']
@@ -745,7 +754,7 @@ def status(static, session, fixes=()):
         if python2:
             return HAND_GRADE, _one_line(python2_words)
         crash = crash_summary(tails)
-        return HAND_GRADE, _one_line('the node %s%s' % ('does not start' if not node_ran(session) else 'died',
+        return HAND_GRADE, _one_line('the node %s%s' % ('died' if published(session) else 'does not start',
                                                           ': %s' % crash if crash else ' (see runs)'))
     missing = missing_evidence(static, session)
     if missing:
