@@ -4,7 +4,7 @@
     python3 lab/bench/grader_bench.py [--students 60] [--jobs 4,6] [--out DIR] [--record]
     python3 lab/bench/grader_bench.py --from-results DIR/results.json [--record]
 
-(from the repository, after ``make build`` and ``source tools/env.sh``; about 40 minutes on two cores). A full
+(from the repository, after ``make build`` and ``source tools/env.sh``; about 70 minutes on two cores (67 on 2026-11-27)). A full
 ``make bench`` runs it last and records it; ``BENCH_STAGES=grader make bench`` runs a class of 4 into
 ``$EXAM_WS/bench-quick/grader``. Phases:
 
