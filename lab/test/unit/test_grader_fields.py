@@ -1,0 +1,74 @@
+"""A record read by attributes (score/fields.py): nested objects as attributes, a missing optional key
+None, a misspelt one an error, data-keyed objects mappings, lists tuples, nothing settable."""
+import keyword
+
+import pytest
+
+from exam_lab.grader.score import fields, records
+
+SCHEMA = {'name': str, 'note': records.Optional(str), 'where': records.Maybe({'file': str, 'line': int}),
+          'topics': records.Map(str, [str]), 'calls': records.Items(records.Row(float, str)), 'tags': [str]}
+
+
+def test_a_view_reads_nested_objects_as_attributes():
+    value = {'name': 'exam', 'where': {'file': 'a.py', 'line': 3}, 'topics': {'/p': ['/exam']},
+             'calls': [[1.5, 'WARNING']], 'tags': ['x', 'y']}
+    view = fields.view(value, SCHEMA)
+    assert view.name == 'exam' and view.where.file == 'a.py' and view.where.line == 3
+    assert view.note is None, 'an optional key that is missing reads None'
+    assert dict(view.topics) == {'/p': ('/exam',)} and view.topics.get('/q') is None
+    assert view.calls == ((1.5, 'WARNING'),) and view.tags == ('x', 'y')
+    assert fields.view(view, SCHEMA) is view and fields.view(None, SCHEMA) is None
+
+
+def test_a_misspelt_field_is_an_error_never_none():
+    view = fields.view({'name': 'exam'}, SCHEMA)
+    with pytest.raises(AttributeError, match='nmae'):
+        view.nmae
+    with pytest.raises(TypeError):
+        view['name']  # no reading by string keys: attributes only
+
+
+def test_nothing_of_a_view_can_be_set():
+    view = fields.view({'name': 'exam', 'where': {'file': 'a.py', 'line': 3}, 'topics': {'/p': []}}, SCHEMA)
+    for target, name in ((view, 'name'), (view.where, 'file'), (view, 'other')):
+        with pytest.raises(AttributeError):
+            setattr(target, name, 'x')
+    with pytest.raises(AttributeError):
+        del view.name
+    with pytest.raises(TypeError):
+        view.topics['/q'] = []
+    with pytest.raises(AttributeError):
+        view.tags.append('z')
+
+
+def test_an_empty_object_is_false_as_its_dict_is():
+    assert not fields.view({}, SCHEMA) and fields.view({'name': ''}, SCHEMA)
+    assert not fields.view({'name': 'exam', 'topics': {}}, SCHEMA).topics
+
+
+def test_a_value_not_of_the_schemas_shape_is_given_as_it_is():
+    assert fields.view({'where': 'nowhere', 'tags': 'x'}, SCHEMA).where == 'nowhere'
+
+
+@pytest.mark.parametrize('schema', [records.SessionRecord.SCHEMA, records.ProbeRecord.SCHEMA, records.STATIC,
+                                    records.InspectRecord.SCHEMA])
+def test_every_field_of_the_records_reads_as_an_attribute(schema):
+    def keys(schema):
+        while isinstance(schema, (records.Maybe, records.Optional)):
+            schema = schema.schema
+        if isinstance(schema, dict):
+            for key, inner in schema.items():
+                yield key
+                yield from keys(inner)
+        elif isinstance(schema, (records.Map, records.Items)):
+            yield from keys(schema.schema)
+        elif isinstance(schema, list):
+            yield from keys(schema[0])
+        elif isinstance(schema, (tuple, records.Row)):
+            for inner in (schema.schemas if isinstance(schema, records.Row) else schema):
+                yield from keys(inner)
+    bad = sorted(k for k in set(keys(schema)) if not k.isidentifier() or keyword.iskeyword(k)
+                 or k in fields.Fields.__slots__)
+    assert bad == []
+
