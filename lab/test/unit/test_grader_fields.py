@@ -1,10 +1,13 @@
 """A record read by attributes (score/fields.py): nested objects as attributes, a missing optional key
-None, a misspelt one an error, data-keyed objects mappings, lists tuples, nothing settable."""
+None, a misspelt one an error, data-keyed objects mappings, lists tuples, nothing settable. And the
+rubric reads a session the same whether it is given as kept (dicts) or as its view."""
 import keyword
 
 import pytest
 
-from exam_lab.grader.score import fields, records
+from exam_lab.grader.score import fields, records, rubric
+
+from test_grader_rubric import STATIC, measured
 
 SCHEMA = {'name': str, 'note': records.Optional(str), 'where': records.Maybe({'file': str, 'line': int}),
           'topics': records.Map(str, [str]), 'calls': records.Items(records.Row(float, str)), 'tags': [str]}
@@ -72,3 +75,11 @@ def test_every_field_of_the_records_reads_as_an_attribute(schema):
                  or k in fields.Fields.__slots__)
     assert bad == []
 
+
+def test_the_rubric_reads_a_session_as_kept_or_as_its_view():
+    session, static = measured(calls=[[13.55, 'WARNING']]), dict(STATIC, code={'service_calls': [], 'publishes': [],
+                                                                              'timers': []})
+    viewed = fields.view(session, records.SessionRecord.SCHEMA), fields.view(static, records.STATIC)
+    assert rubric.score('altitude', viewed[1], viewed[0]) == rubric.score('altitude', static, session)
+    assert rubric.status(viewed[1], viewed[0]) == rubric.status(static, session)
+    assert rubric.doubts(viewed[1], viewed[0]) == rubric.doubts(static, session)
