@@ -50,6 +50,23 @@ def test_an_empty_object_is_false_as_its_dict_is():
     assert not fields.view({'name': 'exam', 'topics': {}}, SCHEMA).topics
 
 
+def test_a_record_is_viewed_with_its_own_schema():
+    record = records.SessionRecord.make({'outcome': 'not_run', 'build': None, 'runs': [], 'error': 'no node'})
+    view = fields.view(record)
+    assert view.outcome == 'not_run' and view.error == 'no node' and view.runs == () and view.refused is None
+    with pytest.raises(AttributeError):
+        view.probe
+
+
+def test_a_view_copies_nothing_before_a_field_is_read():
+    import copy
+    trace = [[float(t), 1.0] for t in range(5)]
+    view = fields.view({'trace': {'published': trace, 'oracle': []}}, records.ProbeRecord.SCHEMA)
+    trace.append([5.0, 2.0])  # read after: the view reads the value as it is then
+    assert view.trace.published[-1] == (5.0, 2.0) and len(view.trace.published) == 6
+    assert copy.copy(view) is view and copy.deepcopy(view) is view
+
+
 def test_a_value_not_of_the_schemas_shape_is_given_as_it_is():
     assert fields.view({'where': 'nowhere', 'tags': 'x'}, SCHEMA).where == 'nowhere'
 
