@@ -4,7 +4,7 @@ import json
 from exam_lab.grader import class_run, runner
 from exam_lab.grader.publish import grades
 from exam_lab.grader.score.records import MEASUREMENTS
-from exam_lab.grader.score import rubric
+from exam_lab.grader.score import flight
 
 from test_grader_rubric import STATIC, measured
 
@@ -22,7 +22,7 @@ def test_rescore_applies_todays_rubric_to_the_kept_measurements(tmp_path, monkey
         (folder / 'grade.json').write_text(json.dumps(grades.score(kept)))
     records, changes = grades.rescore(str(tmp_path))
     assert changes == [] and [r['total'] for r in records] == [17.0, 17.0]
-    monkeypatch.setattr(rubric, 'warning_window', lambda probe: (probe['delay'] - 0.3, probe['delay'] + 0.3))
+    monkeypatch.setattr(flight, 'warning_window', lambda probe: (probe.delay - 0.3, probe.delay + 0.3))
     records, changes = grades.rescore(str(tmp_path))
     assert changes == ['late: 17 -> 15.5 (Q14b 3 -> 1.5)']  # the delay's 1.5 of 14b
     late_record = json.loads((tmp_path / 'late' / 'grade.json').read_text())

@@ -10,7 +10,7 @@ import math
 import os
 
 from exam_lab.grader.score.records import MEASUREMENTS
-from exam_lab.grader.score.rubric import calls
+from exam_lab.grader.score.flight import calls
 from exam_lab.grader.score.safe_text import one_line
 
 #: Legs of each run, in order, and the side of the threshold each is flown on.
