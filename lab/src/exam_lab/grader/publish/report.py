@@ -6,11 +6,10 @@ is made, and every output cleans what it writes again (:mod:`exam_lab.grader.sco
 record may also be made elsewhere (read back from grade.json, a test, a later change of the runner).
 """
 import csv
-import json
 import os
 
 from exam_lab.grader.publish import cells
-from exam_lab.grader.score import safe_text
+from exam_lab.grader.score import kept, safe_text
 from exam_lab.grader.score.sheets import ITEMS, SHEETS
 
 #: What no machine scores, with the rubric's points (sheet 000's notes).
@@ -28,12 +27,13 @@ def points_text(x):
 
 
 def grade_record(student, sheet, items, for_the_teacher, extra=None, status=('graded', '')):
-    """The content of grade.json; ``status`` is ``(status, reason)`` (see :func:`rubric.status`)."""
-    record = {'student': student, 'sheet': sheet, 'total': sum(i['points'] for i in items),
+    """The content of grade.json (a :class:`~exam_lab.grader.score.kept.GradeRecord`'s value: checked,
+    its text made safe); ``status`` is ``(status, reason)`` (see :func:`rubric.status`)."""
+    record = {'version': kept.VERSION, 'student': student, 'sheet': sheet, 'total': sum(i['points'] for i in items),
               'max': sum(i['max'] for i in items), 'items': items, 'for_the_teacher': for_the_teacher,
               'status': status[0], 'status_reason': status[1]}
     record.update(extra or {})
-    return safe_text.cleaned(record)
+    return kept.GradeRecord.make(record).value
 
 
 def _status_line(record):
@@ -88,9 +88,8 @@ def markdown(record):
 def write_grade(out_dir, record):
     """Write ``grade.json`` and ``grade.md`` into ``out_dir``."""
     os.makedirs(out_dir, exist_ok=True)
-    with open(os.path.join(out_dir, 'grade.json'), 'w') as f:
-        json.dump(safe_text.cleaned(record), f, indent=1, sort_keys=True)
-        f.write('\n')
+    with open(os.path.join(out_dir, kept.GradeRecord.FILE), 'w') as f:
+        f.write(kept.GradeRecord.make(record).to_json() + '\n')
     with open(os.path.join(out_dir, 'grade.md'), 'w') as f:
         f.write(markdown(record))
 
