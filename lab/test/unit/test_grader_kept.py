@@ -188,3 +188,19 @@ def test_make_rescore_says_who_was_not_rescored_and_fails(tmp_path, capsys):
     assert '1 student(s) NOT rescored' in said and '  Bob: not rescored (its grade kept as it was): ' \
         'measurements.json: not JSON: ' in said
     assert os.path.isfile(str(out / 'index.html'))  # the desk written for the class all the same
+
+
+def test_the_desk_reads_each_grade_through_its_type_and_survives_one_that_is_not(tmp_path):
+    from exam_lab.grader.publish import desk
+    out = tmp_path / 'out'
+    for name in ('Ann', 'Bob'):
+        kept_folder(out, 'before-version', name)
+    ann, bob = [GradeRecord.read(str(out / name / 'grade.json')).value for name in ('Ann', 'Bob')]
+    lines = desk.finish(str(out), [ann, dict(bob, remark='a key no grade has', student='Bob\x1b[2J')])
+    assert [line for line in lines if line.startswith('Bob')][0] == \
+        "Bob: its grade is not a grade record (a grader bug, please report): RecordError: grade.json: unexpected " \
+        "key(s) 'remark'"
+    assert [line for line in lines if line.startswith('Ann')] == []
+    page = (out / 'index.html').read_text()
+    assert 'its grade is not a grade record' in page and '\x1b' not in page
+

@@ -48,6 +48,10 @@ class InspectRecord(Record):
     """
     FILE = 'inspect.json'
     MAX_BYTES = 1 << 20
+    #: The student's text (notes and fixes quoting its files, the launch file's and the code's words,
+    #: the documents' names) made safe here; the launch files' paths are opened by the session and
+    #: the code's file names (``comments``) are kept exactly (the measurements keep them so).
+    CLEAN = ('refused', 'notes', 'fixes', 'static', 'facts')
     SCHEMA = {
         'uid': Number(0, 2 ** 32, integer=True),
         'refused': Maybe(str),

@@ -195,7 +195,8 @@ class Record(object):
     shape to its current one in :meth:`upgraded`, before the check. With ``CLEAN``, every string of the record, keys too, is
     :func:`~exam_lab.grader.score.safe_text.clean` once it matched its schema: the one place where
     a student's text (node and topic names, log lines, a request) is made safe, whoever reads the
-    record later. ``NON_FINITE``: NaN and Infinity may be read from its JSON (measured values)."""
+    record later; ``CLEAN`` a tuple of keys cleans those fields only (the others are paths to open,
+    or names kept exactly). ``NON_FINITE``: NaN and Infinity may be read from its JSON (measured values)."""
     FILE = MAX_BYTES = SCHEMA = None
     CLEAN = NON_FINITE = False
 
@@ -245,7 +246,11 @@ class Record(object):
 
     @classmethod
     def _made(cls, value):
-        record = cls(cleaned(value) if cls.CLEAN else value)
+        if cls.CLEAN is True:
+            value = cleaned(value)
+        elif cls.CLEAN:
+            value = dict(value, **{key: cleaned(value[key]) for key in cls.CLEAN if key in value})
+        record = cls(value)
         record.validate()
         return record
 
