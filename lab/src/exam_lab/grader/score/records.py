@@ -111,6 +111,8 @@ class SimilarityRecord(Record):
     detector; the page escapes nothing more), every pair's ``scores``, ``notes``; or ``error``."""
     FILE = 'similarity.json'
     MAX_BYTES = 32 << 20
+    #: Its file names and the code in its HTML are the students': made safe here (no markup is added).
+    CLEAN = True
     SCHEMA = {
         'error': Optional(Text(20000)), 'notes': [str],
         'pairs': Optional(Items({'a': Text(255), 'b': Text(255), 'score_a': _SHARE, 'score_b': _SHARE,
