@@ -204,3 +204,19 @@ def test_the_desk_reads_each_grade_through_its_type_and_survives_one_that_is_not
     page = (out / 'index.html').read_text()
     assert 'its grade is not a grade record' in page and '\x1b' not in page
 
+
+
+def test_the_measurements_keep_names_exactly_and_their_session_clean(tmp_path):
+    """A file name in bytes that are not UTF-8 stays as the run kept it; a session edited by hand
+    (an escape sequence in a request) is made safe as it is read, for the plot and the rubric."""
+    measured = kept_copy('before-version')
+    measured['comments']['files'] = ['scripts/n\udcff.py']
+    probe = measured['session']['runs'][0]['probe']
+    probe['calls'][0][1] = 'WARNING\x1b]0;owned\x07'
+    measured['notes'].append('bell\x07')
+    record = MeasurementsRecord.make(measured)
+    assert record.comments['files'] == ['scripts/n\udcff.py'] and record.notes[-1] == 'bell'
+    assert record.session['runs'][0]['probe']['calls'][0][1] == 'WARNING'
+    kept_folder(tmp_path, 'before-version', 'Ann')
+    (tmp_path / 'Ann' / MEASUREMENTS).write_text(json.dumps(measured))
+    assert flightplot.load_runs(str(tmp_path / 'Ann'))[0][1]['calls'][0][1] == 'WARNING'

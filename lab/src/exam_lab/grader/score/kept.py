@@ -5,10 +5,11 @@ Both are the grader's own files, written by root in OUT, but they hold a student
 log lines, the name of a file) and they outlive the grader that wrote them: a rescore, run as the
 teacher, reads a class graded months ago. So each is read as a box's record is (capped, checked
 against its schema) and carries a ``version``. The grade's text is made safe where it is made
-(``CLEAN``); the measurements keep what was measured exactly (a file name in bytes that are not
-UTF-8 as its surrogate escapes: the session in them is a clean record already), and the grade made
-of them is clean. A file of an
-older shape is brought to the current one by :meth:`MeasurementsRecord.upgraded` /
+(``CLEAN``); the measurements' session and the teacher's notes are too (the session is a clean
+record already: a file edited by hand is made so again as it is read, for the flight plot), and the
+names they hold (the student's, its folder's, its code's files) are kept exactly, a name in bytes
+that are not UTF-8 as its surrogate escapes: the grade made of them is clean. A file of an older
+shape is brought to the current one by :meth:`MeasurementsRecord.upgraded` /
 :meth:`GradeRecord.upgraded` before the check (one function per older shape, named for it); one that
 matches neither stops that student's rescore with a sentence naming the file and the field.
 """
@@ -44,6 +45,7 @@ class MeasurementsRecord(Record):
     :func:`exam_lab.grader.publish.grades.rescore` and the flight plot."""
     FILE = MEASUREMENTS
     MAX_BYTES = SessionRecord.MAX_BYTES + (8 << 20)
+    CLEAN = ('session', 'notes', 'fixes', 'how_run', 'static')
     NON_FINITE = True
     SCHEMA = {
         'version': OneOf(VERSION),
