@@ -220,3 +220,17 @@ def test_the_measurements_keep_names_exactly_and_their_session_clean(tmp_path):
     kept_folder(tmp_path, 'before-version', 'Ann')
     (tmp_path / 'Ann' / MEASUREMENTS).write_text(json.dumps(measured))
     assert flightplot.load_runs(str(tmp_path / 'Ann'))[0][1]['calls'][0][1] == 'WARNING'
+
+
+def test_a_grader_bug_with_a_huge_message_is_still_one_students_record(tmp_path, monkeypatch):
+    """The note of a bug (its traceback) and the error in the session are cut to a record's bounds:
+    the student's grade is written, the class goes on."""
+    from exam_lab.grader import class_run, runner
+
+    def fails(*args, **kwargs):
+        raise RuntimeError('x' * 200000)
+    monkeypatch.setattr(runner, 'grade_submission', fails)
+    record = class_run.grade_student('Jane', str(tmp_path / 'Jane_1001_assignsubmission_file_'), str(tmp_path))
+    assert record['status'] == 'not graded' and record['participant'] == 1001
+    assert GradeRecord.read(str(tmp_path / 'Jane' / 'grade.json')).value == record
+    assert any(note.startswith('grader error, please report: ') for note in record['for_the_teacher'])

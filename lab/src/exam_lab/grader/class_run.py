@@ -7,7 +7,6 @@ import json
 import os
 import re
 import shutil
-import traceback
 
 from exam_lab.grader import runner
 from exam_lab.grader.boxed import archives, classlist, similarity
@@ -158,7 +157,7 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
                                        on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
     except Exception as err:  # anything: this student's row says so, the class goes on
         record = grades.could_not_grade(name, sheet, '%r' % err,
-                                        ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
+                                        [grades.bug_note()])
         moodle_name = os.path.basename(os.path.abspath(folder).rstrip('/'))
         record.update(participant=identity.participant_number(moodle_name), folder=moodle_name)  # who, even so
         try:

@@ -31,7 +31,6 @@ import shutil
 import sys
 import tempfile
 import time
-import traceback
 
 from exam_lab.grader.boxed import archives
 from exam_lab.grader.host import bwrap, egress, limits, sandbox, staging
@@ -120,7 +119,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             session = grades.no_session(Outcome.INSPECTION_FAILED, 'the inspection of the upload failed: %s' % err)
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
             session = grades.no_session(Outcome.GRADER_FAILED, 'the grader failed on this submission: %r' % err)
-            notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
+            notes.append(grades.bug_note())
         notes.extend(keep_logs(work, out_dir))
         measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session,
                     'notes': notes, 'fixes': fixes, 'comments': comments, 'isolate': isolate, 'how_run': how_run,

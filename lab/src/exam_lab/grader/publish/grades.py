@@ -4,6 +4,7 @@ record of a grading whose session did not run (:func:`no_session`); the record o
 could not be graded; and the rescore of a run's OUT with today's rubric.
 """
 import os
+import traceback
 
 from exam_lab.grader.publish import provenance, report, teacher
 from exam_lab.grader.score import kept, records, rubric
@@ -118,3 +119,8 @@ def could_not_grade(student, sheet, why, notes=()):
                                list(notes) + [session['error']], {'seconds': 0.0, 'provenance': provenance.stamp()},
                                rubric.status({}, session))
 
+
+def bug_note():
+    """The teacher's note of a grader bug being handled: its traceback on one line, its last
+    MAX_LOG_TEXT characters (a deep recursion's would outgrow any record)."""
+    return 'grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')[-records.MAX_LOG_TEXT:]

@@ -150,7 +150,7 @@ class GradeRecord(Record):
         'student': Text(1000), 'sheet': Maybe(Text(100)),
         'total': _POINTS, 'max': _POINTS,
         'items': Items({'id': Text(50), 'points': _POINTS, 'max': _POINTS, 'evidence': Text(1 << 20)}, 50),
-        'for_the_teacher': _NOTES, 'status': Text(100), 'status_reason': Text(MAX_LOG_TEXT),
+        'for_the_teacher': _NOTES, 'status': Text(100), 'status_reason': _LONG,
         'seconds': Optional(Number(0)), 'doubts': Optional(Maybe(_NOTES)),
         'provenance': Optional(Maybe(_PROVENANCE)),
         'threshold_run': Optional(Maybe({'value': Number(finite=False)})),
