@@ -33,7 +33,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.score.timing_items` (Q13, Q14a, Q14b), :mod:`~.score.verdict` (the status, the doubts);
   :mod:`~.score.fields` (a record read by attributes, following its schema), :mod:`~.score.safe_text`
   (student-derived text without control characters, for every record and output), :mod:`~.score.records`
-  (the typed records that cross the boundary, with their schemas), :mod:`~.score.identity` (who a
+  (the typed records that cross the boundary, with their schemas), :mod:`~.score.kept` (what a grading
+  keeps, as records: its measurements and its grade, versioned), :mod:`~.score.schema` (a schema, its
+  check, the base of every record), :mod:`~.score.identity` (who a
   submission is: Moodle's participant number and folder, the student's name) and :mod:`~.score.boxenv`
   (the paths and the environment a box's processes see).
 - ``publish/`` -- what the teacher reads, from records only: :mod:`~.publish.report` (grade.json,
