@@ -46,6 +46,8 @@ def test_a_list_over_its_cap_keeps_its_first_and_says_so():
     assert len(text) == MAX_TEXT and text.startswith('scripts/') and text.endswith('.py:12')
     many = bounds.closed(['n%d' % i for i in range(600)])
     assert len(many) == MAX_ITEMS and many[-1] == '600 notes (at most 500): the first 499 kept'
+    many = bounds.closed(['n%d' % i for i in range(600)] + ['a cap'], keep=['a cap'])  # a cap's sentence stays
+    assert len(many) == MAX_ITEMS and many[-3:] == ['n497', 'a cap', '601 notes (at most 500): the first 499 kept']
 
 
 def test_501_python_files_are_graded_on_the_first_500(tmp_path):
@@ -64,8 +66,9 @@ def test_every_list_the_code_makes_is_bounded_and_the_threshold_kept(tmp_path):
     threshold's name sorted last and one name of 3000 characters: each list within its cap, the
     threshold kept for Q14a, one sentence per list."""
     names = ['p%03d' % i for i in range(600)] + ['zz' * 1500]
-    code = ''.join("a = rospy.get_param('~%s')\npub.publish(a)\nrospy.Timer(1, f)\n" % n for n in names)
-    files = {'scripts/flood.py': 'import rospy\n' + code + "rospy.get_param('~threshold')\n",
+    code = ''.join("a = rospy.get_param('~%s')\npub.publish(a)\nrospy.Timer(1, f)\nwarn(a)\n" % n for n in names)
+    files = {'scripts/flood.py': "import rospy\nwarn = rospy.ServiceProxy('w', T)\n" + code +
+                                 "rospy.get_param('~threshold')\nrospy.init_node('flood')\n",
              'scripts/argv.py': 'import argparse\np = argparse.ArgumentParser()\n' +
                                 ''.join("p.add_argument('--a%03d')\n" % i for i in range(600))}
     found = package_with(tmp_path, files)
@@ -74,13 +77,29 @@ def test_every_list_the_code_makes_is_bounded_and_the_threshold_kept(tmp_path):
     assert len(static['params_in_code']) == MAX_ITEMS and '~threshold' in static['params_in_code']
     assert all(len(p) <= MAX_TEXT for p in static['params_in_code'])
     assert len(static['args_in_code']) == MAX_ITEMS
-    for key in ('publishes', 'timers'):
+    for key in ('publishes', 'timers', 'service_calls', 'private_before_init'):
         assert len(static['code'][key]) == MAX_ITEMS, key
+    # read before init_node, so a read rospy resolves against <ns>/unnamed: the rubric must still see it
+    assert [w for w in static['code']['private_before_init'] if w.endswith(': ~threshold')]
     said = [n for n in record.notes if '(at most 500): the first 500 are kept' in n]
     assert said[0] == '603 parameter names the code reads (at most 500): the first 500 are kept', said
     assert '600 arguments the code reads (at most 500): the first 500 are kept' in said
+    assert [n for n in said if re.match(r'^6\d\d service calls in the code ', n)], said
+    assert '602 private parameters read before init_node (at most 500): the first 500 are kept' in said
     for what in ('publish calls', 'timers'):  # the good node's own and the flood's
         assert [n for n in said if re.match(r'^6\d\d %s in the code ' % what, n)], said
+
+
+def test_python_2_findings_are_bounded(tmp_path):
+    """501 files of Python 2 (a print statement each): the first 500 findings, the note of them
+    naming five and counting the rest."""
+    found = package_with(tmp_path, {'scripts/old%03d.py' % i: 'print "old"\n' for i in range(501)})
+    record = read_back(InspectRecord, found)
+    assert len(record.static['python2']) == MAX_ITEMS and record.static['python2'][0] == 'scripts/old000.py:1: print statement'
+    assert '501 files of Python 2 (at most 500): the first 500 are kept' in record.notes
+    assert '501 Python files that do not parse as Python 3 (at most 50): the first 50 are named' in record.notes
+    assert [n for n in record.notes if n.startswith('Python 2 code, which ROS Noetic cannot run: ')
+            and n.endswith(' and 496 more')]
 
 
 def test_a_record_over_its_bytes_cuts_its_lists_of_text(tmp_path):
@@ -99,7 +118,7 @@ def test_fixes_and_notes_of_many_files_are_bounded(tmp_path):
     """600 scripts that are not executable (a fix each) and 600 launch files (a note each when
     they are broken): fixes and notes within their caps, said."""
     files = {'scripts/s%03d.py' % i: '#!/usr/bin/env python3\nx = 1\n' for i in range(600)}
-    files.update({'launch/l%03d.launch' % i: '<launch><oops/></launch>\n' for i in range(600)})
+    files.update({'launch/l%03d.launch' % i: '<launch><oops></launch>\n' for i in range(600)})  # not XML
     found = package_with(tmp_path, files)
     record = read_back(InspectRecord, found)
     assert len(record.fixes) == MAX_ITEMS and record.fixes[-1].startswith('6') and 'fixes (at most 500)' in record.fixes[-1]
@@ -107,6 +126,8 @@ def test_fixes_and_notes_of_many_files_are_bounded(tmp_path):
     assert len(record.static['launch_files']) == MAX_ITEMS
     assert record.static['launch']['file'] == 'launch/exam.launch'  # exam.launch read first when some are left out
     assert any(n.startswith('601 launch files (at most 500): the first 500 are read') for n in record.notes)
+    assert [n for n in record.notes if re.match(r'^\d+ problems of the launch files \(at most 50\): the first 50 '
+                                                r'are named$', n)], record.notes[-5:]
 
 
 def test_any_list_left_uncut_is_cut_by_the_record_s_schema():

@@ -53,13 +53,19 @@ def kept(items, what, notes, limit=MAX_ITEMS, first=None, verb='kept', text=MAX_
     return out
 
 
-def closed(notes, what='notes', limit=MAX_ITEMS):
+def closed(notes, what='notes', limit=MAX_ITEMS, keep=()):
     """``notes`` (texts for the teacher) within ``limit`` items, the last saying how many more there
-    were, each cut to MAX_TEXT."""
-    notes = [cut(n) for n in notes]
+    were, each cut to MAX_TEXT; those in ``keep`` (the sentences of caps) are never left out."""
     if len(notes) <= limit:
-        return notes
-    return notes[:limit - 1] + ['%d %s (at most %d): the first %d kept' % (len(notes), what, limit, limit - 1)]
+        return [cut(n) for n in notes]
+    keep = set(keep)
+    room = limit - 1 - sum(1 for n in notes if n in keep)
+    out = []
+    for note in notes:
+        if note in keep or room > 0:
+            room -= note not in keep
+            out.append(cut(note))
+    return out[:limit - 1] + ['%d %s (at most %d): the first %d kept' % (len(notes), what, limit, min(len(out), limit - 1))]
 
 
 def fit(value, record_type, notes_key='notes'):
@@ -79,7 +85,7 @@ def fit(value, record_type, notes_key='notes'):
         cuts.append('%s: %d bytes (at most %d): its lists of text cut to their first %d items of at most %d '
                     'characters' % (record_type.FILE, before, record_type.MAX_BYTES, caps[0], caps[1]))
     if notes is not None and cuts:
-        value[notes_key] = closed(value[notes_key][:MAX_ITEMS - len(cuts)] + cuts)
+        value[notes_key] = closed(value[notes_key] + cuts, keep=cuts)
     return value
 
 

@@ -27,6 +27,11 @@ from exam_lab.grader.score import boxenv, records
 from exam_lab.grader.score.sheets import PACKAGE, SHEETS, threshold_run_value
 
 
+#: Notes of one kind, one a file (a file that does not parse, a launch file's problem), named at most:
+#: a package of hundreds of such files must leave room in the record's notes for the others.
+NOTES_OF_A_KIND = 50
+
+
 def detect_sheet(wanted, package_dir, analyses):
     """``(sheet, how it was chosen)``: given, else from package.xml, else the launch files, else the
     topics the code names; altitude when nothing decides."""
@@ -60,7 +65,7 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     :param draw: in [0, 1), drawn by the grader at grading time: where the threshold run's value lies
         in its range (:func:`~exam_lab.grader.score.sheets.threshold_run_value`); drawn here if None.
     """
-    notes, fixes = [], []
+    notes, fixes, capped = [], [], []  # capped: the sentences of caps, never left out of the notes
     draw = random.SystemRandom().random() if draw is None else draw
     record = {'uid': os.getuid(), 'refused': None, 'sheet': wanted_sheet or 'altitude', 'notes': notes,
               'fixes': fixes, 'static': None, 'threshold_value': SHEETS[wanted_sheet or 'altitude'].threshold,
@@ -79,7 +84,7 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     fixes.extend(source.fix_text(pkg))
     box_env = boxenv.box_env({'PATH': '/usr/bin:/bin'})  # what $(env) reads in the run box, nothing of ours
     analyses = [launch.analyse(path, pkg, name, box_env) for path in bounds.kept(
-        derive.launch_files(pkg), 'launch files', notes, first=lambda p: os.path.basename(p) == 'exam.launch',
+        derive.launch_files(pkg), 'launch files', capped, first=lambda p: os.path.basename(p) == 'exam.launch',
         verb='read', text=None)]
     sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
     notes.insert(0, how)
@@ -97,13 +102,13 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
               'launch': None, 'threshold': None, 'uploads': uploads}
     record.update(sheet=sheet, static=static, threshold_value=SHEETS[sheet].threshold,
                   calls_service=source.calls_a_service(pkg))
-    notes.extend(source.unparsed(pkg))
+    notes.extend(bounds.kept(source.unparsed(pkg), 'Python files that do not parse as Python 3', capped,
+                             NOTES_OF_A_KIND, verb='named'))
     if static['python2']:
         notes.append('Python 2 code, which ROS Noetic cannot run: %s' % archives.listed(static['python2']))
-    for analysis in analyses:
-        for problem in analysis.problems:
-            notes.append('launch: %s' % problem)
-    code = bounds.kept(source.student_code(pkg), 'Python files', notes, verb='read for comments', text=None)
+    notes.extend(bounds.kept(['launch: %s' % problem for analysis in analyses for problem in analysis.problems],
+                             "problems of the launch files", capped, NOTES_OF_A_KIND, verb='named'))
+    code = bounds.kept(source.student_code(pkg), 'Python files', capped, verb='read for comments', text=None)
     if code:
         comments, lines = source.comment_ratio(code)
         record['comments'] = {'comments': comments, 'code': lines, 'files': [os.path.relpath(p, pkg) for p in code]}
@@ -143,20 +148,22 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
                 f.write('<launch><node pkg="%s" type="%s" name="exam" output="screen"/></launch>\n'
                         % (name, os.path.basename(scripts[0])))
             record['main_launch'] = os.path.relpath(minimal, ws)
-    _bound_static(static, notes)
-    record['notes'], record['fixes'] = bounds.closed(notes), bounds.closed(fixes, 'fixes')
+    _bound_static(static, capped)
+    record['notes'] = bounds.closed(notes + capped, keep=capped)
+    record['fixes'] = bounds.closed(fixes, 'fixes')
     return record
 
 
 def _bound_static(static, notes):
     """The lists of ``static`` within their caps (:func:`~exam_lab.grader.boxed.bounds.kept`), the
-    items the rubric reads kept first: what names the threshold's parameter or argument."""
+    items the rubric reads kept first: what names the threshold's parameter or argument. (Its launch
+    files were bounded before they were read.)"""
     name = ((static.get('threshold') or {}).get('name') or '').split('/')[-1]
 
     def reads(item):  # '~threshold', '--threshold' and 'scripts/n.py:3: ~threshold' alike: its name's last part
         return bool(name) and item.rsplit(': ', 1)[-1].strip('~/-').split('/')[-1] == name.strip('-')
-    for key, what in (('python2', 'files of Python 2'), ('params_in_code', 'parameter names the code reads'),
-                      ('args_in_code', 'arguments the code reads'), ('launch_files', 'launch files')):
+    static['python2'] = bounds.kept(static['python2'], 'files of Python 2', notes)
+    for key, what in (('params_in_code', 'parameter names the code reads'), ('args_in_code', 'arguments the code reads')):
         static[key] = bounds.kept(static[key], what, notes, first=reads)
     for key, what in (('service_calls', 'service calls in the code'), ('publishes', 'publish calls in the code'),
                       ('timers', 'timers in the code'), ('private_before_init', 'private parameters read before init_node')):
