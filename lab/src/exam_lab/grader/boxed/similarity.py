@@ -248,8 +248,8 @@ def check(submissions, out_dir, python=None, shared=None, scratch_dir=None):
 def bounded(result):
     """``result`` (the detector's, with its ``notes``) within what similarity.json holds, each cut a
     sentence in its notes: the flagged pairs most alike first (at most the record's number), their
-    highlighted code within MAX_HTML_BYTES (a fragment over the record's length is not kept: cut, its
-    markup would break), every pair's scores most alike first within MAX_SCORES_BYTES."""
+    highlighted code within MAX_HTML_BYTES (a fragment over the record's length is left out, not cut:
+    its markup would break), every pair's scores most alike first within MAX_SCORES_BYTES."""
     notes = []  # what was cut of the class, before what was said of each student
     schema = records.SimilarityRecord.SCHEMA
     pairs = sorted(result.get('pairs') or [], key=lambda p: -max(p['score_a'], p['score_b']))
@@ -260,15 +260,15 @@ def bounded(result):
     for pair in pairs:
         for match in pair['files']:
             for key in ('html_a', 'html_b'):
-                size = len(match[key])
-                if size > html_limit or spent + size > MAX_HTML_BYTES:
-                    match[key] = '(its highlighted code, %d characters, is not kept: at most %d of a file, %d '\
-                                 'of the class)' % (size, html_limit, MAX_HTML_BYTES)
+                size = len(json.dumps(match[key]))  # as written: a character not ASCII is 6 bytes
+                if len(match[key]) > html_limit or spent + size > MAX_HTML_BYTES:
+                    match[key] = '(its highlighted code, %d characters, is not kept: at most %d characters of a '\
+                                 'file, %d bytes of the class)' % (len(match[key]), html_limit, MAX_HTML_BYTES)
                     dropped += 1
                 else:
                     spent += size
     if dropped:
-        notes.append('%d highlighted fragments not kept (at most %d characters of one, %d of the class): '
+        notes.append('%d highlighted fragments not kept (at most %d characters of one, %d bytes of the class): '
                      'the most alike pairs keep theirs' % (dropped, html_limit, MAX_HTML_BYTES))
     scores = sorted(result.get('scores') or [], key=lambda s: -max(s[2], s[3]))
     limit, size = schema['scores'].schema.limit, 0
@@ -280,7 +280,7 @@ def bounded(result):
     if len(scores) > limit:  # else in the detector's order
         result['scores'] = bounds.kept(scores, "pairs' scores (%d bytes at most)" % MAX_SCORES_BYTES, notes, limit,
                                        verb='kept, the most alike')
-    result['notes'] = bounds.closed(notes + result.get('notes', []))
+    result['notes'] = bounds.closed(notes + result.get('notes', []), keep=notes)
     return result
 
 
