@@ -53,6 +53,7 @@ SINGLES = {
     'simple_altitude': ('simple_answer', 'altitude'),   # test_simple_answer: full marks on both sheets
     'simple_depth': ('simple_answer', 'depth'),
     'ours_depth': ('ours', 'depth'),                    # test_grade: our node on the depth sheet
+    'simple_many_files': ('many_files', 'altitude'),    # test_simple_answer: 501 Python files, one over a cap
 }
 
 
@@ -67,7 +68,8 @@ def singles(root):
     import test_simple_answer
     from exam_lab.grader import runner
     from exam_lab.grader.host import underlay
-    packages = {'simple_answer': test_simple_answer.SIMPLE, 'ours': test_grade.OUR_EXAM}
+    packages = {'simple_answer': test_simple_answer.SIMPLE, 'ours': test_grade.OUR_EXAM,
+                'many_files': test_simple_answer.many_files(os.path.join(root, 'many_files'))}
 
     def one(name):
         package, sheet = SINGLES[name]

@@ -27,6 +27,8 @@ GRADE = os.path.join(REPO, 'lab', 'scripts', 'grade.py')
 HOSTILE = os.path.join(HERE, 'hostile')
 GOOD = os.path.join(HERE, 'submissions', 'good_student', 'exam')
 
+#: Gradings side by side (the burner's box has a CPU quota of cores / JOBS: limits.box_cpus).
+JOBS = 2
 #: The victim: the good student's package, graded beside the burner (the first two start together
 #: with JOBS=2), then beside whoever comes next; it must keep its 17 points.
 VICTIM_NAME = 'b_victim'
@@ -167,7 +169,7 @@ def grade(root):
         write_secrets(secret_file)
         write_outside(outside_token)
         try:
-            done = subprocess.run([sys.executable, GRADE, '--class', klass, '--out', out, '--jobs', '2',
+            done = subprocess.run([sys.executable, GRADE, '--class', klass, '--out', out, '--jobs', str(JOBS),
                                    '--worksheet', worksheet, '--no-similarity'], env=env,
                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=CLASS_TIMEOUT)
             status, stdout, stderr = (done.returncode, done.stdout.decode('utf-8', 'replace'),

@@ -14,8 +14,8 @@ lab/test/unit/test_grader_moodle.py), each student a kind of upload that used to
 - ``Dee Copy`` and ``Eve Original``: the same code; Dee's package also holds 3 MB of YAML and
   60 more Python files than the check reads of one student; ``Gus Deep`` a file in folders deeper than
   an upload may be (the case of the same kind: refused alone, by the grading and by the check);
-- ``Fay Many``: 501 Python files, one over the inspection record's list cap: a sentence naming the
-  cap and the value on her row, no traceback.
+- ``Fay Many``: 501 Python files, one over the inspection record's list cap: graded on the first
+  500, a sentence naming the cap and the value for the teacher, no traceback.
 
 The class zip itself is staged for its intake by a class's bounds, not one upload's.
 
@@ -191,10 +191,11 @@ def test_a_copy_is_flagged_whatever_data_one_of_them_hands_in(graded):
                     % (similarity.MAX_STUDENT_FILES, similarity.MAX_STUDENT_BYTES)) in cut[0], similar['notes']
 
 
-def test_a_cap_hit_reads_as_a_sentence(graded):
+def test_a_cap_hit_reads_as_a_sentence_and_the_student_is_graded_on_what_fits(graded):
     fay = graded['records']['Fay Many']
-    assert fay['status'] == rubric.NOT_GRADED
-    assert 'inspect.json.comments.files: 501 files (at most 500)' in fay['status_reason'], fay['status_reason']
+    assert fay['status'] != rubric.NOT_GRADED, fay['status_reason']
+    assert 'no script of the package starts a ROS node' in fay['status_reason'], fay['status_reason']
+    assert '501 Python files (at most 500): the first 500 are read for comments' in fay['for_the_teacher']
     assert 'Traceback' not in fay['status_reason'] and 'File "' not in fay['status_reason']
 
 

@@ -6,6 +6,7 @@ submarinedrone and the simple answer's exam).
 """
 import os
 import re
+import shutil
 import subprocess
 
 import pytest
@@ -28,6 +29,35 @@ def test_the_simple_answer_gets_full_marks(singles, sheet):
     evidence = '\n'.join('%s %s/%s: %s' % (i['id'], i['points'], i['max'], i['evidence']) for i in record['items'])
     assert got == {item: points for item, (points, _) in ITEMS.items()}, evidence
     assert record['total'] == record['max'] == 17.0
+
+
+#: Python files of :func:`many_files`: one over what the inspection's record lists (records.MAX_ITEMS).
+MANY_FILES = 501
+
+
+def many_files(target):
+    """The simple answer and tiny modules beside it (``src/exam_parts/m000.py``: ``x = 0``), MANY_FILES
+    Python files in all, written as ``target/exam``; returns that folder."""
+    package = os.path.join(target, 'exam')
+    shutil.copytree(SIMPLE, package)
+    own = sum(name.endswith('.py') for _, _, names in os.walk(package) for name in names)
+    os.makedirs(os.path.join(package, 'src', 'exam_parts'))
+    for index in range(MANY_FILES - own):
+        with open(os.path.join(package, 'src', 'exam_parts', 'm%03d.py' % index), 'w') as f:
+            f.write('x = %d\n' % index)
+    return package
+
+
+def test_501_python_files_are_graded_on_what_fits_with_a_sentence(singles):
+    """Issue 36 point 6: a package of 501 Python files, one more than inspect.json lists, was "not
+    graded" (its record failed its schema). Graded on what fits, it keeps every machine point, and the
+    teacher reads the cap and the value."""
+    record = singles['simple_many_files']  # graded alone (class_runs.py SINGLES)
+    got = {i['id']: i['points'] for i in record['items']}
+    evidence = '\n'.join('%s %s/%s: %s' % (i['id'], i['points'], i['max'], i['evidence']) for i in record['items'])
+    assert got == {item: points for item, (points, _) in ITEMS.items()}, evidence
+    assert record['status'] in ('graded', 'graded with fixes'), record['status_reason']
+    assert '%d Python files (at most 500): the first 500 are read for comments' % MANY_FILES in record['for_the_teacher']
 
 
 def test_the_simple_answer_is_no_package_of_the_repository():

@@ -287,3 +287,43 @@ def test_a_class_archive_keeps_each_script_s_x_bit_through_every_copy(tmp_path, 
     finally:
         os.umask(umask)
     assert name == 'Ann Lee'
+
+
+def test_a_class_tar_judges_a_student_s_huge_member_on_that_student_s_row(tmp_path, monkeypatch):
+    """Issue 36 point 3, for a class the teacher packed as a .tar.gz: a student's member over the
+    student's own bounds refuses that student alone, on its row, as in a class zip (it was counted
+    against the class's total while the tar was listed, and stopped the listing of the whole class);
+    the class's own bounds (what listing reads through, its entries) still refuse the class. Bounds
+    lowered: 5 MB of zeros (a few KB packed) stand for a recording of gigabytes."""
+    monkeypatch.setattr(archives, 'MAX_BYTES', 1 << 20)
+    monkeypatch.setattr(classlist, 'CLASS_BYTES', 4 << 20)
+    monkeypatch.setattr(classlist, 'CLASS_READ_BYTES', 8 << 20)
+    upload = open(make_zip(tmp_path / 'exam.zip', [('exam/package.xml', PACKAGE_XML)]), 'rb').read()
+    folder = '%s_%d_assignsubmission_file_/'
+    archive = str(tmp_path / 'class.tar.gz')
+    with tarfile.open(archive, 'w:gz') as tf:
+        for name, data in ((folder % ('Ann Lee', 11) + 'exam.zip', upload),
+                           (folder % ('Bob Bag', 12) + 'exam.zip', upload),
+                           (folder % ('Bob Bag', 12) + 'flight.bag', b'\0' * (5 << 20)),
+                           (folder % ('Cy Fine', 13) + 'exam.zip', upload)):
+            info = tarfile.TarInfo(name)
+            info.size = len(data)
+            tf.addfile(info, io.BytesIO(data))
+    assert os.path.getsize(archive) < 64 << 10
+    refused = {}
+    students = classlist.list_students(archive, str(tmp_path / 'scratch'), refused)
+    assert [name for name, _ in students] == ['Ann Lee', 'Bob Bag', 'Cy Fine']
+    paths = dict(students)
+    assert refused == {paths['Bob Bag']: "the files of 'Bob Bag_12_assignsubmission_file_': %d more bytes, beyond "
+                                         "the %d a submission may unpack" % ((5 << 20) + len(upload), 1 << 20)}
+    assert os.listdir(paths['Bob Bag']) == []
+    for name in ('Ann Lee', 'Cy Fine'):
+        assert open(os.path.join(paths[name], 'exam.zip'), 'rb').read() == upload, name
+    monkeypatch.setattr(classlist, 'CLASS_READ_BYTES', 3 << 20)  # the class's own bounds still hold
+    with pytest.raises(archives.UnpackError, match=r'class.tar.gz: listing it would read \d+ bytes \(at most 3145728 '
+                                                   r'for a class, students refused by their own bounds included\)'):
+        classlist.list_students(archive, str(tmp_path / 'again'))
+    monkeypatch.setattr(classlist, 'CLASS_READ_BYTES', 8 << 20)
+    monkeypatch.setattr(classlist, 'CLASS_FILES', 3)
+    with pytest.raises(archives.UnpackError, match=r'holds more than 3 entries \(at most 3 for a class\)'):
+        classlist.list_students(archive, str(tmp_path / 'more'))

@@ -12,7 +12,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it),
   :mod:`~.boxed.derive` (which launch file and threshold are run; the derived launch files the grader
   runs), :mod:`~.boxed.documents` (participant number, PDF
-  reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own).
+  reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own),
+  :mod:`~.boxed.bounds` (what a box puts into its record, cut to the record's caps with a sentence).
 - ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`
   (rospy: plays the drone with the harness's fake drone, measures, watches the node's pid).
 - ``host/`` -- root: :mod:`~.host.session` (builds and runs one submission: the student's steps in its

@@ -1,7 +1,8 @@
 """A class's students: one sub-folder (or archive) per student, as Moodle's "download all
 submissions" gives, from a folder or from an archive of it. No rospy here.
 
-A class archive is bounded as a whole (CLASS_FILES entries, CLASS_BYTES unpacked); each student's
+A class archive is bounded as a whole (CLASS_FILES entries, CLASS_BYTES unpacked, CLASS_READ_BYTES read
+through to list a tar); each student's
 files are checked and paid by the student's own bounds (:class:`~exam_lab.grader.boxed.archives.Budget`,
 the checks of :class:`~exam_lab.grader.boxed.archives.Plan`), so one student's bad files refuse that
 student only. Names are cleaned by :func:`~exam_lab.grader.score.identity.student_name`.
@@ -20,6 +21,10 @@ from exam_lab.grader.score.identity import participant_number, student_name
 #: (entries, bytes of the students it unpacks); each student's files are paid from MAX_FILES / MAX_BYTES.
 CLASS_FILES = 100000
 CLASS_BYTES = 4 * 1024 * 1024 * 1024
+#: What listing a class tar may read through, the members of students refused by their own bounds
+#: included: a compressed tar is decompressed to find each next entry, so a student's file over its own
+#: bounds (a 5 GB recording) is read, never kept, up to this bound of the class's.
+CLASS_READ_BYTES = 4 * CLASS_BYTES
 #: Characters kept at the end of a student's name too long to be a folder's (:func:`_fitting`): Moodle's
 #: ``_<participant>_assignsubmission_file_`` and more, at most 240 bytes in any script.
 _KEPT_END = 60
@@ -60,8 +65,10 @@ def _hidden(entry):
 
 def _class_entries(kind, opened, label):
     """``[(member, name, kind, size, link target)]`` of an open class archive, read as far as the
-    class's bounds allow (a compressed tar is decompressed while it is listed); raises UnpackError past
-    them."""
+    class's bounds allow; raises UnpackError past them. Each student's entries are judged afterwards by
+    that student's bounds (:func:`_student_plan`), a zip's and a tar's alike: a tar's member over them
+    is read through (a compressed tar is decompressed while it is listed) within CLASS_READ_BYTES, and
+    refuses its student only."""
     if kind == 'zip':
         count = len(opened.infolist())
         if count > CLASS_FILES:
@@ -71,9 +78,11 @@ def _class_entries(kind, opened, label):
     try:
         for entry in tar_entries(opened):
             read += entry[0].size
-            if len(entries) >= CLASS_FILES or read > CLASS_BYTES:
-                raise UnpackError('%s holds more than %d entries or %d bytes (the bounds of a class)'
-                                  % (label, CLASS_FILES, CLASS_BYTES))
+            if len(entries) >= CLASS_FILES:
+                raise UnpackError('%s holds more than %d entries (at most %d for a class)' % (label, CLASS_FILES, CLASS_FILES))
+            if read > CLASS_READ_BYTES:
+                raise UnpackError('%s: listing it would read %d bytes (at most %d for a class, students '
+                                  'refused by their own bounds included)' % (label, read, CLASS_READ_BYTES))
             entries.append(entry)
     except (tarfile.TarError, OSError, EOFError) as err:
         raise UnpackError('%s is not a readable tar archive: %s' % (label, err))

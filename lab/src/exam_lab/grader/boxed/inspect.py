@@ -22,9 +22,14 @@ import random
 import re
 import sys
 
-from exam_lab.grader.boxed import archives, derive, documents, launch, package, source
+from exam_lab.grader.boxed import archives, bounds, derive, documents, launch, package, source
 from exam_lab.grader.score import boxenv, records
 from exam_lab.grader.score.sheets import PACKAGE, SHEETS, threshold_run_value
+
+
+#: Notes of one kind, one a file (a file that does not parse, a launch file's problem), named at most:
+#: a package of hundreds of such files must leave room in the record's notes for the others.
+NOTES_OF_A_KIND = 50
 
 
 def detect_sheet(wanted, package_dir, analyses):
@@ -60,7 +65,7 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     :param draw: in [0, 1), drawn by the grader at grading time: where the threshold run's value lies
         in its range (:func:`~exam_lab.grader.score.sheets.threshold_run_value`); drawn here if None.
     """
-    notes, fixes = [], []
+    notes, fixes, capped = [], [], []  # capped: the sentences of caps, never left out of the notes
     draw = random.SystemRandom().random() if draw is None else draw
     record = {'uid': os.getuid(), 'refused': None, 'sheet': wanted_sheet or 'altitude', 'notes': notes,
               'fixes': fixes, 'static': None, 'threshold_value': SHEETS[wanted_sheet or 'altitude'].threshold,
@@ -78,7 +83,9 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     package.copy_package(pkg_source, pkg, fixes)
     fixes.extend(source.fix_text(pkg))
     box_env = boxenv.box_env({'PATH': '/usr/bin:/bin'})  # what $(env) reads in the run box, nothing of ours
-    analyses = [launch.analyse(path, pkg, name, box_env) for path in derive.launch_files(pkg)]
+    analyses = [launch.analyse(path, pkg, name, box_env) for path in bounds.kept(
+        derive.launch_files(pkg), 'launch files', capped, first=lambda p: os.path.basename(p) == 'exam.launch',
+        verb='read', text=None)]
     sheet, how = detect_sheet(wanted_sheet, pkg, analyses)
     notes.insert(0, how)
     chosen = derive.choose(analyses, sheet)
@@ -95,13 +102,13 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
               'launch': None, 'threshold': None, 'uploads': uploads}
     record.update(sheet=sheet, static=static, threshold_value=SHEETS[sheet].threshold,
                   calls_service=source.calls_a_service(pkg))
-    notes.extend(source.unparsed(pkg))
+    notes.extend(bounds.kept(source.unparsed(pkg), 'Python files that do not parse as Python 3', capped,
+                             NOTES_OF_A_KIND, verb='named'))
     if static['python2']:
-        notes.append('Python 2 code, which ROS Noetic cannot run: %s' % ', '.join(static['python2']))
-    for analysis in analyses:
-        for problem in analysis.problems:
-            notes.append('launch: %s' % problem)
-    code = source.student_code(pkg)
+        notes.append('Python 2 code, which ROS Noetic cannot run: %s' % archives.listed(static['python2']))
+    notes.extend(bounds.kept(['launch: %s' % problem for analysis in analyses for problem in analysis.problems],
+                             "problems of the launch files", capped, NOTES_OF_A_KIND, verb='named'))
+    code = bounds.kept(source.student_code(pkg), 'Python files', capped, verb='read for comments', text=None)
     if code:
         comments, lines = source.comment_ratio(code)
         record['comments'] = {'comments': comments, 'code': lines, 'files': [os.path.relpath(p, pkg) for p in code]}
@@ -141,7 +148,26 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
                 f.write('<launch><node pkg="%s" type="%s" name="exam" output="screen"/></launch>\n'
                         % (name, os.path.basename(scripts[0])))
             record['main_launch'] = os.path.relpath(minimal, ws)
+    _bound_static(static, capped)
+    record['notes'] = bounds.closed(notes + capped, keep=capped)
+    record['fixes'] = bounds.closed(fixes, 'fixes')
     return record
+
+
+def _bound_static(static, notes):
+    """The lists of ``static`` within their caps (:func:`~exam_lab.grader.boxed.bounds.kept`), the
+    items the rubric reads kept first: what names the threshold's parameter or argument. (Its launch
+    files were bounded before they were read.)"""
+    name = ((static.get('threshold') or {}).get('name') or '').split('/')[-1]
+
+    def reads(item):  # '~threshold', '--threshold' and 'scripts/n.py:3: ~threshold' alike: its name's last part
+        return bool(name) and item.rsplit(': ', 1)[-1].strip('~/-').split('/')[-1] == name.strip('-')
+    static['python2'] = bounds.kept(static['python2'], 'files of Python 2', notes)
+    for key, what in (('params_in_code', 'parameter names the code reads'), ('args_in_code', 'arguments the code reads')):
+        static[key] = bounds.kept(static[key], what, notes, first=reads)
+    for key, what in (('service_calls', 'service calls in the code'), ('publishes', 'publish calls in the code'),
+                      ('timers', 'timers in the code'), ('private_before_init', 'private parameters read before init_node')):
+        static['code'][key] = bounds.kept(static['code'][key], what, notes, first=reads)
 
 
 def main(argv=None):
@@ -160,7 +186,8 @@ def main(argv=None):
     if args.toplevel:
         os.symlink(args.toplevel, os.path.join(args.ws, 'src', 'CMakeLists.txt'))
     try:
-        records.write(args.out, records.InspectRecord, inspect(args.upload, args.ws, args.out, args.sheet, args.draw))
+        record = inspect(args.upload, args.ws, args.out, args.sheet, args.draw)
+        records.write(args.out, records.InspectRecord, bounds.fit(record, records.InspectRecord))
     except records.RecordError as err:  # a sentence for the teacher, not a traceback
         sys.stderr.write('inspect: its record exceeds a bound: %s\n' % err)
         return 4

@@ -15,8 +15,13 @@ import argparse
 import os
 import sys
 
-from exam_lab.grader.boxed import archives, classlist
+from exam_lab.grader.boxed import archives, bounds, classlist
 from exam_lab.grader.score import records
+
+#: Most characters of why a student's files were refused: a class of MAX_STUDENTS refused students, with
+#: their names and folders, stays within intake.json's bytes (the reasons are one sentence, their names
+#: cut to 80 characters).
+MAX_REFUSED = 500
 
 
 def main(argv=None):
@@ -33,11 +38,16 @@ def main(argv=None):
     except archives.UnpackError as err:
         sys.stderr.write('intake: the class archive cannot be opened safely: %s\n' % err)
         return 3
+    if len(students) > records.IntakeRecord.MAX_STUDENTS:  # a class's bound, as its entries and bytes are
+        sys.stderr.write('intake: the class archive holds %d students (at most %d for a class)\n'
+                         % (len(students), records.IntakeRecord.MAX_STUDENTS))
+        return 3
     try:
-        records.write(args.out, records.IntakeRecord, {
+        records.write(args.out, records.IntakeRecord, bounds.fit({
             'uid': os.getuid(), 'students': [dict({'name': name, 'path': os.path.relpath(path, args.out)},
-                                                  **({'refused': refused[path][:records.MAX_TEXT]} if path in refused else {}))
-                                             for name, path in students]})
+                                                  **({'refused': bounds.cut(refused[path], MAX_REFUSED)}
+                                                     if path in refused else {}))
+                                             for name, path in students]}, records.IntakeRecord, None))
     except records.RecordError as err:  # a sentence for the teacher, not a traceback
         sys.stderr.write('intake: its record exceeds a bound: %s\n' % err)
         return 4

@@ -26,8 +26,9 @@ import sys
 import tempfile
 
 from exam_lab.grader import workspace
-from exam_lab.grader.boxed import archives
+from exam_lab.grader.boxed import archives, bounds
 from exam_lab.grader.boxed.package import open_submission
+from exam_lab.grader.score import records
 
 VERSION = '0.5.0'
 #: copydetect's noise threshold (k, characters of normalised code) and window.
@@ -43,6 +44,10 @@ MAX_FILE_BYTES = 200 * 1024
 #: programs first (:func:`student_code`).
 MAX_STUDENT_FILES = 50
 MAX_STUDENT_BYTES = 512 * 1024
+#: What similarity.json keeps of the pairs' highlighted code and of every pair's scores, within its
+#: record's bytes (:class:`~exam_lab.grader.score.records.SimilarityRecord`: 32 MB): the most alike first.
+MAX_HTML_BYTES = 16 << 20
+MAX_SCORES_BYTES = 8 << 20
 #: Languages by suffix, for files pygments does not know by name.
 LANGUAGES = {'.launch': 'xml', '.xml': 'xml', '.txt': 'cmake', '.py': 'python', '.cpp': 'cpp', '.cc': 'cpp',
              '.cxx': 'cpp', '.c': 'cpp', '.h': 'cpp', '.hpp': 'cpp'}
@@ -232,11 +237,51 @@ def check(submissions, out_dir, python=None, shared=None, scratch_dir=None):
         except (SimilarityError, subprocess.SubprocessError) as err:
             result = {'error': str(err)}
         result['notes'] = notes
+        result = bounds.fit(bounded(result), records.SimilarityRecord)
         with open(os.path.join(out_dir, 'similarity.json'), 'w') as f:
             json.dump(result, f, indent=1, sort_keys=True)
         return result
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
+
+
+def bounded(result):
+    """``result`` (the detector's, with its ``notes``) within what similarity.json holds, each cut a
+    sentence in its notes: the flagged pairs most alike first (at most the record's number), their
+    highlighted code within MAX_HTML_BYTES (a fragment over the record's length is left out, not cut:
+    its markup would break), every pair's scores most alike first within MAX_SCORES_BYTES."""
+    notes = []  # what was cut of the class, before what was said of each student
+    schema = records.SimilarityRecord.SCHEMA
+    pairs = sorted(result.get('pairs') or [], key=lambda p: -max(p['score_a'], p['score_b']))
+    if 'pairs' in result:
+        result['pairs'] = pairs = bounds.kept(pairs, 'pairs flagged', notes, schema['pairs'].schema.limit,
+                                              verb='kept, the most alike')
+    html_limit, spent, dropped = schema['pairs'].schema.schema['files'][0]['html_a'].limit, 0, 0
+    for pair in pairs:
+        for match in pair['files']:
+            for key in ('html_a', 'html_b'):
+                size = len(json.dumps(match[key]))  # as written: a character not ASCII is 6 bytes
+                if len(match[key]) > html_limit or spent + size > MAX_HTML_BYTES:
+                    match[key] = '(its highlighted code, %d characters, is not kept: at most %d characters of a '\
+                                 'file, %d bytes of the class)' % (len(match[key]), html_limit, MAX_HTML_BYTES)
+                    dropped += 1
+                else:
+                    spent += size
+    if dropped:
+        notes.append('%d highlighted fragments not kept (at most %d characters of one, %d bytes of the class): '
+                     'the most alike pairs keep theirs' % (dropped, html_limit, MAX_HTML_BYTES))
+    scores = sorted(result.get('scores') or [], key=lambda s: -max(s[2], s[3]))
+    limit, size = schema['scores'].schema.limit, 0
+    for index, row in enumerate(scores[:limit]):
+        size += len(json.dumps(row)) + 2
+        if size > MAX_SCORES_BYTES:
+            limit = index
+            break
+    if len(scores) > limit:  # else in the detector's order
+        result['scores'] = bounds.kept(scores, "pairs' scores (%d bytes at most)" % MAX_SCORES_BYTES, notes, limit,
+                                       verb='kept, the most alike')
+    result['notes'] = bounds.closed(notes + result.get('notes', []), keep=notes)
+    return result
 
 
 # --- inside the detector's environment -------------------------------------------------------------

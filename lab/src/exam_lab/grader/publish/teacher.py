@@ -10,6 +10,8 @@ from exam_lab.grader.score import measured
 
 #: Log lines worth the teacher's eye: warnings, errors, tracebacks.
 _ODD = re.compile(r'\[(WARN|ERROR|FATAL)\]|Traceback|Error\b|Exception\b')
+#: Files the comment statistics name (up to 500 were read: the rest are counted).
+SHOWN_FILES = 20
 
 
 def hints(static, session, notes, comments, isolate, how_run=None):
@@ -21,7 +23,8 @@ def hints(static, session, notes, comments, isolate, how_run=None):
     if comments:
         out.append('comments (not scored): %d comment lines for %d lines of code (%.0f %%) in %s'
                    % (comments['comments'], comments['code'], 100.0 * comments['comments'] / max(comments['code'], 1),
-                      ', '.join(comments['files'])))
+                      ', '.join(comments['files'][:SHOWN_FILES]) + (' and %d more' % (len(comments['files']) - SHOWN_FILES)
+                                                                     if len(comments['files']) > SHOWN_FILES else '')))
     static, session = measured.static_of(static), measured.session_of(session)
     probe = measured.main_probe(session)
     if probe:
