@@ -390,6 +390,24 @@ def test_a_right_node_flies_as_long_as_before_and_the_wait_is_bounded(monkeypatc
     assert lasts['never'] - lasts['right'] == pytest.approx(wait - legs.BACK_S - legs.DEEP_S, abs=0.3)
 
 
+
+def test_a_value_is_read_once_it_moved_and_a_stale_one_at_stale_s(monkeypatch):
+    """The node's value after an input change (legs.settled, on the synthetic clock): read SETTLE_S
+    later; a node that follows late (blocked in a callback) is waited for until its value moved, but no
+    longer than STALE_S, and then its stale value is what it published."""
+    from exam_lab.harness import wait
+    for lag, value, read_after in ((0.1, 1430.0, legs.SETTLE_S), (3.0, 1430.0, 3.1),
+                                   (legs.STALE_S + 1.0, 1170.0, legs.STALE_S)):
+        clock = SyntheticClock()
+        monkeypatch.setattr(legs, 'time', clock)
+        monkeypatch.setattr(wait, 'time', clock)
+        node = ScriptedNode(clock, lag=lag)
+        clock.sleep(lag + 1.0)
+        since = node.fly(1430.0)
+        got, count = legs.settled(node, since, before=1170.0)
+        assert got == value and count > 0, lag
+        assert clock.now - since == pytest.approx(read_after, abs=0.11), lag
+
 def test_owes():
     calls = [(1.0, 'WARNING'), (2.0, 'NORMAL'), (3.0, 'WARNING')]
     assert legs.owes(calls, 'below', 0.0) and not legs.owes(calls[:2], 'below', 0.0)
