@@ -8,7 +8,7 @@ import pytest
 from exam_lab.grader.boxed import derive, launch, source
 
 from exam_lab.grader.host import session
-from exam_lab.grader.judge import flight, legs
+from exam_lab.grader.judge import legs, pilot
 
 from exam_lab.grader.score import rubric
 
@@ -314,15 +314,15 @@ class ScriptedNode(object):
 
 
 def synthetic_flight(monkeypatch, node, clock, rates, warned_before=False):
-    """The probe's flight (flight.Flight.fly_legs, unchanged) around a scripted node on the synthetic
+    """The probe's flight (pilot.Flight.fly_legs, unchanged) around a scripted node on the synthetic
     clock; ``warned_before``: its value was above for 6 s just before (the calibration's high point),
     so it gave a WARNING there. Returns the main run's session record, scored as the grader does."""
     from exam_lab.harness import wait
-    monkeypatch.setattr(flight, 'time', clock)
+    monkeypatch.setattr(pilot, 'time', clock)
     monkeypatch.setattr(wait, 'time', clock)
     drone = type('Drone', (), {'rates': rates, 'service': type('Service', (), {'calls': node.calls})()})()
     graph = type('Graph', (), {'student_nodes': lambda self: ['/exam']})()
-    flying = flight.Flight({'threshold': 1300.0, 'delay': 5.0, 'late_warning': 60.0}, node.fly, node, drone, graph)
+    flying = pilot.Flight({'threshold': 1300.0, 'delay': 5.0, 'late_warning': 60.0}, node.fly, node, drone, graph)
     if warned_before:
         node.fly(1430.0)
         clock.sleep(6.0)

@@ -16,7 +16,7 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
 - ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`
   (rospy: plays the drone with the harness's fake drone, measures; its entry point), :mod:`~.judge.graph`
   (the master's view, rospy's refusals, the clock, the node's pid watched), :mod:`~.judge.node` (the
-  student's node, its inputs and output found), :mod:`~.judge.flight` (the inputs set, the calibration,
+  student's node, its inputs and output found), :mod:`~.judge.pilot` (the inputs set, the calibration,
   the legs flown) and :mod:`~.judge.legs` (the legs' holds and checks, pure).
 - ``host/`` -- root: :mod:`~.host.session` (builds and runs one submission: the student's steps in its
   box, the master and the probe as the slot's judge uid), :mod:`~.host.sandbox` (the box: opened, its command lines, run, closed),

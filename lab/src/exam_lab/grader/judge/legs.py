@@ -2,7 +2,7 @@
 each is checked on the node's own values, the node's value read after an input change, and the trace
 kept for the teacher's plot. Pure (no rospy: every function takes the samples, the calls and the
 times it judges), so the rules the rubric times from are unit-tested on synthetic time; the probe
-(:mod:`exam_lab.grader.judge.flight`) flies them.
+(:mod:`exam_lab.grader.judge.pilot`) flies them.
 """
 import math
 import time

@@ -38,7 +38,7 @@ The main scenario (times are the script's, all recorded as wall-clock times of t
    the rubric times each rule from them and judges nothing on a leg the node's value did not reach.
 
 The probe's parts, each a module of :mod:`exam_lab.grader.judge`: :mod:`~.graph` (the master's view,
-rospy's refusals, the clock and the node's pid watched), :mod:`~.node` (step 1), :mod:`~.flight`
+rospy's refusals, the clock and the node's pid watched), :mod:`~.node` (step 1), :mod:`~.pilot`
 (steps 2 to 4) and :mod:`~.legs` (the legs' holds and checks, pure). This module runs them in order
 and writes the result (:class:`~exam_lab.grader.score.records.ProbeRecord`).
 """
@@ -51,7 +51,7 @@ import time
 import rosgraph
 import rospy
 
-from exam_lab.grader.judge.flight import Calibration, Flight, Inputs
+from exam_lab.grader.judge.pilot import Calibration, Flight, Inputs
 from exam_lab.grader.judge.graph import ClockWatch, Graph, NodeWatch, RefusedConnections, node_pid, node_uri
 from exam_lab.grader.judge.legs import AFTER_S, trace
 from exam_lab.grader.judge.node import NodeFinder

@@ -1,4 +1,4 @@
-"""What the probe flies: the drone's inputs set (:class:`Inputs`), question 11's check points and the
+"""The probe's pilot, what it flies: the drone's inputs set (:class:`Inputs`), question 11's check points and the
 calibration that puts the node's own value where each leg needs it (:class:`Calibration`), and the
 legs themselves (:class:`Flight`), every leg held from the node's own first value on its side. The rules
 each leg keeps (holds, calls owed, checks) are :mod:`exam_lab.grader.judge.legs`'s; this module only
