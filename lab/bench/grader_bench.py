@@ -4,7 +4,7 @@
     python3 lab/bench/grader_bench.py [--students 60] [--jobs 4,6] [--out DIR] [--record]
     python3 lab/bench/grader_bench.py --from-results DIR/results.json [--record]
 
-(from the repository, after ``make build`` and ``source tools/env.sh``; about 40 minutes on two cores). A full
+(from the repository, after ``make build`` and ``source tools/env.sh``; about 70 minutes on two cores (67 on 2026-11-27)). A full
 ``make bench`` runs it last and records it; ``BENCH_STAGES=grader make bench`` runs a class of 4 into
 ``$EXAM_WS/bench-quick/grader``. Phases:
 
@@ -236,7 +236,7 @@ def render(results):
         'The timings are those the rubric judges, over every student of the row: the output rate '
         '(10 Hz +- 10 % passes), the WARNING after the first reading above the threshold (the rubric times it '
         'from the node\'s own value and passes 4.7 s up to the delay, one period of the slowest input and a tick: '
-        '`rubric.warning_window`; the packages warning at once or 50 s late left out) and the NORMAL after the first reading back (<= 0.5 s).', '']
+        '`score/flight.py` `warning_window`; the packages warning at once or 50 s late left out) and the NORMAL after the first reading back (<= 0.5 s).', '']
         + rows + ['',
         'Goals: one submission in at most 90 s (%s), a class of 60 in at most 15 minutes on two cores, no point '
         'moved. Measured: %s. %s' % (

@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # `make bench`: measures the exam node against lab/bench/baseline_exam_node.py and writes
-# docs/benchmarks.md and docs/figures/bench_fleet.png (17 minutes measured with BENCH_PROFILE=1 on two cores
-# on 2026-11-25, before the grader's stage; that stage grades a class of 60 twice, about 40 minutes more).
+# docs/benchmarks.md and docs/figures/bench_fleet.png (80 minutes measured with BENCH_PROFILE=1 on two cores
+# on 2026-11-27: the node's stages 13 minutes, then the grader's stage, which grades every test package alone
+# and a class of 60 twice, 67 minutes).
 #   BENCH_QUICK=1    a few seconds per stage; results go to $EXAM_WS/bench-quick/, docs/ is untouched
 #   BENCH_STAGES=rate,fleet  only these stages (rate latency slow max_rate fleet grader), also to $EXAM_WS/bench-quick/
 #   BENCH_FLEET_SIZES=5,20,50  the fleet sizes of ours (default 1,5,10,20,50,100: 200 nodes and the
 #                    master's CPU at 100 pairs need a machine with the cores and about 8 GB for them)
 # A full run ends with the grader's speed (lab/bench/grader_bench.py: a class of 60 at JOBS 4 and 6,
-# about 40 minutes more on two cores), recorded in lab/bench/grader.md and rendered into docs/benchmarks.md.
+# about 70 minutes more on two cores), recorded in lab/bench/grader.md and rendered into docs/benchmarks.md.
 #   BENCH_PROFILE=1  also profile ours with py-spy (installed from PyPI into a throwaway directory)
 #   BENCH_RENDER_ONLY=1  measure nothing: render the docs again from the last results
 # Every process it starts carries the run's log folder in its environment (exam_lab's supervisor); the
@@ -94,7 +95,7 @@ else
   wait "$bench_pid"
 fi
 if [ "$grader" = record ]; then
-  echo "bench: the grader's speed (lab/bench/grader_bench.py, about 40 minutes)"
+  echo "bench: the grader's speed (lab/bench/grader_bench.py, about 70 minutes)"
   /usr/bin/python3 "$repo/lab/bench/grader_bench.py" --out "$scratch/grader" --record &
   bench_pid=$!
   wait "$bench_pid"

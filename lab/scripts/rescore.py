@@ -7,7 +7,9 @@ For each student of OUT (or the one submission graded there), the rubric is appl
 measurements.json that ``make grade`` kept beside its grade.json; grade.json (with the points it had,
 ``previous``, and its provenance), grade.md, grades.csv, the page, results.json, moodle-feedback.zip and hand.csv (the
 teacher's points kept) are written again, and each student whose points or status moved is printed
-with the items that moved. No ROS, no sandbox, no root. A change of the rubric that needs measurements
+with the items that moved; a student whose measurements.json or grade.json is not a record of the
+grader is listed as not rescored (its files left as they were; the exit status is 1). No ROS, no
+sandbox, no root. A change of the rubric that needs measurements
 the run did not make (a new flight, another input) needs make grade again (docs/grading.md).
 """
 import argparse
@@ -30,12 +32,18 @@ def main(argv=None):
         print('rescore: no measurements.json in %s (graded before measurements were kept? run make grade '
               'again)' % out, file=sys.stderr)
         return 1
-    records, changes = grades.rescore(out)
+    records, lines = grades.rescore(out)
+    refused = [line for line in lines if grades.NOT_RESCORED in line]
+    changes = [line for line in lines if line not in refused]
     print(report.table(records))
     print('%d of %d student(s) changed:' % (len(changes), len(records)) if changes else
           'no point changed for any of the %d student(s)' % len(records))
     for line in changes:
         print('  ' + safe_text.one_line(line))
+    if refused:  # the others are rescored; these keep their files as they were
+        print('%d student(s) NOT rescored (a kept file that is not a record of the grader):' % len(refused))
+        for line in refused:
+            print('  ' + safe_text.one_line(line))
     single = grades.graded_folders(out) == [out]
     similar = None
     if not single and os.path.isfile(os.path.join(out, 'similarity.json')):
@@ -44,7 +52,7 @@ def main(argv=None):
     for line in desk.finish(out, records, single=single, similar=similar, worksheet=args.worksheet,
                             scale=args.worksheet_scale):
         print(line)
-    return 0
+    return 1 if refused else 0
 
 
 if __name__ == '__main__':

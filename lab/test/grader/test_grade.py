@@ -369,7 +369,7 @@ def test_rescoring_the_class_from_its_measurements_moves_nothing_and_a_rubric_ch
     """make rescore on the class just graded: today's rubric on the measurements kept, no run again
     (seconds); then a tighter 14b window, as a rubric correction would: only Q14b moves."""
     import time
-    from exam_lab.grader.score import rubric
+    from exam_lab.grader.score import flight
     out, records = graded
     started = time.monotonic()
     again, changes = grades.rescore(str(out))
@@ -382,7 +382,7 @@ def test_rescoring_the_class_from_its_measurements_moves_nothing_and_a_rubric_ch
             [(i['id'], i['points']) for i in record['items']], name
         assert by_name[name]['provenance']['how'] == 'rescore' and by_name[name]['previous']['total'] == record['total']
     # WARNING due before the delay: nobody's on time
-    monkeypatch.setattr(rubric, 'warning_window', lambda probe: (probe['delay'] - 0.3, probe['delay'] - 0.5))
+    monkeypatch.setattr(flight, 'warning_window', lambda probe: (probe.delay - 0.3, probe.delay - 0.5))
     again, changes = grades.rescore(str(out))
     moved = [line for line in changes if 'Q14b' in line]
     assert moved and all('Q14b' in line for line in changes), changes

@@ -118,6 +118,11 @@ def test_similarity_html_holds_only_the_highlight(tmp_path):
         egress.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
     assert egress.read_record(write(tmp_path, {'error': 'no venv', 'notes': []}, 'similarity.json'),
                               records.SimilarityRecord).value == {'error': 'no venv', 'notes': []}
+    # The students' file names and code are made safe where the record is made; the highlight stays.
+    match.update(file_a='a\x1b[2J.py', html_b="w\x07 <span class='highlight-green'>v\u202e</span>")
+    read = egress.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
+    assert read.pairs[0]['files'][0]['file_a'] == 'a.py'
+    assert read.pairs[0]['files'][0]['html_b'] == "w <span class='highlight-green'>v</span>"
 
 
 def test_a_cap_hit_is_a_sentence_naming_the_cap_and_the_value(tmp_path):
@@ -141,3 +146,19 @@ def test_a_class_larger_than_a_list_cap_is_one_intake(tmp_path):
     got = egress.read_record(write(tmp_path, {'uid': 61000, 'students': students}, 'intake.json'),
                              records.IntakeRecord, records.IntakeRecord.MAX_BYTES)
     assert len(got.students) == 600 and got.students[7]['refused'].startswith('the files of S 7')
+
+
+def test_the_inspections_text_is_made_safe_where_its_record_is_made(tmp_path):
+    """A student's words in the inspection's record (a note quoting a file name, the launch file's
+    words, a document's name) lose their escape sequences as root reads the record; the paths the
+    session opens and the code's file names are kept exactly."""
+    odd = 'scripts/n\udcff\x1b[2J.py'
+    found = inspect_record(notes=['link %s dropped' % odd, 'bell\x07'], fixes=['\u202eevil'],
+                           static=dict(inspect_record()['static'], threshold_reason='reads \x1b]0;owned\x07it'),
+                           facts={'participant': 1, 'folder': 'F\x1b[31m', 'documents': [{'name': 'r\x07.pdf', 'pages': 1}]},
+                           handed_in_launch='exam/launch/\udcfe.launch', comments={'comments': 1, 'code': 2, 'files': [odd]})
+    record = egress.read_record(write(tmp_path, json.dumps(found).encode()), records.InspectRecord)
+    assert record.notes == ['link scripts/n\\xff.py dropped', 'bell'] and record.fixes == ['evil']
+    assert record.static['threshold_reason'] == 'reads it' and record.facts['folder'] == 'F'
+    assert record.facts['documents'] == [{'name': 'r.pdf', 'pages': 1}]
+    assert record.handed_in_launch == 'exam/launch/\udcfe.launch' and record.comments['files'] == [odd]

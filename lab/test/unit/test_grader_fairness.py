@@ -10,7 +10,7 @@ from exam_lab.grader.boxed import derive, launch, source
 from exam_lab.grader.host import session
 from exam_lab.grader.judge import legs, pilot
 
-from exam_lab.grader.score import rubric
+from exam_lab.grader.score import flight, rubric, tolerances, verdict
 
 from exam_lab.grader.publish import report
 
@@ -175,12 +175,12 @@ def test_status_of_each_case():
 
 
 def test_crash_summary():
-    assert rubric.crash_summary(TRACEBACK) == "KeyError: '~threshold' at exam/scripts/exam_node.py:26"
+    assert verdict.crash_summary(TRACEBACK) == "KeyError: '~threshold' at exam/scripts/exam_node.py:26"
     syntax = ('  File "exam/scripts/exam_node.py", line 19\n    print "x"\n    ^\n'
               "SyntaxError: Missing parentheses in call to 'print'. Did you mean print(...)?\n")
-    assert rubric.crash_summary(syntax).startswith("SyntaxError: Missing parentheses in call to 'print'")
-    assert rubric.crash_summary(syntax).endswith('at exam/scripts/exam_node.py:19')
-    assert rubric.crash_summary('[ INFO] all good\n') == ''
+    assert verdict.crash_summary(syntax).startswith("SyntaxError: Missing parentheses in call to 'print'")
+    assert verdict.crash_summary(syntax).endswith('at exam/scripts/exam_node.py:19')
+    assert verdict.crash_summary('[ INFO] all good\n') == ''
 
 
 def test_python2_is_named(tmp_path):
@@ -426,12 +426,12 @@ def test_a_warning_at_the_next_reading_of_the_slowest_input_is_on_time(sheet, ra
     5 s: up to one period of the slowest input later (c18: 5.98 s on the depth drone's 1 Hz). On time up
     to that and a tick, from the sheet's drone's own rates; the long excursion lasts past it."""
     period = 1.0 / min(rates.values())
-    late = 5.0 + max(rubric.WARNING_LATE_S, period + 1.0 / rubric.RATE_HZ)
-    early = 5.0 - rubric.WARNING_EARLY_S
+    late = 5.0 + max(tolerances.WARNING_LATE_S, period + 1.0 / tolerances.RATE_HZ)
+    early = 5.0 - tolerances.WARNING_EARLY_S
     assert late < 5.0 + legs.AFTER_S, 'the long excursion must outlast the window'
     for latency, ok in ((early - 0.01, False), (early + 0.01, True), (5.0 + period - 0.02, True),
                         (late - 0.01, True), (late + 0.01, False)):
         record = flown([[7.6 + latency, 'WARNING'], [14.6 + 0.05, 'NORMAL']])
         main_of(record)['input_rates'] = dict(rates)
         assert lost(record) == ({} if ok else {'Q14b': 1.5}), (sheet, latency)
-        assert rubric.warning_window(main_of(record)) == pytest.approx((early, late))
+        assert flight.warning_window(main_of(record)) == pytest.approx((early, late))

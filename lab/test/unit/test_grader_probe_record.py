@@ -13,6 +13,8 @@ from exam_lab.grader.host import session
 from exam_lab.grader.score import records
 from exam_lab.grader.score.records import ProbeRecord, RecordError, SessionRecord
 
+from test_grader_kept import kept_copy
+
 #: A real probe's result: the main run of a correct answer (make fairness, 2026-11-26).
 REAL = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'data', 'probe-main.json')
 
@@ -46,7 +48,7 @@ def keep_runs(folder, runs, checked=True):
         session = SessionRecord.make(session).value
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, records.MEASUREMENTS), 'w') as f:
-        json.dump({'session': session}, f)
+        json.dump(dict(kept_copy('before-version'), session=session), f)
 
 
 def refused(value, record_type=ProbeRecord):
@@ -172,12 +174,11 @@ def test_the_runner_reads_the_sessions_record_capped_and_checked(tmp_path):
 def test_a_rescore_reads_back_the_session_record_the_run_kept(tmp_path):
     """measurements.json holds the session's record as the run made it (NaN included); a rescore reads
     it back to the same record and the same grade."""
-    from test_grader_rubric import STATIC
     probe = real_probe()
     probe['formula'][1]['published'] = float('nan')
     session_ = SessionRecord.make(real_session(probe)).value
-    kept = {'student': 'Ann', 'sheet': 'altitude', 'static': STATIC, 'session': session_, 'notes': [], 'fixes': [],
-            'comments': None, 'isolate': True, 'how_run': 'test', 'extra': {'seconds': 40.0}}
+    kept = {'student': 'Ann', 'sheet': 'altitude', 'static': kept_copy('before-version')['static'], 'session': session_,
+            'notes': [], 'fixes': [], 'comments': None, 'isolate': True, 'how_run': 'test', 'extra': {'seconds': 40.0}}
     folder = tmp_path / 'Ann'
     folder.mkdir()
     (folder / records.MEASUREMENTS).write_text(json.dumps(kept))

@@ -4,25 +4,34 @@ import json
 from exam_lab.grader import class_run, runner
 from exam_lab.grader.publish import grades
 from exam_lab.grader.score.records import MEASUREMENTS
-from exam_lab.grader.score import rubric
+from exam_lab.grader.score import flight
 
-from test_grader_rubric import STATIC, measured
+from test_grader_kept import kept_copy
+
+
+def late_measurements():
+    """A real grading's measurements (good_student, kept before the version), its main run's second
+    WARNING (and the drone's answer to it) 0.5 s later: 5.41 s after the node's own value stayed
+    above, inside the rubric's window, 0.11 s outside a window of the delay +-0.3 s."""
+    late = kept_copy('before-version')
+    probe = late['session']['runs'][0]['probe']
+    warning = [call for call in probe['calls'] if call[1] == 'WARNING'][1]
+    answer = [a for a in probe['answers'] if a[:2] == warning][0]
+    warning[0] = answer[0] = warning[0] + 0.5
+    return dict(late, student='late')
 
 
 def test_rescore_applies_todays_rubric_to_the_kept_measurements(tmp_path, monkeypatch):
-    """Two students' measurements (synthetic, as a run keeps them): no change with the same rubric; a
+    """Two students' measurements (real ones, as a run keeps them): no change with the same rubric; a
     tighter WARNING window moves the late student's Q14b only, with its previous points kept."""
-    late = [[-2.0, 'NORMAL'], [8.5 + 5.4, 'WARNING'], [16.0 + 0.08, 'NORMAL']]
-    for name, session in (('on_time', measured()), ('late', measured(calls=late))):
+    for name, kept in (('on_time', dict(kept_copy('before-version'), student='on_time')), ('late', late_measurements())):
         folder = tmp_path / name
         folder.mkdir()
-        kept = {'student': name, 'sheet': 'altitude', 'static': STATIC, 'session': session, 'notes': [],
-                'fixes': [], 'comments': None, 'isolate': True, 'how_run': 'test', 'extra': {'seconds': 40.0}}
         (folder / MEASUREMENTS).write_text(json.dumps(kept))
         (folder / 'grade.json').write_text(json.dumps(grades.score(kept)))
     records, changes = grades.rescore(str(tmp_path))
     assert changes == [] and [r['total'] for r in records] == [17.0, 17.0]
-    monkeypatch.setattr(rubric, 'warning_window', lambda probe: (probe['delay'] - 0.3, probe['delay'] + 0.3))
+    monkeypatch.setattr(flight, 'warning_window', lambda probe: (probe.delay - 0.3, probe.delay + 0.3))
     records, changes = grades.rescore(str(tmp_path))
     assert changes == ['late: 17 -> 15.5 (Q14b 3 -> 1.5)']  # the delay's 1.5 of 14b
     late_record = json.loads((tmp_path / 'late' / 'grade.json').read_text())

@@ -1,7 +1,7 @@
 """The rubric on synthetic measurements: each flaw costs exactly its points, with the numbers."""
 import pytest
 
-from exam_lab.grader.score import rubric
+from exam_lab.grader.score import flight, rubric, tolerances
 from exam_lab.grader.score.sheets import ITEMS
 
 #: The main run's flight (s): rest 0, short excursion 3-6, long excursion 8.5-16, end 18.5.
@@ -280,8 +280,8 @@ def test_a_node_that_waits_for_a_fresh_reading_of_each_input_is_timed_from_its_o
     assert lost(session) == {}
     assert 'its value followed the inputs within 1.20 s (at most 1.79 s' in evidence_of(session, 'Q11')
     assert 'WARNING 5.00 s after its own value went above the threshold and stayed' in evidence_of(session, 'Q14b')
-    assert rubric.lag_tolerance(session['runs'][0]['probe']) == pytest.approx(1 / 0.778 + rubric.LAG_SLACK_S)
-    assert rubric.lag_tolerance({}) == pytest.approx(1 / rubric.OLD_SLOWEST_HZ + rubric.LAG_SLACK_S)
+    assert flight.lag_tolerance(session['runs'][0]['probe']) == pytest.approx(1 / 0.778 + tolerances.LAG_SLACK_S)
+    assert flight.lag_tolerance({}) == pytest.approx(1 / tolerances.OLD_SLOWEST_HZ + tolerances.LAG_SLACK_S)
 
 
 def test_the_delay_counts_from_when_the_own_value_stays_beyond():

@@ -29,9 +29,16 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   box on student bytes, its record read back) and :mod:`~.host.underlay` (the simulators' workspace,
   built once, under every student's package).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima),
-  :mod:`~.score.rubric` (points, evidence and status from the measurements), :mod:`~.score.safe_text`
+  :mod:`~.score.rubric` (points, evidence and status from the measurements: :func:`~.score.rubric.score`)
+  and its parts: :mod:`~.score.tolerances` (each tolerance, one constant), :mod:`~.score.measured` (the
+  session's runs and probes as the items read them), :mod:`~.score.node_items` (runs, Q10-Q12),
+  :mod:`~.score.flight` (the flight's calls, legs and lags; the WARNING's window),
+  :mod:`~.score.timing_items` (Q13, Q14a, Q14b), :mod:`~.score.verdict` (the status, the doubts);
+  :mod:`~.score.fields` (a record read by attributes, following its schema), :mod:`~.score.safe_text`
   (student-derived text without control characters, for every record and output), :mod:`~.score.records`
-  (the typed records that cross the boundary, with their schemas), :mod:`~.score.identity` (who a
+  (the typed records that cross the boundary, with their schemas), :mod:`~.score.kept` (what a grading
+  keeps, as records: its measurements and its grade, versioned), :mod:`~.score.schema` (a schema, its
+  check, the base of every record), :mod:`~.score.identity` (who a
   submission is: Moodle's participant number and folder, the student's name) and :mod:`~.score.boxenv`
   (the paths and the environment a box's processes see).
 - ``publish/`` -- what the teacher reads, from records only: :mod:`~.publish.report` (grade.json,

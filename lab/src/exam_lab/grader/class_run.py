@@ -7,7 +7,6 @@ import json
 import os
 import re
 import shutil
-import traceback
 
 from exam_lab.grader import runner
 from exam_lab.grader.boxed import archives, classlist, similarity
@@ -158,7 +157,7 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
                                        on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
     except Exception as err:  # anything: this student's row says so, the class goes on
         record = grades.could_not_grade(name, sheet, '%r' % err,
-                                        ['grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')])
+                                        [grades.bug_note()])
         moodle_name = os.path.basename(os.path.abspath(folder).rstrip('/'))
         record.update(participant=identity.participant_number(moodle_name), folder=moodle_name)  # who, even so
         try:
@@ -173,15 +172,11 @@ def _refused_at_intake(name, folder, out_dir, sheet, why):
     folder_name = os.path.basename(folder)
     measured = {'student': name, 'sheet': sheet or 'altitude', 'static': {}, 'notes': [], 'fixes': [],
                 'comments': None, 'isolate': None, 'how_run': None,
-                'session': grades.no_session('refused', 'submission refused: %s' % why, refused=True),
+                'session': grades.no_session(records.Outcome.REFUSED, 'submission refused: %s' % why, refused=True),
                 'extra': {'participant': identity.participant_number(folder_name), 'folder': folder_name,
                           'documents': [], 'seconds': 0.0}}
     os.makedirs(out_dir, exist_ok=True)
-    with open(os.path.join(out_dir, records.MEASUREMENTS), 'w') as f:
-        json.dump(measured, f, indent=1, sort_keys=True)
-    record = grades.score(measured)
-    report.write_grade(out_dir, record)
-    return record
+    return grades.keep_and_score(out_dir, measured)
 
 
 def class_similarity(klass, out, records_):

@@ -30,7 +30,6 @@ import random
 import shutil
 import sys
 import time
-import traceback
 
 from exam_lab.grader.boxed import archives
 from exam_lab.grader.host import bwrap, egress, limits, sandbox, staging
@@ -38,8 +37,9 @@ from exam_lab.grader.host.boxed_run import INSPECT_BOUNDS, Boxed, InspectionFail
 from exam_lab.grader.host.bwrap import can_isolate
 from exam_lab.grader.host.session import budget_sentence
 from exam_lab.grader.host.underlay import box_binds, default_underlay, ensure_underlay, package_path
-from exam_lab.grader.publish import grades, progress, report, teacher
+from exam_lab.grader.publish import grades, progress, teacher
 from exam_lab.grader.score import identity, records
+from exam_lab.grader.score.records import Outcome
 from exam_lab.grader.score.boxenv import BOX_WS
 from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, SHEETS, margin_of
 from exam_lab.harness.supervisor import Supervisor, end_pids, marked
@@ -101,22 +101,22 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                 chosen_sheet, static = found.sheet, found.static
                 job = plan_job(found)
                 if job is None:
-                    session = grades.no_session('no_node', 'no script of the package starts a ROS node', no_node=True)
+                    session = grades.no_session(Outcome.NO_NODE, 'no script of the package starts a ROS node', no_node=True)
                 elif deadline - time.monotonic() < START_TIMEOUT:
                     why = budget_sentence(STUDENT_BUDGET, 'nothing was run (%.0f s left after the inspection)'
                                           % (deadline - time.monotonic()))
-                    session = grades.no_session('not_run', why, budget_used=why)
+                    session = grades.no_session(Outcome.NOT_RUN, why, budget_used=why)
                 else:
                     how_run = teacher.how_run(box)
                     session = run_session(job, work, underlay, isolate, box, on_step,
                                           left=deadline - time.monotonic())
         except (archives.UnpackError, staging.UploadRefused) as err:
-            session = grades.no_session('refused', 'submission refused: %s' % err, refused=True)
+            session = grades.no_session(Outcome.REFUSED, 'submission refused: %s' % err, refused=True)
         except InspectionFailed as err:
-            session = grades.no_session('inspection_failed', 'the inspection of the upload failed: %s' % err)
+            session = grades.no_session(Outcome.INSPECTION_FAILED, 'the inspection of the upload failed: %s' % err)
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
-            session = grades.no_session('grader_failed', 'the grader failed on this submission: %r' % err)
-            notes.append('grader error, please report: %s' % traceback.format_exc().replace('\n', ' | '))
+            session = grades.no_session(Outcome.GRADER_FAILED, 'the grader failed on this submission: %r' % err)
+            notes.append(grades.bug_note())
         notes.extend(keep_logs(work, out_dir))
         measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session,
                     'notes': notes, 'fixes': fixes, 'comments': comments, 'isolate': isolate, 'how_run': how_run,
@@ -212,14 +212,14 @@ def session_outcome(log_dir, status, output, left, survivors):
             result = egress.read_record(os.path.join(log_dir, records.SessionRecord.FILE), records.SessionRecord,
                                         records.SessionRecord.MAX_BYTES).value
         except records.RecordError as err:
-            return grades.no_session('session_failed', 'the session\'s record was refused: %s' % err,
+            return grades.no_session(Outcome.SESSION_FAILED, 'the session\'s record was refused: %s' % err,
                                      survivors=survivors)
         result['survivors'] = result.get('survivors', 0) + survivors
         return result
     if status is None:
         why = budget_sentence(STUDENT_BUDGET, 'the session was killed after %.0f s' % (left + SESSION_KILL_S))
-        return grades.no_session('session_killed', why, budget_used=why, survivors=survivors)
-    return grades.no_session('session_failed', 'the session failed (exit %s): %s' % (status, session_tail(output)),
+        return grades.no_session(Outcome.SESSION_KILLED, why, budget_used=why, survivors=survivors)
+    return grades.no_session(Outcome.SESSION_FAILED, 'the session failed (exit %s): %s' % (status, session_tail(output)),
                              survivors=survivors)
 
 
@@ -236,10 +236,6 @@ def keep_logs(work, out_dir):
 
 
 def publish(out_dir, measured):
-    """Keep what a grading measured (:data:`~exam_lab.grader.score.records.MEASUREMENTS`, what a rescore
-    reads), score it, write grade.json and grade.md; return the grade record."""
-    with open(os.path.join(out_dir, records.MEASUREMENTS), 'w') as f:
-        json.dump(measured, f, indent=1, sort_keys=True)
-    record = grades.score(measured)
-    report.write_grade(out_dir, record)
-    return record
+    """Keep what a grading measured (a :class:`~exam_lab.grader.score.kept.MeasurementsRecord`, what a
+    rescore reads), score it, write grade.json and grade.md; return the grade record."""
+    return grades.keep_and_score(out_dir, measured)

@@ -41,7 +41,7 @@ import time
 from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
 from exam_lab.grader.host.egress import read_capped, read_record
 from exam_lab.grader.host.sandbox import Box
-from exam_lab.grader.score.records import MAX_ENDED, MAX_LOG_TEXT, ProbeRecord, RecordError, SessionRecord
+from exam_lab.grader.score.records import MAX_ENDED, MAX_LOG_TEXT, Outcome, ProbeRecord, RecordError, SessionRecord
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
@@ -375,7 +375,7 @@ def refuse(record, problem):
 def session(job):
     """Check, build and run one submission (the module's docstring); returns the value of its
     :class:`~exam_lab.grader.score.records.SessionRecord`."""
-    result = {'outcome': 'ran', 'build': None, 'runs': [], 'survivors': 0}
+    result = {'outcome': Outcome.RAN, 'build': None, 'runs': [], 'survivors': 0}
     box = Box.attached(job['box'])
     # The judge keeps the grader's environment, with a HOME and ROS folders of its own the box cannot
     # see; its folder is its own (0700), where it writes as its uid.
@@ -396,7 +396,7 @@ def session(job):
         if by_budget and (result['launch_check'] or {}).get('status', 0) is None:
             result['budget_used'] = result['error'] = budget.spend(
                 'roslaunch\'s check of the launch file was stopped after %.0f s' % limit)
-            result['outcome'] = 'check_stopped'
+            result['outcome'] = Outcome.CHECK_STOPPED
             return result
         limit, by_budget = budget.limit(job['build_timeout'], STEP_STOP_S)
         status, _, seconds = sup.run(
@@ -412,7 +412,7 @@ def session(job):
                 if by_budget else 'catkin_make did not finish within the build\'s time limit (%.0f s)' % limit
         if status != 0:
             result['budget_used'] = budget.used
-            result['outcome'] = 'build_stopped' if status is None else 'build_failed'
+            result['outcome'] = Outcome.BUILD_STOPPED if status is None else Outcome.BUILD_FAILED
             return result
         for run in job['runs']:
             if run['tag'] == 'threshold':

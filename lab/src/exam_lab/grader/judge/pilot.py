@@ -1,8 +1,8 @@
-"""The probe's pilot, what it flies: the drone's inputs set (:class:`Inputs`), question 11's check points and the
-calibration that puts the node's own value where each leg needs it (:class:`Calibration`), and the
-legs themselves (:class:`Flight`), every leg held from the node's own first value on its side. The rules
-each leg keeps (holds, calls owed, checks) are :mod:`exam_lab.grader.judge.legs`'s; this module only
-flies them, on the wall clock.
+"""The probe's pilot, what it flies: the drone's inputs set (:class:`Inputs`), question 11's check
+points and the calibration that puts the node's own value where each leg needs it (:class:`Calibration`),
+and the legs themselves (:class:`Flight`), every leg held from the node's own first value on its side.
+The rules each leg keeps (holds, calls owed, checks) are :mod:`exam_lab.grader.judge.legs`'s; this
+module only flies them, on the wall clock.
 """
 import math
 import time

@@ -15,7 +15,8 @@ import json
 import os
 
 from exam_lab.grader.publish import feedback, flightplot, gradescope, hand, moodle, page, report
-from exam_lab.grader.score import safe_text
+from exam_lab.grader.score import kept, safe_text
+from exam_lab.grader.score.records import RecordError
 
 
 def _grade_md(record):
@@ -28,6 +29,22 @@ def _failure(err):
     """One line for the teacher: what went wrong, capped (a message may quote a student's bytes)."""
     why = safe_text.one_line('%s: %s' % (type(err).__name__, err))
     return why if len(why) <= 300 else why[:297] + '...'
+
+
+def _grade_records(records):
+    """``(records, refused)``: each grade read through its type (a
+    :class:`~exam_lab.grader.score.kept.GradeRecord`: checked, its text made safe; what grade_record
+    and a rescore made is one already, and the outputs take it as it is, escaping only for their own
+    format). One that is not (a grader's bug) is shown all the same, its text cleaned here, and
+    ``refused`` (by the record's id) says why, for its section."""
+    made, refused = [], {}
+    for record in records:
+        try:
+            made.append(kept.GradeRecord.make(record).value)
+        except RecordError as err:
+            made.append(safe_text.cleaned(record))
+            refused[id(made[-1])] = ['its grade is not a grade record (a grader bug, please report): %s' % _failure(err)]
+    return made, refused
 
 
 def _student(out, record, single):
@@ -65,10 +82,11 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
     :param title: the class's name (:func:`moodle.class_name`); the output folder's name when None.
     :param show: what the students' feedback pages show (:func:`feedback.write`); None: lab/check_visibility.ini.
     """
-    records = safe_text.cleaned(records)  # as grade_record made them; a record read back is made so again
     lines, notes, entries = [], [], {}
+    records, refused = _grade_records(records)
     for record in records:
         entry = entries[record['student']] = _student(out, record, single)
+        entry['problems'][:0] = refused.get(id(record), [])
         lines += ['%s: %s' % (record['student'], problem) for problem in entry['problems']]
     try:
         added = hand.write(os.path.join(out, hand.FILE), records)
@@ -104,12 +122,12 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         else:
             lines.append('similarity: %d pair(s) flagged of %d student(s) (%s)'
                          % (len(pairs), similar.get('students', 0), os.path.join(out, 'index.html#similarity')))
-    kept = os.path.join(out, 'page.json')  # the class's name, for a page made again (make rescore)
+    named = os.path.join(out, 'page.json')  # the class's name, for a page made again (make rescore)
     if title:
-        with open(kept, 'w') as f:
+        with open(named, 'w') as f:
             json.dump({'title': title}, f)
-    elif os.path.isfile(kept):
-        with open(kept) as f:
+    elif os.path.isfile(named):
+        with open(named) as f:
             title = json.load(f).get('title')
     title = 'Exam grades: %s' % (records[0]['student'] if single and records else title or os.path.basename(out))
     try:

@@ -5,12 +5,12 @@ Drawn from the probe's results as the grading kept them (:func:`load_runs`: the 
 the student's measurements, never a file of the judge's or a box's read back) with matplotlib's Agg
 backend (no display needed); times are seconds from the probe's start.
 """
-import json
 import math
 import os
 
+from exam_lab.grader.score.kept import MeasurementsRecord
 from exam_lab.grader.score.records import MEASUREMENTS
-from exam_lab.grader.score.rubric import calls
+from exam_lab.grader.score.flight import calls
 from exam_lab.grader.score.safe_text import one_line
 
 #: Legs of each run, in order, and the side of the threshold each is flown on.
@@ -31,17 +31,16 @@ LIMIT = 1e6
 def load_runs(folder):
     """``[(tag, probe result)]`` of the runs whose probe gave a result, a result refused for its times or
     its master too (``refused_probe``), from the measurements the grading kept in ``folder``
-    (:data:`~exam_lab.grader.score.records.MEASUREMENTS`, the grader's own file): their session is the
-    :class:`~exam_lab.grader.score.records.SessionRecord` made when the student was graded, its text
-    made safe there. ``[]`` without measurements. Drawn as they are: a file edited by hand only costs
-    what :class:`Clamp` leaves out."""
+    (:class:`~exam_lab.grader.score.kept.MeasurementsRecord`, the grader's own file, read as a record:
+    capped, checked): their session is the :class:`~exam_lab.grader.score.records.SessionRecord` made
+    when the student was graded, its text made safe there. ``[]`` without measurements; raises
+    :class:`~exam_lab.grader.score.records.RecordError` (naming the file and the field) when they are
+    not a record. Drawn as they are: a value out of range only costs what :class:`Clamp` leaves out."""
     path = os.path.join(folder, MEASUREMENTS)
     if not os.path.isfile(path):
         return []
-    with open(path) as f:
-        session = json.load(f).get('session') or {}
-    runs = [(run.get('tag'), run.get('probe') or run.get('refused_probe')) for run in session.get('runs') or []]
-    return [(tag, probe) for tag, probe in runs if isinstance(probe, dict)]
+    runs = [(run['tag'], run['probe'] or run.get('refused_probe')) for run in MeasurementsRecord.read(path).session['runs']]
+    return [(tag, probe) for tag, probe in runs if probe is not None]
 
 
 def legs(schedule):

@@ -3,17 +3,20 @@
 record of a grading whose session did not run (:func:`no_session`); the record of a submission that
 could not be graded; and the rescore of a run's OUT with today's rubric.
 """
-import json
 import os
+import traceback
 
 from exam_lab.grader.publish import provenance, report, teacher
-from exam_lab.grader.score import records, rubric
+from exam_lab.grader.score import kept, records, rubric
 
 
 def score(measured, how='run'):
-    """The grade record of one submission from what its run measured
-    (:data:`~exam_lab.grader.score.records.MEASUREMENTS`): the one place the rubric is applied, by a run
-    and by a rescore alike. ``how`` goes into its provenance."""
+    """The grade record of one submission from what its run measured (a
+    :class:`~exam_lab.grader.score.kept.MeasurementsRecord`, or the value of one: checked here): the
+    one place the rubric is applied, by a run and by a rescore alike. ``how`` goes into its provenance."""
+    if not isinstance(measured, kept.MeasurementsRecord):
+        measured = kept.MeasurementsRecord.make(measured)
+    measured = measured.value
     static, session = measured['static'], measured['session']
     run_value = rubric.threshold_run_value(static, session)
     extra = dict(measured['extra'], doubts=rubric.doubts(static, session), provenance=provenance.stamp(how),
@@ -22,6 +25,21 @@ def score(measured, how='run'):
                                teacher.hints(static, session, measured['notes'] + measured['fixes'],
                                              measured['comments'], measured['isolate'], measured['how_run']),
                                extra, rubric.status(static, session, measured['fixes']))
+
+
+def keep_and_score(out_dir, measured):
+    """Keep what a grading measured in ``out_dir`` (``measured``, the value of a
+    :class:`~exam_lab.grader.score.kept.MeasurementsRecord` of today's version, checked first: a
+    grader's bug shows here, not at the rescore), score it (:func:`score`), write grade.json and
+    grade.md; return the grade record."""
+    record = kept.MeasurementsRecord.make(dict(measured, version=kept.VERSION))
+    partial = os.path.join(out_dir, records.MEASUREMENTS + '.part')
+    with open(partial, 'w') as f:
+        f.write(record.to_json())
+    os.rename(partial, os.path.join(out_dir, records.MEASUREMENTS))
+    grade = score(record)
+    report.write_grade(out_dir, grade)
+    return grade
 
 
 def graded_folders(out):
@@ -33,23 +51,39 @@ def graded_folders(out):
                   if os.path.isfile(os.path.join(out, name, records.MEASUREMENTS)))
 
 
+#: The words of a line of :func:`rescore` for a student it did not rescore.
+NOT_RESCORED = 'not rescored'
+
+
 def rescore(out):
     """Apply today's rubric to the measurements a run kept in ``out``: no ROS, no box, seconds for a
     class. Each grade.json/grade.md is written again, with the points it had (``previous``); a class's
-    grades.csv too.
+    grades.csv too. Both files are read as records (:mod:`exam_lab.grader.score.kept`: capped, checked,
+    an older version brought to today's): a student whose measurements.json or grade.json does not
+    match is not rescored (its files stay as they were) and the others are.
 
     :returns: ``(records, changes)``; ``changes``: one line per student whose points or status moved,
-        saying which items moved and from what to what.
+        saying which items moved and from what to what, and one per student not rescored
+        (``<student>: not rescored ...: <file>.<field>: why``). A student not rescored keeps its
+        grade in ``records`` (and grades.csv) when its grade.json could be read.
     """
     graded, changes = [], []
     folders = graded_folders(out)
     for folder in folders:
-        with open(os.path.join(folder, records.MEASUREMENTS)) as f:
-            measured = json.load(f)
-        old = {}
-        if os.path.isfile(os.path.join(folder, 'grade.json')):
-            with open(os.path.join(folder, 'grade.json')) as f:
-                old = json.load(f)
+        name = os.path.basename(folder.rstrip('/'))
+        try:
+            old = kept.GradeRecord.read(os.path.join(folder, 'grade.json')).value \
+                if os.path.isfile(os.path.join(folder, 'grade.json')) else {}
+        except records.RecordError as err:
+            changes.append('%s: %s (its grade.json kept as it is, not in grades.csv): %s' % (name, NOT_RESCORED, err))
+            continue
+        try:
+            measured = kept.MeasurementsRecord.read(os.path.join(folder, records.MEASUREMENTS))
+        except records.RecordError as err:
+            changes.append('%s: %s (its grade kept as it was): %s' % (name, NOT_RESCORED, err))
+            if old:
+                graded.append(old)
+            continue
         record = score(measured, how='rescore')
         before = {i['id']: i['points'] for i in old.get('items', [])}
         record['previous'] = {'total': old.get('total'), 'status': old.get('status'), 'items': before,
@@ -70,8 +104,8 @@ def rescore(out):
 
 def no_session(outcome, error, **more):
     """The session's record (:class:`~exam_lab.grader.score.records.SessionRecord`'s value) of a grading
-    whose session did not run or failed: its ``outcome`` (one of
-    :data:`~exam_lab.grader.score.records.OUTCOMES`), ``error`` (why, for the teacher) and ``more``
+    whose session did not run or failed: its ``outcome`` (an
+    :class:`~exam_lab.grader.score.records.Outcome`), ``error`` (why, for the teacher) and ``more``
     (``refused``, ``no_node``, ``budget_used``, ``survivors``)."""
     return records.SessionRecord.make(dict(more, outcome=outcome, build=None, runs=[],
                                            error=error[:records.MAX_LOG_TEXT])).value
@@ -80,8 +114,13 @@ def no_session(outcome, error, **more):
 def could_not_grade(student, sheet, why, notes=()):
     """The record of a submission the grader could not grade: every item 0, and why."""
     sheet = sheet or 'altitude'
-    session = no_session('grader_failed', 'could not grade: %s' % why)
+    session = no_session(records.Outcome.GRADER_FAILED, 'could not grade: %s' % why)
     return report.grade_record(student, sheet, rubric.score(sheet, {}, session),
                                list(notes) + [session['error']], {'seconds': 0.0, 'provenance': provenance.stamp()},
                                rubric.status({}, session))
 
+
+def bug_note():
+    """The teacher's note of a grader bug being handled: its traceback on one line, its last
+    MAX_LOG_TEXT characters (a deep recursion's would outgrow any record)."""
+    return 'grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')[-records.MAX_LOG_TEXT:]

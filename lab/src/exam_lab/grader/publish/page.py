@@ -151,7 +151,8 @@ def _status_cell(record):
 def render(records, title, entries, pairs=None, notes=None):
     """The page's HTML.
 
-    :param records: the grade records (grade.json), in the table's order.
+    :param records: the grade records (grade.json, as :func:`~exam_lab.grader.publish.report.grade_record`
+        or the desk made them: their text clean), in the table's order.
     :param entries: per student: ``{"plot": relative path of the PNG or None, "grade_md": text,
         "documents": [{"name", "pages"}], "folder": relative path of its results, "problems": what the
         desk could not make for it, "plot_failed": its plot was not drawn for one of those}``.
@@ -159,11 +160,11 @@ def render(records, title, entries, pairs=None, notes=None):
         None when it did not run.
     :param notes: lines for the top of the page (the worksheet's summary, the similarity's limits).
 
-    Every text is cleaned of control characters first (student-derived); a student whose section
-    cannot be made gets one that says why, and the others theirs.
+    Every other text is cleaned of control characters first (student-derived: the desk's lines, the
+    similarity's pairs); a student whose section cannot be made gets one that says why, and the
+    others theirs.
     """
-    records, entries, pairs, notes = (safe_text.cleaned(records), safe_text.cleaned(entries),
-                                      safe_text.cleaned(pairs), safe_text.cleaned(notes))
+    entries, pairs, notes = safe_text.cleaned(entries), safe_text.cleaned(pairs), safe_text.cleaned(notes)
     title = safe_text.clean(title)
     parts = ['<!DOCTYPE html>', '<html lang="en"><head><meta charset="utf-8">',
              '<title>%s</title>' % _e(title), '<style>%s</style></head><body>' % _STYLE,

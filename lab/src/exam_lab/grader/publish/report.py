@@ -1,16 +1,17 @@
 """The grader's outputs: grade.json, grade.md (for the teacher and the student), grades.csv, and the
 table printed on the terminal. No rospy here.
 
-A record's text is student-derived (evidence, log lines, names): :func:`grade_record` cleans it where it
-is made, and every output cleans what it writes again (:mod:`exam_lab.grader.score.safe_text`), since a
-record may also be made elsewhere (read back from grade.json, a test, a later change of the runner).
+A record's text is student-derived (evidence, log lines, names): :func:`grade_record` makes it a
+:class:`~exam_lab.grader.score.kept.GradeRecord`, which cleans it (:mod:`exam_lab.grader.score.safe_text`)
+where it is made; grade.json is written and read back through that type too, so grade.md is made of
+clean text as it is. A line for the terminal or a cell of grades.csv is put on one line
+(:func:`~exam_lab.grader.score.safe_text.one_line`), which cleans it on the way for any caller.
 """
 import csv
-import json
 import os
 
 from exam_lab.grader.publish import cells
-from exam_lab.grader.score import safe_text
+from exam_lab.grader.score import kept, safe_text
 from exam_lab.grader.score.sheets import ITEMS, SHEETS
 
 #: What no machine scores, with the rubric's points (sheet 000's notes).
@@ -28,12 +29,13 @@ def points_text(x):
 
 
 def grade_record(student, sheet, items, for_the_teacher, extra=None, status=('graded', '')):
-    """The content of grade.json; ``status`` is ``(status, reason)`` (see :func:`rubric.status`)."""
-    record = {'student': student, 'sheet': sheet, 'total': sum(i['points'] for i in items),
+    """The content of grade.json (a :class:`~exam_lab.grader.score.kept.GradeRecord`'s value: checked,
+    its text made safe); ``status`` is ``(status, reason)`` (see :func:`rubric.status`)."""
+    record = {'version': kept.VERSION, 'student': student, 'sheet': sheet, 'total': sum(i['points'] for i in items),
               'max': sum(i['max'] for i in items), 'items': items, 'for_the_teacher': for_the_teacher,
               'status': status[0], 'status_reason': status[1]}
     record.update(extra or {})
-    return safe_text.cleaned(record)
+    return kept.GradeRecord.make(record).value
 
 
 def _status_line(record):
@@ -43,8 +45,8 @@ def _status_line(record):
 
 
 def markdown(record):
-    """grade.md: the score table, each lost point's reason, the hints for the teacher."""
-    record = safe_text.cleaned(record)
+    """grade.md: the score table, each lost point's reason, the hints for the teacher, of a grade
+    record as :func:`grade_record` made it (its text clean)."""
     sheet = SHEETS.get(record['sheet'])
     title = sheet and 'sheet %s (%s, %s)' % (sheet.seed, sheet.name, sheet.drone_pkg) or 'no sheet'
     if record.get('status') == 'not graded':
@@ -88,11 +90,11 @@ def markdown(record):
 def write_grade(out_dir, record):
     """Write ``grade.json`` and ``grade.md`` into ``out_dir``."""
     os.makedirs(out_dir, exist_ok=True)
-    with open(os.path.join(out_dir, 'grade.json'), 'w') as f:
-        json.dump(safe_text.cleaned(record), f, indent=1, sort_keys=True)
-        f.write('\n')
+    record = kept.GradeRecord.make(record)
+    with open(os.path.join(out_dir, kept.GradeRecord.FILE), 'w') as f:
+        f.write(record.to_json() + '\n')
     with open(os.path.join(out_dir, 'grade.md'), 'w') as f:
-        f.write(markdown(record))
+        f.write(markdown(record.value))
 
 
 def write_csv(path, records):
@@ -137,5 +139,5 @@ def needing_the_teacher(records):
 def evidence_lines(record):
     """Each item with points lost, and why (printed under the table for one submission)."""
     return [safe_text.one_line('%s %s/%s: %s' % (e['id'], _points(e['points']), _points(e['max']),
-                                                 safe_text.clean(e['evidence']).split('\n', 1)[0]))
+                                                 e['evidence'].split('\n', 1)[0]))
             for e in record['items'] if e['points'] < e['max']]

@@ -6,7 +6,7 @@ import pwd
 import re
 
 from exam_lab.grader.publish import report
-from exam_lab.grader.score import rubric
+from exam_lab.grader.score import measured
 
 #: Log lines worth the teacher's eye: warnings, errors, tracebacks.
 _ODD = re.compile(r'\[(WARN|ERROR|FATAL)\]|Traceback|Error\b|Exception\b')
@@ -22,32 +22,34 @@ def hints(static, session, notes, comments, isolate, how_run=None):
         out.append('comments (not scored): %d comment lines for %d lines of code (%.0f %%) in %s'
                    % (comments['comments'], comments['code'], 100.0 * comments['comments'] / max(comments['code'], 1),
                       ', '.join(comments['files'])))
-    probe = rubric.main_probe(session)
+    static, session = measured.static_of(static), measured.session_of(session)
+    probe = measured.main_probe(session)
     if probe:
-        for node, info in sorted(probe.get('graph', {}).items()):
+        for node, info in sorted((probe.graph or {}).items()):
             out.append('node %s: publishes %s; subscribes %s; serves %s' % (
-                node, ', '.join('%s (%s)' % tuple(p) for p in info['publishes'] if p[0] != '/rosout') or 'nothing',
-                ', '.join('%s (%s)' % tuple(s) for s in info['subscribes']) or 'nothing',
-                ', '.join(info['services']) or 'nothing'))
-        calibration = probe.get('calibration') or {}
-        if calibration.get('by') == 'oracle' and calibration.get('reason'):
-            out.append('Q13/Q14 flown by the oracle\'s values: %s' % calibration['reason'])
-    for run in (session or {}).get('runs', []):
-        odd = [l for l in run.get('launch', {}).get('tail', '').splitlines() if _ODD.search(l)]
+                node, ', '.join('%s (%s)' % tuple(p) for p in info.publishes if p[0] != '/rosout') or 'nothing',
+                ', '.join('%s (%s)' % tuple(s) for s in info.subscribes) or 'nothing',
+                ', '.join(info.services) or 'nothing'))
+        calibration = probe.calibration
+        if calibration and calibration.by == 'oracle' and calibration.reason:
+            out.append('Q13/Q14 flown by the oracle\'s values: %s' % calibration.reason)
+    for run in session.runs or ():
+        tail = measured.otherwise(run.launch.tail if run.launch else None, '')
+        odd = [l for l in tail.splitlines() if _ODD.search(l)]
         if odd:
-            out.append('%s run, odd lines in the log: %s' % (run['tag'], ' | '.join(odd[:4])))
-    if static and static.get('launch') and static['launch']['file'] and len(static.get('launch_files', [])) > 1:
-        out.append('launch file graded: %s (of %s)' % (static['launch']['file'], ', '.join(static['launch_files'])))
-    if (session or {}).get('build') is not None:  # something of the student's ran
+            out.append('%s run, odd lines in the log: %s' % (run.tag, ' | '.join(odd[:4])))
+    if static and static.launch and static.launch.file and len(static.launch_files or ()) > 1:
+        out.append('launch file graded: %s (of %s)' % (static.launch.file, ', '.join(static.launch_files)))
+    if session.build is not None:  # something of the student's ran
         out.append('ran in a network namespace with only loopback' if isolate else
                    'ran WITHOUT network isolation (no network namespace could be made): the student code could '
                    'reach the network')
         out.append(how_run or 'not run')
-    if (session or {}).get('budget_used'):
-        out.append(session['budget_used'])
-    if (session or {}).get('survivors'):
+    if session.budget_used:
+        out.append(session.budget_used)
+    if session.survivors:
         out.append('%d processes of the student were still alive after its steps ended: killed'
-                   % session['survivors'])
+                   % session.survivors)
     out.append('not scored by the machine: %s' % report.NOT_SCORED)
     return out
 

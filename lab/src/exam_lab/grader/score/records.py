@@ -3,242 +3,23 @@
 A box (:mod:`exam_lab.grader.boxed.inspect`, :mod:`~exam_lab.grader.boxed.intake`, the similarity
 check) writes one JSON object; root reads it only through :func:`exam_lab.grader.host.egress.read_record`,
 which gives the bytes to a record's ``from_json``. That checks every field against the record's
-schema (types, ranges, string lengths, list lengths, no unknown keys) and raises :class:`RecordError`
-on anything unexpected: a record of an unexpected shape is a crash of that box, never data to use.
-
-Schemas are plain values: a type (``str``, ``int``, ``float``, ``bool``), :class:`Text` (a string of at
-most ``n`` characters), :class:`Number` (finite, within bounds), ``[schema]`` (a list of at most
-:data:`MAX_ITEMS`; :class:`Items` for another limit), ``{key: schema}`` (an object; :class:`Optional` keys may be missing), :class:`Maybe`
-(None or the schema), :class:`OneOf` (one of fixed values), :class:`Map` (an object whose keys are data),
-:class:`Row` (a list of fixed length, each item its own schema), a tuple of schemas (any one of them).
+schema (types, ranges, string lengths, list lengths, no unknown keys; :mod:`exam_lab.grader.score.schema`)
+and raises :class:`RecordError` on anything unexpected: a record of an unexpected shape is a crash of
+that box, never data to use. What the grader keeps of a grading (its measurements, its grade) are
+records too: :mod:`exam_lab.grader.score.kept`.
 """
-import json
-import math
-import os
+import enum
 import re
 
-from exam_lab.grader.score.safe_text import cleaned
+# The schema machinery, importable from here as well (records.check, records.Text...).
+from exam_lab.grader.score.schema import (  # noqa: F401
+    MAX_ITEMS, MAX_TEXT, Items, Map, Maybe, Number, OneOf, Optional, Record, RecordError, Row, Text, check, parse,
+    relative, shown, write)
 from exam_lab.grader.score.sheets import SHEETS
 
-#: What a grading measured, kept beside grade.json by the runner (its session a :class:`SessionRecord`):
-#: a rescore scores it again, the flight plot draws from it.
+#: What a grading measured, kept beside grade.json by the runner (:class:`~exam_lab.grader.score.kept.MeasurementsRecord`,
+#: its session a :class:`SessionRecord`): a rescore scores it again, the flight plot draws from it.
 MEASUREMENTS = 'measurements.json'
-#: Longest string of a record (a note, a path) and most items of one list.
-MAX_TEXT = 2000
-MAX_ITEMS = 500
-
-
-class RecordError(ValueError):
-    """A box's record that does not match its schema: the message says where and why."""
-
-
-class Text(object):
-    def __init__(self, limit=MAX_TEXT):
-        self.limit = limit
-
-
-class Number(object):
-    """A number within ``[low, high]``; with ``finite=False`` any float, NaN and infinities too (a value a
-    student's node published, which the rubric judges)."""
-
-    def __init__(self, low=-1e12, high=1e12, integer=False, finite=True):
-        self.low, self.high, self.integer, self.finite = low, high, integer, finite
-
-
-class Items(object):
-    """A list of at most ``limit`` items, each matching ``schema``."""
-
-    def __init__(self, schema, limit=MAX_ITEMS):
-        self.schema, self.limit = schema, limit
-
-
-class Map(object):
-    """An object whose keys are data (node or topic names): at most ``limit`` keys matching ``key``,
-    each value matching ``schema``."""
-
-    def __init__(self, key, schema, limit=MAX_ITEMS):
-        self.key, self.schema, self.limit = key, schema, limit
-
-
-class Row(object):
-    """A list of exactly ``len(schemas)`` items, each matching its own schema (``[t, request]``)."""
-
-    def __init__(self, *schemas):
-        self.schemas = schemas
-
-
-class Maybe(object):
-    def __init__(self, schema):
-        self.schema = schema
-
-
-class Optional(object):
-    """A key of an object that may be missing."""
-
-    def __init__(self, schema):
-        self.schema = schema
-
-
-class OneOf(object):
-    def __init__(self, *values):
-        self.values = values
-
-
-def check(value, schema, where='record'):
-    """``value`` when it matches ``schema``; raises :class:`RecordError` naming ``where`` otherwise."""
-    if isinstance(schema, (Maybe, Optional)):
-        return None if value is None and isinstance(schema, Maybe) else check(value, schema.schema, where)
-    if isinstance(schema, OneOf):
-        if isinstance(value, bool) or value not in schema.values:
-            raise RecordError('%s: %s is not one of %s' % (where, _shown(value), ', '.join(map(str, schema.values))))
-        return value
-    if isinstance(schema, tuple):  # the first that matches
-        for inner in schema:
-            try:
-                return check(value, inner, where)
-            except RecordError:
-                continue
-        raise RecordError('%s: %s is of none of the expected types' % (where, _shown(value)))
-    if schema is str:
-        schema = Text()
-    if isinstance(schema, Text):
-        if not isinstance(value, str):
-            raise RecordError('%s: a string expected, got %s' % (where, type(value).__name__))
-        if len(value) > schema.limit:
-            raise RecordError('%s: a string of %d characters (at most %d)' % (where, len(value), schema.limit))
-        return value
-    if schema is bool:
-        if not isinstance(value, bool):
-            raise RecordError('%s: true or false expected, got %s' % (where, type(value).__name__))
-        return value
-    if schema in (int, float):
-        schema = Number(integer=schema is int)
-    if isinstance(schema, Number):
-        wanted = int if schema.integer else (int, float)
-        if isinstance(value, bool) or not isinstance(value, wanted):
-            raise RecordError('%s: %s expected, got %s' % (where, 'an integer' if schema.integer else 'a number',
-                                                           type(value).__name__))
-        if schema.finite and not (math.isfinite(value) and schema.low <= value <= schema.high):
-            raise RecordError('%s: %s is outside [%g, %g]' % (where, _shown(value), schema.low, schema.high))
-        return value
-    if isinstance(schema, list):
-        schema = Items(schema[0])
-    if isinstance(schema, Items):
-        if not isinstance(value, list):
-            raise RecordError('%s: a list expected, got %s' % (where, type(value).__name__))
-        if len(value) > schema.limit:
-            raise RecordError('%s: %d %s (at most %d)' % (where, len(value), _noun(where), schema.limit))
-        return [check(item, schema.schema, '%s[%d]' % (where, index)) for index, item in enumerate(value)]
-    if isinstance(schema, Row):
-        if not isinstance(value, list) or len(value) != len(schema.schemas):
-            raise RecordError('%s: a list of %d items expected, got %s' % (where, len(schema.schemas), _shown(value)))
-        return [check(item, inner, '%s[%d]' % (where, index))
-                for index, (item, inner) in enumerate(zip(value, schema.schemas))]
-    if isinstance(schema, Map):
-        if not isinstance(value, dict):
-            raise RecordError('%s: an object expected, got %s' % (where, type(value).__name__))
-        if len(value) > schema.limit:
-            raise RecordError('%s: %d keys (at most %d)' % (where, len(value), schema.limit))
-        return {check(key, schema.key, '%s key' % where): check(inner, schema.schema, '%s[%s]' % (where, _shown(key)))
-                for key, inner in value.items()}
-    if isinstance(schema, dict):
-        if not isinstance(value, dict):
-            raise RecordError('%s: an object expected, got %s' % (where, type(value).__name__))
-        unknown = sorted(set(value) - set(schema))
-        if unknown:
-            raise RecordError('%s: unexpected key(s) %s' % (where, ', '.join(_shown(k) for k in unknown[:5])))
-        checked = {}
-        for key, inner in schema.items():
-            if key not in value:
-                if isinstance(inner, Optional):
-                    continue
-                raise RecordError('%s: %s is missing' % (where, key))
-            checked[key] = check(value[key], inner, '%s.%s' % (where, key))
-        return checked
-    raise TypeError('not a schema: %r' % (schema,))
-
-
-def _noun(where):
-    """What a list at ``where`` holds, for its cap's sentence: ``inspect.json.comments.files`` holds files."""
-    key = where.rsplit('.', 1)[-1]
-    return key.replace('_', ' ') if re.match(r'^[a-z_]+s$', key) else 'items'
-
-
-def _shown(value):
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + '...'
-
-
-def parse(raw, schema, what, constants=False):
-    """The JSON object in ``raw`` (bytes), checked against ``schema``; with ``constants``, NaN and
-    Infinity are numbers (Python's json writes them for a non-finite float)."""
-    try:
-        value = json.loads(raw.decode('utf-8'), parse_constant=None if constants else _no_constant)
-    except (UnicodeDecodeError, ValueError) as err:
-        raise RecordError('%s: not JSON: %s' % (what, err))
-    return check(value, schema, what)
-
-
-def _no_constant(name):
-    raise ValueError('%s is not a number JSON allows' % name)
-
-
-def _relative(path, where):
-    """A path inside the workspace: relative, without '..' (root joins it to a folder of its own)."""
-    if path.startswith('/') or '\0' in path or '..' in path.split('/'):
-        raise RecordError('%s: %s is not a path inside the workspace' % (where, _shown(path)))
-    return path
-
-
-class Record(object):
-    """A record type: its file's name (``FILE``), its cap (``MAX_BYTES``), its ``SCHEMA``; a record's
-    attributes are the schema's keys (None when an optional one is missing), ``value`` the whole
-    checked object. With ``CLEAN``, every string of the record, keys too, is
-    :func:`~exam_lab.grader.score.safe_text.clean` once it matched its schema: the one place where
-    a student's text (node and topic names, log lines, a request) is made safe, whoever reads the
-    record later. ``NON_FINITE``: NaN and Infinity may be read from its JSON (measured values)."""
-    FILE = MAX_BYTES = SCHEMA = None
-    CLEAN = NON_FINITE = False
-
-    def __init__(self, value):
-        self.value = value
-        self.__dict__.update({key: value.get(key) for key in self.SCHEMA})
-
-    @classmethod
-    def from_json(cls, raw, max_bytes):
-        """The record in ``raw`` (bytes); raises :class:`RecordError` on anything unexpected."""
-        if len(raw) > max_bytes:
-            raise RecordError('%s: %d bytes (at most %d)' % (cls.FILE, len(raw), max_bytes))
-        return cls._made(parse(raw, cls.SCHEMA, cls.FILE, constants=cls.NON_FINITE))
-
-    @classmethod
-    def make(cls, value):
-        """The record of ``value`` (made by the grader itself from what it read): checked as one read
-        from a file is; raises :class:`RecordError`."""
-        return cls._made(check(value, cls.SCHEMA, cls.FILE))
-
-    @classmethod
-    def _made(cls, value):
-        record = cls(cleaned(value) if cls.CLEAN else value)
-        record.validate()
-        return record
-
-    def to_json(self):
-        """The record's JSON text: :meth:`from_json` of it gives the same record."""
-        return json.dumps(self.value, indent=1, sort_keys=True)
-
-    def validate(self):
-        """Checks across fields, beyond the schema's."""
-
-
-def write(folder, record_type, value):
-    """Write ``value`` as ``folder/<record_type.FILE>`` (checked first: a box's own bug shows there),
-    atomically: the reader finds the whole record or none."""
-    check(value, record_type.SCHEMA, record_type.FILE)
-    partial = os.path.join(folder, record_type.FILE + '.part')
-    with open(partial, 'w') as f:
-        json.dump(value, f, sort_keys=True)
-    os.rename(partial, os.path.join(folder, record_type.FILE))
 
 
 #: What the inspection read of the package for the rubric (``static`` of :func:`~exam_lab.grader.score.rubric.score`).
@@ -267,6 +48,10 @@ class InspectRecord(Record):
     """
     FILE = 'inspect.json'
     MAX_BYTES = 1 << 20
+    #: The student's text (notes and fixes quoting its files, the launch file's and the code's words,
+    #: the documents' names) made safe here; the launch files' paths are opened by the session and
+    #: the code's file names (``comments``) are kept exactly (the measurements keep them so).
+    CLEAN = ('refused', 'notes', 'fixes', 'static', 'facts')
     SCHEMA = {
         'uid': Number(0, 2 ** 32, integer=True),
         'refused': Maybe(str),
@@ -288,7 +73,7 @@ class InspectRecord(Record):
     def validate(self):
         for key in ('main_launch', 'threshold_launch', 'handed_in_launch'):
             if getattr(self, key) is not None:
-                _relative(getattr(self, key), 'inspect.json.%s' % key)
+                relative(getattr(self, key), 'inspect.json.%s' % key)
         if self.threshold_launch is not None and self.main_launch is None:
             raise RecordError('inspect.json: a threshold run without a main run')
         if self.threshold_launch is not None and self.threshold_run_value is None:
@@ -308,12 +93,12 @@ class IntakeRecord(Record):
     def validate(self):
         for index, student in enumerate(self.students):
             where = 'intake.json.students[%d]' % index
-            _relative(student['path'], where + '.path')
+            relative(student['path'], where + '.path')
             name = student['name']
             if name in ('', '.', '..') or name != name.strip(' .') or \
                     not all(c.isalnum() or c in ' -._' for c in name):
                 raise RecordError('%s.name: %s is not a student\'s name (a folder name of letters, digits, '
-                                  'space and -._)' % (where, _shown(name)))
+                                  'space and -._)' % (where, shown(name)))
 
 
 #: A share of code (0..1, a little more by rounding).
@@ -326,6 +111,8 @@ class SimilarityRecord(Record):
     detector; the page escapes nothing more), every pair's ``scores``, ``notes``; or ``error``."""
     FILE = 'similarity.json'
     MAX_BYTES = 32 << 20
+    #: Its file names and the code in its HTML are the students': made safe here (no markup is added).
+    CLEAN = True
     SCHEMA = {
         'error': Optional(Text(20000)), 'notes': [str],
         'pairs': Optional(Items({'a': Text(255), 'b': Text(255), 'score_a': _SHARE, 'score_b': _SHARE,
@@ -393,9 +180,10 @@ class ProbeRecord(Record):
         'output': Optional({'expected': _NAME, 'topic': Maybe(_NAME), 'type': Maybe(_NAME), 'candidates': [_NAME]}),
         'formula': Optional(Items({'inputs': Map(Text(100), _VALUE, 4), 'expected': _VALUE,
                                    'published': Maybe(_VALUE), 'samples': _COUNT}, 20)),
+        # A probe of before 2026-11-26 18:20 calibrated on lo and hi only: measurements kept then have no 'near'.
         'calibration': Optional(dict({'by': OneOf('own', 'oracle'), 'reason': Text(), 'fit': Maybe(Row(_VALUE, _VALUE))},
-                                     **{side: {'x': _VALUE, 'target': _VALUE, 'value': Maybe(_VALUE)}
-                                        for side in ('lo', 'hi', 'near')})),
+                                     **{side: schema({'x': _VALUE, 'target': _VALUE, 'value': Maybe(_VALUE)})
+                                        for side, schema in (('lo', dict), ('hi', dict), ('near', Optional))})),
         'schedule': Optional(Map(Text(50), _TIME, 20)),
         'legs': Optional(Maybe(Map(Text(50), LEG, 20))),
         'rate': Optional({'samples': _COUNT, 'hz': Maybe(Number()), 'max_gap': Maybe(Number()),
@@ -414,11 +202,33 @@ class ProbeRecord(Record):
     }
 
 
-#: How one grading ended (``outcome`` of :class:`SessionRecord`): the session's own ('ran': built,
-#: the runs tried; 'build_failed', 'build_stopped': by its limit or the budget; 'check_stopped':
-#: roslaunch's check stopped by the budget), and the runner's when no session ran or it failed.
-OUTCOMES = ('ran', 'build_failed', 'build_stopped', 'check_stopped',
-            'session_failed', 'session_killed', 'not_run', 'no_node', 'refused', 'inspection_failed', 'grader_failed')
+class Outcome(str, enum.Enum):
+    """How one grading ended (``outcome`` of :class:`SessionRecord`). A member is its string too: the
+    JSON holds ``"ran"``, and ``Outcome.RAN == 'ran'``, so a reader of the old strings reads it the same."""
+    #: The session's own: built, the runs tried.
+    RAN = 'ran'
+    #: The build failed; stopped by its time limit or the student's budget.
+    BUILD_FAILED = 'build_failed'
+    BUILD_STOPPED = 'build_stopped'
+    #: roslaunch's check of the launch file stopped by the budget.
+    CHECK_STOPPED = 'check_stopped'
+    #: The runner's, when no session ran or it failed: the session's process failed or its record was
+    #: refused; it was killed past the budget; the budget was spent before it; no script starts a node;
+    #: the upload refused; the inspection's box failed; the grader's own bug.
+    SESSION_FAILED = 'session_failed'
+    SESSION_KILLED = 'session_killed'
+    NOT_RUN = 'not_run'
+    NO_NODE = 'no_node'
+    REFUSED = 'refused'
+    INSPECTION_FAILED = 'inspection_failed'
+    GRADER_FAILED = 'grader_failed'
+
+    def __str__(self):  # '%s' and str() give the value, as format() does: the text the JSON holds
+        return self.value
+
+
+#: Every outcome (their strings, in the order above).
+OUTCOMES = tuple(Outcome)
 #: Most characters of a log excerpt (a build's or roslaunch's last lines) in the session's record.
 MAX_LOG_TEXT = 20000
 #: Most ended nodes roslaunch's output reports in one run (a node respawned in a loop).
@@ -441,14 +251,14 @@ _RUN = {
 class SessionRecord(Record):
     """How one grading's session went (:mod:`exam_lab.grader.host.session`, ``session.json``): roslaunch's
     check of the launch file, the build, each run (its probe's :class:`ProbeRecord` or why there is none,
-    roslaunch's words about the nodes), the processes left, the budget; ``outcome``, one of
-    :data:`OUTCOMES`. The runner makes one too when no session ran (``error``, ``refused``,
+    roslaunch's words about the nodes), the processes left, the budget; ``outcome``, an
+    :class:`Outcome` (a member, the record made). The runner makes one too when no session ran (``error``, ``refused``,
     ``no_node``): the measurements a rescore reads hold this record."""
     FILE = 'session.json'
     MAX_BYTES = 24 << 20
     CLEAN = NON_FINITE = True
     SCHEMA = {
-        'outcome': OneOf(*OUTCOMES),
+        'outcome': OneOf(*(o.value for o in Outcome)),
         'build': Maybe({'status': Maybe(Number(-1e6, 1e6, integer=True)), 'seconds': Number(0), 'tail': Text(MAX_LOG_TEXT),
                         'timeout': Number(0), 'stopped': Optional(Text())}),
         'runs': Items(_RUN, 2),
@@ -459,3 +269,6 @@ class SessionRecord(Record):
         'budget_used': Optional(Maybe(Text())), 'error': Optional(Text(MAX_LOG_TEXT)),
         'threshold_skipped': Optional(Text()), 'refused': Optional(bool), 'no_node': Optional(bool),
     }
+
+    def validate(self):
+        self.value['outcome'] = self.outcome = Outcome(self.outcome)

@@ -1,0 +1,114 @@
+"""What a grading measured, as the rubric reads it: the session's and the inspection's records through
+their views (:func:`~exam_lab.grader.score.fields.view`), the main and threshold runs' probes, whether
+the node ran, published and stayed up, the inputs rospy refused, and an item's record. Pure, no rospy.
+
+Every function here takes the records as they are kept (dicts, from ``measurements.json`` or a test)
+or as views, and reads views only.
+"""
+from exam_lab.grader.score import fields, records
+from exam_lab.grader.score.sheets import ITEMS
+
+
+def session_of(session):
+    """The view of a session's record (:class:`~exam_lab.grader.score.records.SessionRecord`); an
+    empty one for None (a session that did not run: every field None)."""
+    return fields.view(session or {}, records.SessionRecord.SCHEMA)
+
+
+def static_of(static):
+    """The view of what the inspection read (:data:`~exam_lab.grader.score.records.STATIC`), None
+    staying None."""
+    return fields.view(static, records.STATIC)
+
+
+def probe_of(probe):
+    """The view of a probe's result (:class:`~exam_lab.grader.score.records.ProbeRecord`); an empty one
+    for None (no run, no result: every field None)."""
+    return fields.view(probe or {}, records.ProbeRecord.SCHEMA)
+
+
+def otherwise(value, default):
+    """``value``, or ``default`` when it is None (a key its record lacks)."""
+    return default if value is None else value
+
+
+def item(item_id, points, evidence):
+    maximum = ITEMS[item_id][0]
+    return {'id': item_id, 'points': round(max(0.0, min(points, maximum)) * 2) / 2, 'max': maximum,
+            'evidence': evidence}
+
+
+def run_of(session, tag):
+    """The session's run ``tag`` ('main', 'threshold'), or None."""
+    runs = [r for r in session_of(session).runs or () if r.tag == tag]
+    return runs[0] if runs else None
+
+
+def main_probe(session):
+    run = run_of(session, 'main')
+    return run.probe if run and run.probe else None
+
+
+def threshold_probe(session):
+    run = run_of(session, 'threshold')
+    return run.probe if run and run.probe else None
+
+
+def threshold_run_value(static, session):
+    """The threshold run's value, which no output a student reads may show: as flown (its probe's
+    plan), else as drawn by the inspection (a run skipped or failed); None when there was none."""
+    probe = threshold_probe(session)
+    if probe and probe.threshold is not None:
+        return probe.threshold
+    threshold = static_of(static or {}).threshold
+    return threshold.run_value if threshold else None
+
+
+def node_ran(session):
+    probe = main_probe(session)
+    return bool(probe and probe.nodes)
+
+
+def published(session):
+    """True when the node published a value in the main run. A node that dies before its first value
+    "does not start", whether or not the probe saw it register on the way (a crash just after
+    ``init_node`` is seen or not depending on the machine's load: the words must not)."""
+    probe = main_probe(session)
+    return node_ran(session) and bool((probe.trace and probe.trace.published) or
+                                      (probe.rate and probe.rate.samples))
+
+
+def stayed_up(session):
+    """True when the node registered in the main run and roslaunch never saw it end."""
+    if not node_ran(session):
+        return False
+    launch = run_of(session, 'main').launch
+    return not (launch and launch.ended)
+
+
+def not_run(session):
+    """Why an item was not measured: the upload refused, nothing run, no build, or no node."""
+    session = session_of(session)
+    build = session.build
+    if session.refused:
+        return 'not measured: the upload was refused (see runs)'
+    if build is None:
+        return 'not measured: nothing was run (see runs)'
+    if build.status != 0:
+        return 'not measured: the package did not build (see runs)'
+    return 'not measured: the node did not run (see runs)'
+
+
+def refused_inputs(probe):
+    """The input topics whose subscription rospy refused (another message type than the drone's)."""
+    return sorted(t for t, info in (probe_of(probe).input_types or {}).items() if info and info.refused)
+
+
+def adapted_inputs(probe):
+    """The grader's fixes for refused subscriptions, one line each: the inputs its drone published in
+    the type the node asked for (:meth:`exam_lab.grader.judge.probe.Probe.input_types`)."""
+    return ['the drone published %s as %s, the type the node subscribed with (rospy refused the drone\'s %s): '
+            'Q10 lost that input once, the rest judged on that run' % (
+                topic, info.adapted, 'std_msgs/Float32' if info.published is None else info.published)
+            for topic, info in sorted((probe_of(probe).input_types or {}).items())
+            if info and info.refused and info.adapted]

@@ -1,0 +1,272 @@
+"""The schema machinery of the grader's records (:mod:`exam_lab.grader.score.records`,
+:mod:`exam_lab.grader.score.kept`): a schema, the check of a value against it, the base of every
+record type. Pure, no rospy.
+
+Schemas are plain values: a type (``str``, ``int``, ``float``, ``bool``), :class:`Text` (a string of at
+most ``n`` characters), :class:`Number` (finite, within bounds), ``[schema]`` (a list of at most
+:data:`MAX_ITEMS`; :class:`Items` for another limit), ``{key: schema}`` (an object; :class:`Optional` keys may be missing), :class:`Maybe`
+(None or the schema), :class:`OneOf` (one of fixed values), :class:`Map` (an object whose keys are data),
+:class:`Row` (a list of fixed length, each item its own schema), a tuple of schemas (any one of them).
+"""
+import json
+import math
+import os
+import re
+
+from exam_lab.grader.score.safe_text import cleaned
+
+#: Longest string of a record (a note, a path) and most items of one list.
+MAX_TEXT = 2000
+MAX_ITEMS = 500
+
+
+class RecordError(ValueError):
+    """A box's record that does not match its schema: the message says where and why."""
+
+
+class Text(object):
+    def __init__(self, limit=MAX_TEXT):
+        self.limit = limit
+
+
+class Number(object):
+    """A number within ``[low, high]``; with ``finite=False`` any float, NaN and infinities too (a value a
+    student's node published, which the rubric judges)."""
+
+    def __init__(self, low=-1e12, high=1e12, integer=False, finite=True):
+        self.low, self.high, self.integer, self.finite = low, high, integer, finite
+
+
+class Items(object):
+    """A list of at most ``limit`` items, each matching ``schema``."""
+
+    def __init__(self, schema, limit=MAX_ITEMS):
+        self.schema, self.limit = schema, limit
+
+
+class Map(object):
+    """An object whose keys are data (node or topic names): at most ``limit`` keys matching ``key``,
+    each value matching ``schema``."""
+
+    def __init__(self, key, schema, limit=MAX_ITEMS):
+        self.key, self.schema, self.limit = key, schema, limit
+
+
+class Row(object):
+    """A list of exactly ``len(schemas)`` items, each matching its own schema (``[t, request]``)."""
+
+    def __init__(self, *schemas):
+        self.schemas = schemas
+
+
+class Maybe(object):
+    def __init__(self, schema):
+        self.schema = schema
+
+
+class Optional(object):
+    """A key of an object that may be missing."""
+
+    def __init__(self, schema):
+        self.schema = schema
+
+
+class OneOf(object):
+    def __init__(self, *values):
+        self.values = values
+
+
+def check(value, schema, where='record'):
+    """``value`` when it matches ``schema``; raises :class:`RecordError` naming ``where`` otherwise."""
+    if isinstance(schema, (Maybe, Optional)):
+        return None if value is None and isinstance(schema, Maybe) else check(value, schema.schema, where)
+    if isinstance(schema, OneOf):
+        if isinstance(value, bool) or value not in schema.values:
+            raise RecordError('%s: %s is not one of %s' % (where, shown(value), ', '.join(map(str, schema.values))))
+        return value
+    if isinstance(schema, tuple):  # the first that matches; else why the last did not
+        why = None
+        for inner in schema:
+            try:
+                return check(value, inner, where)
+            except RecordError as err:
+                why = err
+        raise RecordError('%s: %s is of none of the expected types (%s)' % (where, shown(value), why))
+    if schema is str:
+        schema = Text()
+    if isinstance(schema, Text):
+        if not isinstance(value, str):
+            raise RecordError('%s: a string expected, got %s' % (where, type(value).__name__))
+        if len(value) > schema.limit:
+            raise RecordError('%s: a string of %d characters (at most %d)' % (where, len(value), schema.limit))
+        return value
+    if schema is bool:
+        if not isinstance(value, bool):
+            raise RecordError('%s: true or false expected, got %s' % (where, type(value).__name__))
+        return value
+    if schema in (int, float):
+        schema = Number(integer=schema is int)
+    if isinstance(schema, Number):
+        wanted = int if schema.integer else (int, float)
+        if isinstance(value, bool) or not isinstance(value, wanted):
+            raise RecordError('%s: %s expected, got %s' % (where, 'an integer' if schema.integer else 'a number',
+                                                           type(value).__name__))
+        if schema.finite and not (math.isfinite(value) and schema.low <= value <= schema.high):
+            raise RecordError('%s: %s is outside [%g, %g]' % (where, shown(value), schema.low, schema.high))
+        return value
+    if isinstance(schema, list):
+        schema = Items(schema[0])
+    if isinstance(schema, Items):
+        if not isinstance(value, list):
+            raise RecordError('%s: a list expected, got %s' % (where, type(value).__name__))
+        if len(value) > schema.limit:
+            raise RecordError('%s: %d %s (at most %d)' % (where, len(value), _noun(where), schema.limit))
+        return [check(item, schema.schema, '%s[%d]' % (where, index)) for index, item in enumerate(value)]
+    if isinstance(schema, Row):
+        if not isinstance(value, list) or len(value) != len(schema.schemas):
+            raise RecordError('%s: a list of %d items expected, got %s' % (where, len(schema.schemas), shown(value)))
+        return [check(item, inner, '%s[%d]' % (where, index))
+                for index, (item, inner) in enumerate(zip(value, schema.schemas))]
+    if isinstance(schema, Map):
+        if not isinstance(value, dict):
+            raise RecordError('%s: an object expected, got %s' % (where, type(value).__name__))
+        if len(value) > schema.limit:
+            raise RecordError('%s: %d keys (at most %d)' % (where, len(value), schema.limit))
+        return {check(key, schema.key, '%s key' % where): check(inner, schema.schema, '%s[%s]' % (where, shown(key)))
+                for key, inner in value.items()}
+    if isinstance(schema, dict):
+        if not isinstance(value, dict):
+            raise RecordError('%s: an object expected, got %s' % (where, type(value).__name__))
+        unknown = sorted(set(value) - set(schema))
+        if unknown:
+            raise RecordError('%s: unexpected key(s) %s' % (where, ', '.join(shown(k) for k in unknown[:5])))
+        checked = {}
+        for key, inner in schema.items():
+            if key not in value:
+                if isinstance(inner, Optional):
+                    continue
+                raise RecordError('%s: %s is missing' % (where, key))
+            checked[key] = check(value[key], inner, '%s.%s' % (where, key))
+        return checked
+    raise TypeError('not a schema: %r' % (schema,))
+
+
+def _noun(where):
+    """What a list at ``where`` holds, for its cap's sentence: ``inspect.json.comments.files`` holds files."""
+    key = where.rsplit('.', 1)[-1]
+    return key.replace('_', ' ') if re.match(r'^[a-z_]+s$', key) else 'items'
+
+
+def shown(value):
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + '...'
+
+
+def parse(raw, schema, what, constants=False):
+    """The JSON object in ``raw`` (bytes), checked against ``schema``; with ``constants``, NaN and
+    Infinity are numbers (Python's json writes them for a non-finite float)."""
+    return check(load(raw, what, constants), schema, what)
+
+
+def load(raw, what, constants=False):
+    """The JSON value in ``raw`` (bytes), unchecked; raises :class:`RecordError` naming ``what``."""
+    try:
+        return json.loads(raw.decode('utf-8'), parse_constant=None if constants else _no_constant)
+    except (UnicodeDecodeError, ValueError) as err:
+        raise RecordError('%s: not JSON: %s' % (what, err))
+
+
+def _no_constant(name):
+    raise ValueError('%s is not a number JSON allows' % name)
+
+
+def relative(path, where):
+    """A path inside the workspace: relative, without '..' (root joins it to a folder of its own)."""
+    if path.startswith('/') or '\0' in path or '..' in path.split('/'):
+        raise RecordError('%s: %s is not a path inside the workspace' % (where, shown(path)))
+    return path
+
+
+class Record(object):
+    """A record type: its file's name (``FILE``), its cap (``MAX_BYTES``), its ``SCHEMA``; a record's
+    attributes are the schema's keys (None when an optional one is missing), ``value`` the whole
+    checked object; two records are equal when their JSON is (NaN included). A record type whose
+    files outlive the grader that wrote them (:mod:`exam_lab.grader.score.kept`) brings an older
+    shape to its current one in :meth:`upgraded`, before the check. With ``CLEAN``, every string of the record, keys too, is
+    :func:`~exam_lab.grader.score.safe_text.clean` once it matched its schema: the one place where
+    a student's text (node and topic names, log lines, a request) is made safe, whoever reads the
+    record later; ``CLEAN`` a tuple of keys cleans those fields only (the others are paths to open,
+    or names kept exactly). ``NON_FINITE``: NaN and Infinity may be read from its JSON (measured values)."""
+    FILE = MAX_BYTES = SCHEMA = None
+    CLEAN = NON_FINITE = False
+
+    def __init__(self, value):
+        self.value = value
+        self.__dict__.update({key: value.get(key) for key in self.SCHEMA})
+
+    def __eq__(self, other):
+        return type(self) is type(other) and self.to_json() == other.to_json()
+
+    def __ne__(self, other):
+        return not self == other
+
+    __hash__ = None
+
+    @classmethod
+    def from_json(cls, raw, max_bytes=None):
+        """The record in ``raw`` (bytes), at most ``max_bytes`` (the type's ``MAX_BYTES`` when None);
+        raises :class:`RecordError` on anything unexpected."""
+        max_bytes = cls.MAX_BYTES if max_bytes is None else max_bytes
+        if len(raw) > max_bytes:
+            raise RecordError('%s: %d bytes (at most %d)' % (cls.FILE, len(raw), max_bytes))
+        return cls.make(load(raw, cls.FILE, constants=cls.NON_FINITE))
+
+    @classmethod
+    def read(cls, path):
+        """The record in the file ``path``, one the grader wrote itself (kept in OUT; for a box's, root
+        uses :func:`exam_lab.grader.host.egress.read_record`): read up to ``MAX_BYTES``, then as
+        :meth:`from_json`; raises :class:`RecordError` naming the file when it cannot be read."""
+        try:
+            with open(path, 'rb') as f:
+                raw = f.read(cls.MAX_BYTES + 1)
+        except OSError as err:
+            raise RecordError('%s: %s' % (os.path.basename(path), err.strerror or err))
+        return cls.from_json(raw)
+
+    @classmethod
+    def make(cls, value):
+        """The record of ``value`` (made by the grader itself from what it read): checked as one read
+        from a file is; raises :class:`RecordError`."""
+        return cls._made(check(cls.upgraded(value), cls.SCHEMA, cls.FILE))
+
+    @classmethod
+    def upgraded(cls, value):
+        """``value`` in the type's current shape (the same value when it is in it already)."""
+        return value
+
+    @classmethod
+    def _made(cls, value):
+        if cls.CLEAN is True:
+            value = cleaned(value)
+        elif cls.CLEAN:
+            value = dict(value, **{key: cleaned(value[key]) for key in cls.CLEAN if key in value})
+        record = cls(value)
+        record.validate()
+        return record
+
+    def to_json(self):
+        """The record's JSON text: :meth:`from_json` of it gives the same record."""
+        return json.dumps(self.value, indent=1, sort_keys=True)
+
+    def validate(self):
+        """Checks across fields, beyond the schema's."""
+
+
+def write(folder, record_type, value):
+    """Write ``value`` as ``folder/<record_type.FILE>`` (checked first: a box's own bug shows there),
+    atomically: the reader finds the whole record or none."""
+    check(value, record_type.SCHEMA, record_type.FILE)
+    partial = os.path.join(folder, record_type.FILE + '.part')
+    with open(partial, 'w') as f:
+        json.dump(value, f, sort_keys=True)
+    os.rename(partial, os.path.join(folder, record_type.FILE))
