@@ -154,9 +154,10 @@ def isolation_rows(text):
     return rows
 
 
-def test_the_isolation_table_names_every_module_of_boxed():
+@pytest.mark.parametrize('folder', ['boxed', 'judge'])
+def test_the_isolation_table_names_every_module_of(folder):
     rows = isolation_rows(read(GRADING))
-    assert rows.get('boxed') == grader_folders()['boxed']
+    assert rows.get(folder) == grader_folders()[folder]
 
 
 def test_the_module_list_check_catches_a_missing_module():

@@ -146,11 +146,9 @@ def test_reading_student_bytes_is_bounded(tmp_path):
              ('bytearray(2 << 30)', (60.0, 60, 1 << 30), 'MemoryError'),
              ('os.symlink("/etc/shadow", "inspect.json")', (60.0, 60, 1 << 30), 'a link, not followed')]
     for statement, bounds, words in cases:
-        work = tempfile.mkdtemp(prefix='exam-bounds-test-')
+        work = staging.new_work('exam-bounds-test-')
         try:
-            os.chmod(work, 0o711)
-            for sub in ('upload', 'ws', 'ws/src'):
-                os.mkdir(os.path.join(work, sub), 0o755)
+            staging.stage_work(work, [])
             start = time.monotonic()
             with sandbox.Box(work) as box:
                 boxed = boxed_run.Boxed(box, work)

@@ -283,9 +283,9 @@ def test_steps_seen_in_the_log_folder(tmp_path):
 
 
 def test_the_probe_trace_is_compact():
-    from exam_lab.grader.judge import probe
+    from exam_lab.grader.judge import legs
     samples = [(T0 + 0.01 * i, float(i)) for i in range(1000)] + [(T0 + 11.0, float('nan'))]
-    got = probe.trace(samples, [[T0, 1170.0], [T0 + 3.0, 1430.123456]])
+    got = legs.trace(samples, [[T0, 1170.0], [T0 + 3.0, 1430.123456]])
     assert 100 <= len(got['published']) <= 112
     assert got['published'][-1] == [T0 + 11.0, None]
     assert got['oracle'][1] == [T0 + 3.0, 1430.123]

@@ -8,7 +8,7 @@ import pytest
 from exam_lab.grader.boxed import derive, launch, source
 
 from exam_lab.grader.host import session
-from exam_lab.grader.judge import probe
+from exam_lab.grader.judge import legs, pilot
 
 from exam_lab.grader.score import flight, rubric, tolerances, verdict
 
@@ -40,7 +40,7 @@ def test_the_stale_reading_leg_is_not_reached():
     """A node blocked 5 s in a callback keeps publishing 1040 m while the grader flies it "above":
     the leg is not reached, and nothing is judged on it."""
     samples = [(10.0 + 0.1 * i, 1040.0) for i in range(75)]  # the whole long excursion, stale
-    leg = probe.leg_check(samples, 1300.0, 'above', 10.0, 17.5)
+    leg = legs.leg_check(samples, 1300.0, 'above', 10.0, 17.5)
     assert leg['reached'] is None and leg['first'] == 1040.0 and leg['samples'] == 75
     record = with_legs(measured(calls=[[13.0, 'WARNING'], [16.1, 'NORMAL']]), reached={'long_up': None},
                        values={'long_up': 1040.0})
@@ -69,11 +69,11 @@ def test_an_unreached_leg_names_the_refused_input_the_drone_could_not_speak():
 
 def test_a_leg_reached_late_counts_from_the_node_and_says_so():
     samples = [(10.0 + 0.1 * i, 1040.0 if i < 20 else 1430.0) for i in range(75)]
-    leg = probe.leg_check(samples + [(17.6, 1040.0)], 1300.0, 'above', 10.0, 17.5)
+    leg = legs.leg_check(samples + [(17.6, 1040.0)], 1300.0, 'above', 10.0, 17.5)
     assert leg['reached'] == pytest.approx(12.0) and leg['off_side'] == 0 and leg['first'] == 1040.0
-    leg = probe.leg_check(samples + [(17.4, 1040.0)], 1300.0, 'above', 10.0, 17.5)
+    leg = legs.leg_check(samples + [(17.4, 1040.0)], 1300.0, 'above', 10.0, 17.5)
     assert leg['off_side'] == 1
-    assert not probe.on_side(float('nan'), 1300.0, 'below') and probe.on_side(1300.0, 1300.0, 'below')
+    assert not legs.on_side(float('nan'), 1300.0, 'below') and legs.on_side(1300.0, 1300.0, 'below')
 
 
 def test_legs_reached_change_nothing_for_a_good_node():
@@ -314,28 +314,24 @@ class ScriptedNode(object):
 
 
 def synthetic_flight(monkeypatch, node, clock, rates, warned_before=False):
-    """The probe's flight (probe.Probe.flight, unchanged) around a scripted node on the synthetic
+    """The probe's flight (pilot.Flight.fly_legs, unchanged) around a scripted node on the synthetic
     clock; ``warned_before``: its value was above for 6 s just before (the calibration's high point),
     so it gave a WARNING there. Returns the main run's session record, scored as the grader does."""
     from exam_lab.harness import wait
-    monkeypatch.setattr(probe, 'time', clock)
+    monkeypatch.setattr(pilot, 'time', clock)
     monkeypatch.setattr(wait, 'time', clock)
-    flying = object.__new__(probe.Probe)
-    flying.plan = {'threshold': 1300.0, 'delay': 5.0, 'late_warning': 60.0}
-    flying.recorder = node
-    flying.drone = type('Drone', (), {'rates': rates, 'service': type('Service', (), {'calls': node.calls})()})()
-    flying.graph = type('Graph', (), {'student_nodes': lambda self: ['/exam']})()
-    flying.result = {}
-    flying.fly = node.fly
+    drone = type('Drone', (), {'rates': rates, 'service': type('Service', (), {'calls': node.calls})()})()
+    graph = type('Graph', (), {'student_nodes': lambda self: ['/exam']})()
+    flying = pilot.Flight({'threshold': 1300.0, 'delay': 5.0, 'late_warning': 60.0}, node.fly, node, drone, graph)
     if warned_before:
         node.fly(1430.0)
         clock.sleep(6.0)
         node.fly(1299.9)
         clock.sleep(1.0)
-    flying.flight(1170.0, 1430.0, 1299.9)
+    result = flying.fly_legs(1170.0, 1430.0, 1299.9)
     record = measured(calls=[[t, s] for t, s in node.calls()])
     main = main_of(record)
-    main.update(schedule=flying.result['schedule'], legs=flying.result['legs'], threshold=1300.0,
+    main.update(schedule=result['schedule'], legs=result['legs'], threshold=1300.0,
                 input_rates=dict(rates))
     main['calibration']['near'] = {'x': 1299.9, 'value': 1299.9, 'target': 1299.9}
     return record
@@ -384,21 +380,39 @@ def test_a_right_node_flies_as_long_as_before_and_the_wait_is_bounded(monkeypatc
             assert lost(record) == {}, name
         else:
             assert lost(record) == {'Q13': 2.0, 'Q14b': 0.5} or before, name
-    wait = probe.normal_wait(5.0, ALTITUDE_RATES)
-    assert wait == pytest.approx(5.0 + probe.AFTER_S + 1 / 0.778)
+    wait = legs.normal_wait(5.0, ALTITUDE_RATES)
+    assert wait == pytest.approx(5.0 + legs.AFTER_S + 1 / 0.778)
     # (a value already below when the rest begins reaches it at once, not a tick later)
     assert rests['right, warned before'] == pytest.approx(rests['right'], abs=0.15)
     assert rests['never'] == pytest.approx(rests['right'])
     assert lasts['right, warned before'] == pytest.approx(lasts['right'], abs=0.15)
-    assert rests['never, warned before'] - rests['right'] == pytest.approx(wait - probe.REST_S, abs=0.15)
-    assert lasts['never'] - lasts['right'] == pytest.approx(wait - probe.BACK_S - probe.DEEP_S, abs=0.3)
+    assert rests['never, warned before'] - rests['right'] == pytest.approx(wait - legs.REST_S, abs=0.15)
+    assert lasts['never'] - lasts['right'] == pytest.approx(wait - legs.BACK_S - legs.DEEP_S, abs=0.3)
 
+
+
+def test_a_value_is_read_once_it_moved_and_a_stale_one_at_stale_s(monkeypatch):
+    """The node's value after an input change (legs.settled, on the synthetic clock): read SETTLE_S
+    later; a node that follows late (blocked in a callback) is waited for until its value moved, but no
+    longer than STALE_S, and then its stale value is what it published."""
+    from exam_lab.harness import wait
+    for lag, value, read_after in ((0.1, 1430.0, legs.SETTLE_S), (3.0, 1430.0, 3.1),
+                                   (legs.STALE_S + 1.0, 1170.0, legs.STALE_S)):
+        clock = SyntheticClock()
+        monkeypatch.setattr(legs, 'time', clock)
+        monkeypatch.setattr(wait, 'time', clock)
+        node = ScriptedNode(clock, lag=lag)
+        clock.sleep(lag + 1.0)
+        since = node.fly(1430.0)
+        got, count = legs.settled(node, since, before=1170.0)
+        assert got == value and count > 0, lag
+        assert clock.now - since == pytest.approx(read_after, abs=0.11), lag
 
 def test_owes():
     calls = [(1.0, 'WARNING'), (2.0, 'NORMAL'), (3.0, 'WARNING')]
-    assert probe.owes(calls, 'below', 0.0) and not probe.owes(calls[:2], 'below', 0.0)
-    assert not probe.owes([], 'below', 0.0) and not probe.owes([(1.0, 'whatever')], 'below', 0.0)
-    assert probe.owes(calls, 'above', 3.5) and not probe.owes(calls, 'above', 2.5)
+    assert legs.owes(calls, 'below', 0.0) and not legs.owes(calls[:2], 'below', 0.0)
+    assert not legs.owes([], 'below', 0.0) and not legs.owes([(1.0, 'whatever')], 'below', 0.0)
+    assert legs.owes(calls, 'above', 3.5) and not legs.owes(calls, 'above', 2.5)
 
 
 def _sheets_drones():
@@ -414,7 +428,7 @@ def test_a_warning_at_the_next_reading_of_the_slowest_input_is_on_time(sheet, ra
     period = 1.0 / min(rates.values())
     late = 5.0 + max(tolerances.WARNING_LATE_S, period + 1.0 / tolerances.RATE_HZ)
     early = 5.0 - tolerances.WARNING_EARLY_S
-    assert late < 5.0 + probe.AFTER_S, 'the long excursion must outlast the window'
+    assert late < 5.0 + legs.AFTER_S, 'the long excursion must outlast the window'
     for latency, ok in ((early - 0.01, False), (early + 0.01, True), (5.0 + period - 0.02, True),
                         (late - 0.01, True), (late + 0.01, False)):
         record = flown([[7.6 + latency, 'WARNING'], [14.6 + 0.05, 'NORMAL']])

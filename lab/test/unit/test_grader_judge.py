@@ -12,7 +12,7 @@ import pytest
 
 from exam_lab.grader.host import cgroups, limits, sandbox, uids
 from exam_lab.grader.host.session import uid_of
-from exam_lab.grader.judge import probe
+from exam_lab.grader.judge import legs
 from exam_lab.harness.supervisor import Supervisor, descendants
 from exam_lab.harness.wait import wait_until
 
@@ -94,11 +94,11 @@ def test_a_leg_says_when_the_value_reached_its_side_and_when_it_stayed():
     """The delay counts from when the node's own value went beyond and stayed: a value that goes above,
     back, and above again stays from the second time."""
     samples = [(0.0, 1299.9), (0.1, 1301.0), (0.2, 1299.0), (0.3, 1301.0), (0.4, 1430.0), (0.5, 1430.0)]
-    leg = probe.leg_check(samples, 1300.0, 'above', 0.0, 0.5)
+    leg = legs.leg_check(samples, 1300.0, 'above', 0.0, 0.5)
     assert leg['reached'] == 0.1 and leg['stays'] == 0.3 and leg['off_side'] == 1
-    ending_off = probe.leg_check(samples + [(0.6, 1299.0)], 1300.0, 'above', 0.0, 0.6)
+    ending_off = legs.leg_check(samples + [(0.6, 1299.0)], 1300.0, 'above', 0.0, 0.6)
     assert ending_off['reached'] == 0.1 and ending_off['stays'] is None
-    below = probe.leg_check(samples, 1300.0, 'below', 0.0, 0.5)
+    below = legs.leg_check(samples, 1300.0, 'below', 0.0, 0.5)
     assert below['reached'] == 0.0 and below['stays'] is None
 
 

@@ -327,3 +327,27 @@ def test_a_class_tar_judges_a_student_s_huge_member_on_that_student_s_row(tmp_pa
     monkeypatch.setattr(classlist, 'CLASS_FILES', 3)
     with pytest.raises(archives.UnpackError, match=r'holds more than 3 entries \(at most 3 for a class\)'):
         classlist.list_students(archive, str(tmp_path / 'more'))
+
+
+def test_every_box_s_work_folder_is_laid_out_alike(tmp_path):
+    """One layout for every box's work folder (a submission's, a class archive's intake, the similarity
+    check's): 0711, each source as ``upload/<index>/<name>`` (a name that is no file name as
+    ``upload``), the workspace ``ws/src``; a source over its bounds is refused, raised or named in
+    ``refused`` with the others still staged."""
+    ann, big = tmp_path / 'Ann Lee_11_assignsubmission_file_', tmp_path / 'big.zip'
+    ann.mkdir()
+    (ann / 'exam.zip').write_bytes(b'zip')
+    big.write_bytes(b'x' * 64)
+    work = staging.new_work('exam-test-', str(tmp_path))
+    assert stat.S_IMODE(os.stat(work).st_mode) == 0o711
+    refused = {}
+    staged = staging.stage_work(work, [(ann.name, str(ann)), ('..', str(ann / 'exam.zip')), ('big.zip', str(big))],
+                                (16, 10), refused)
+    assert staged == [os.path.join(work, 'upload', '0', ann.name), os.path.join(work, 'upload', '1', 'upload'), None]
+    assert open(os.path.join(staged[0], 'exam.zip'), 'rb').read() == b'zip' and os.path.isfile(staged[1])
+    assert list(refused) == [str(big)] and 'larger than the grader takes' in refused[str(big)]
+    assert sorted(os.listdir(os.path.join(work, 'upload'))) == ['0', '1']
+    assert os.path.isdir(os.path.join(work, 'ws', 'src')) and os.listdir(os.path.join(work, 'ws', 'src')) == []
+    again = staging.new_work('exam-test-', str(tmp_path))
+    with pytest.raises(staging.UploadRefused):
+        staging.stage_work(again, [('big.zip', str(big))], (16, 10))

@@ -6,7 +6,7 @@ import os
 from exam_lab.grader import class_run, runner
 from exam_lab.grader.publish import teacher
 from exam_lab.grader.host import session
-from exam_lab.grader.judge.probe import NodeWatch
+from exam_lab.grader.judge.graph import NodeWatch
 from exam_lab.grader.score import rubric
 
 from test_grader_desk import Clock

@@ -15,7 +15,10 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own),
   :mod:`~.boxed.bounds` (what a box puts into its record, cut to the record's caps with a sentence).
 - ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`
-  (rospy: plays the drone with the harness's fake drone, measures, watches the node's pid).
+  (rospy: plays the drone with the harness's fake drone, measures; its entry point), :mod:`~.judge.graph`
+  (the master's view, rospy's refusals, the clock, the node's pid watched), :mod:`~.judge.node` (the
+  student's node, its inputs and output found), :mod:`~.judge.pilot` (the inputs set, the calibration,
+  the legs flown) and :mod:`~.judge.legs` (the legs' holds and checks, pure).
 - ``host/`` -- root: :mod:`~.host.session` (builds and runs one submission: the student's steps in its
   box, the master and the probe as the slot's judge uid), :mod:`~.host.sandbox` (the box: opened, its command lines, run, closed),
   :mod:`~.host.uids` (a slot's box and judge uids, under a lock; what runs as them ended),

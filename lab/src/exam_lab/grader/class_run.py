@@ -67,9 +67,9 @@ def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
     if scratch:
         os.makedirs(scratch, mode=0o711, exist_ok=True)
     # One file, bounded as a class (a class of 60 with its PDFs is more than one upload may be).
-    work, (staged,) = staging.staged_work('exam-intake-', [(os.path.basename(class_path), class_path)], scratch,
-                                          (classlist.CLASS_BYTES, 1))
+    work = staging.new_work('exam-intake-', scratch)
     work_dirs.append(work)
+    (staged,) = staging.stage_work(work, [(os.path.basename(class_path), class_path)], (classlist.CLASS_BYTES, 1))
     with sandbox.Box(work, bwrap=sandbox.check() is None) as box:
         boxed = Boxed(box, work)
         try:
@@ -192,9 +192,9 @@ def class_similarity(klass, out, records_):
         intake = [(name, folder) for name, folder in listed if folder not in refused]
         python = similarity.ensure_venv()  # as root: an installation, from PyPI, of no student's bytes
         # Each student staged by its own bounds: one over them is not compared, the others are.
-        work, staged = staging.staged_work('exam-similarity-', [(os.path.basename(f), f) for _, f in intake],
-                                           refused=refused)
+        work = staging.new_work('exam-similarity-')
         work_dirs.append(work)
+        staged = staging.stage_work(work, [(os.path.basename(f), f) for _, f in intake], refused=refused)
         kept = [(student, path) for student, path in zip(intake, staged) if path is not None]
         submissions, staged = [student for student, _ in kept], [path for _, path in kept]
         similarity.boilerplate(os.path.join(work, 'upload', 'boilerplate'))

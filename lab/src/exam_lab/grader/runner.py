@@ -29,7 +29,6 @@ import os
 import random
 import shutil
 import sys
-import tempfile
 import time
 
 from exam_lab.grader.boxed import archives
@@ -80,17 +79,15 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     underlay = underlay or ensure_underlay(default_underlay())  # raises: the grader cannot run
     os.makedirs(out_dir, exist_ok=True)
     deadline = time.monotonic() + STUDENT_BUDGET  # the student's own time starts here, the simulators built
-    # In the system's temp folder, not under OUT (which may be private): the box's user must reach
-    # <work>/upload, <work>/ws and <work>/box, and may not list <work>.
-    work = tempfile.mkdtemp(prefix='exam-grade-')
-    os.chmod(work, 0o711)
+    work = staging.new_work('exam-grade-')
     folder = os.path.basename(os.path.abspath(submission).rstrip('/'))
     notes, fixes, static, session, chosen_sheet, comments, how_run = [], [], {}, None, sheet, None, None
     facts = {'participant': identity.participant_number(folder), 'folder': folder, 'documents': []}
     try:
         try:
             progress.report(on_step, 'unpack')
-            upload = stage(submission, work, folder)
+            # The teacher's path, followed: a link given on the command line is the upload it names.
+            (upload,) = staging.stage_work(work, [(folder, os.path.realpath(submission))])
             with sandbox.Box(work, box_binds(underlay), bwrap=sandbox.check() is None,
                              cpus=limits.box_cpus(jobs)) as box:
                 notes.extend(box.notes)
@@ -128,17 +125,6 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
     finally:
         if not keep:
             shutil.rmtree(work, ignore_errors=True)  # never follows a link the box left (rmtree does not)
-
-
-def stage(submission, work, folder):
-    """Stage the teacher's ``submission`` (its path followed) byte for byte as ``<work>/upload/<folder>``,
-    and lay out the workspace the inspection writes the package to; return the staged path."""
-    upload = os.path.join(work, 'upload', folder if folder not in ('', '.', '..') else 'upload')
-    os.mkdir(os.path.dirname(upload), 0o755)
-    staging.stage_upload(os.path.realpath(submission), upload)  # the teacher's path: followed
-    for sub in ('ws', 'ws/src'):
-        os.mkdir(os.path.join(work, sub), 0o755)
-    return upload
 
 
 def inspect(box, work, upload, wanted_sheet, timeout=None):

@@ -100,7 +100,7 @@ WATCHED_DEATHS = 20
 
 
 def watched_deaths(probe):
-    """The deaths the probe's :class:`~exam_lab.grader.judge.probe.NodeWatch` saw (a node started again
+    """The deaths the probe's :class:`~exam_lab.grader.judge.graph.NodeWatch` saw (a node started again
     or gone during the run) in its record (a :class:`~exam_lab.grader.score.records.ProbeRecord`'s
     value: checked, its text clean), as entries of :func:`launch_outcome`'s ``ended``: they cost what a
     death in roslaunch's words costs, and they are the judge's own, whatever roslaunch's log kept."""

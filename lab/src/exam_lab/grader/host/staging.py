@@ -105,15 +105,23 @@ def _tmpfs(path, size, uid):
     return done.returncode == 0
 
 
-def staged_work(prefix, sources, parent=None, bounds=None, refused=None):
-    """A work folder for a box (in ``parent``, by default the system's temp folder: the box's user must
-    reach it), with each ``(name, path)`` of ``sources`` staged read-only as
-    ``<work>/upload/<index>/<name>``, within ``bounds`` (``(bytes, files)``; one upload's when None);
-    returns ``(work, [staged paths])``. With ``refused`` (a dict), a source over its bounds is not
-    staged (None in its place) and ``refused`` receives ``{its path: why}``; otherwise it raises
-    :class:`UploadRefused`."""
+def new_work(prefix, parent=None):
+    """A new work folder for a box, in ``parent``: by default the system's temp folder, not under OUT
+    (which may be private), for the box's user must reach ``<work>/upload``, ``<work>/ws`` and
+    ``<work>/box``; 0711, so it may not list ``<work>``. Laid out by :func:`stage_work`; the caller
+    removes it, whatever staging did: the box's logs are kept from it."""
     work = tempfile.mkdtemp(prefix=prefix, dir=parent)
     os.chmod(work, 0o711)
+    return work
+
+
+def stage_work(work, sources, bounds=None, refused=None):
+    """Lay out the work folder ``work`` (:func:`new_work`) for a box: each ``(name, path)`` of
+    ``sources`` staged read-only as ``<work>/upload/<index>/<name>`` (a path followed only as far as
+    the caller resolved it), within ``bounds`` (``(bytes, files)``; one upload's when None), and the
+    workspace ``<work>/ws/src`` the inspection writes the package to; returns the staged paths. With
+    ``refused`` (a dict), a source over its bounds is not staged (None in its place) and ``refused``
+    receives ``{its path: why}``; otherwise it raises :class:`UploadRefused`."""
     staged = []
     for sub in ('upload', 'ws', 'ws/src'):
         os.mkdir(os.path.join(work, sub), 0o755)
@@ -128,4 +136,4 @@ def staged_work(prefix, sources, parent=None, bounds=None, refused=None):
             refused[path] = str(err)
             shutil.rmtree(os.path.dirname(staged[-1]), ignore_errors=True)
             staged[-1] = None
-    return work, staged
+    return staged

@@ -106,7 +106,7 @@ def refused_inputs(probe):
 
 def adapted_inputs(probe):
     """The grader's fixes for refused subscriptions, one line each: the inputs its drone published in
-    the type the node asked for (:meth:`exam_lab.grader.judge.probe.Probe.input_types`)."""
+    the type the node asked for (:meth:`exam_lab.grader.judge.node.NodeFinder.input_types`)."""
     return ['the drone published %s as %s, the type the node subscribed with (rospy refused the drone\'s %s): '
             'Q10 lost that input once, the rest judged on that run' % (
                 topic, info.adapted, 'std_msgs/Float32' if info.published is None else info.published)

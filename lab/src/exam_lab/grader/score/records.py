@@ -153,7 +153,7 @@ MAX_REQUEST = MAX_TEXT
 _REQUEST = Text(MAX_REQUEST)
 _ANSWER = Text(4 * MAX_REQUEST + 500)
 
-#: One leg of the flight checked on the node's own values (:func:`exam_lab.grader.judge.probe.leg_check`).
+#: One leg of the flight checked on the node's own values (:func:`exam_lab.grader.judge.legs.leg_check`).
 LEG = {'side': OneOf('above', 'below'), 'reached': Maybe(_TIME), 'stays': Maybe(_TIME), 'off_side': _COUNT,
        'first': Maybe(_VALUE), 'last': Maybe(_VALUE), 'samples': _COUNT}
 

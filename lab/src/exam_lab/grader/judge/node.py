@@ -1,0 +1,113 @@
+"""The student's node as the probe finds it on the master: that it started, which inputs it subscribes
+to and with which type (an input it asked for in another numeric type is then published in that type),
+and which topic it publishes its value on. Run in the probe's rospy process
+(:mod:`exam_lab.grader.judge.probe`), before anything is flown.
+"""
+import time
+
+import rospy
+from std_msgs import msg as std_msgs
+
+from exam_lab.harness.fake_drone import TopicRecorder
+from exam_lab.harness.wait import wait_until
+
+#: Seconds to wait for the second input's subscription once the node is up.
+SUBSCRIBE_S = 6.0
+#: Seconds a publisher in the node's type waits for its connection before it is registered anew.
+RETYPE_S = 1.0
+#: Seconds to wait for the output publisher once the node subscribed.
+OUTPUT_S = 3.0
+#: Message types the probe can read values from: every numeric std_msgs type (the sheet names none).
+NUMERIC_TYPES = ('Float32', 'Float64', 'Int8', 'Int16', 'Int32', 'Int64', 'UInt8', 'UInt16', 'UInt32', 'UInt64')
+VALUE_TYPES = {'std_msgs/%s' % name: getattr(std_msgs, name) for name in NUMERIC_TYPES}
+
+
+class NodeFinder(object):
+    """Finds the student's node, its inputs and its output for the probe, from what the master says
+    (``graph``: :class:`~exam_lab.grader.judge.graph.Graph`) and what rospy refused (``refusals``:
+    :class:`~exam_lab.grader.judge.graph.RefusedConnections`), while ``drone`` feeds its inputs."""
+
+    def __init__(self, plan, graph, refusals, drone, t0):
+        self.plan, self.graph, self.refusals, self.drone, self.t0 = plan, graph, refusals, drone, t0
+
+    def wait_for_node(self):
+        """The probe's result's ``nodes`` (none when no node came within the plan's ``start_timeout``)
+        and ``node_seen_s``; once a node came, also ``subscribed`` and ``input_types``."""
+        nodes = wait_until(lambda: self.graph.student_nodes() or None, self.plan['start_timeout'], period=0.1)
+        found = {'nodes': nodes or [], 'node_seen_s': None if not nodes else time.time() - self.t0}
+        if not nodes:
+            return found
+        inputs = [rospy.resolve_name(t) for t in (self.drone.fixed_topic, self.drone.moving_topic)]
+        wait_until(lambda: all(self.graph.subscribers(t) for t in inputs), SUBSCRIBE_S, period=0.1)
+        found['subscribed'] = {t: self.graph.subscribers(t) for t in inputs}
+        found['input_types'] = self.input_types(dict(zip(inputs, (self.drone.fixed_topic, self.drone.moving_topic))))
+        return found
+
+    def input_types(self, inputs, timeout=3.0):
+        """{input topic: {"type" the node subscribed with, "connected", "refused", "adapted"}}: a
+        subscription rospy refused (another type than the drone's) shows as no connection and a refusal
+        in our log. Waits up to ``timeout`` s for each subscribed input to connect or be refused.
+
+        A refused input the node asked for as another numeric std_msgs type is then published in that
+        type (``adapted``: the type, once the node connected to it), as a teacher would change one word to
+        see the rest work: the wrong type costs question 10 alone, not the values and the warning too.
+
+        :param inputs: {resolved input topic: the feeder's name of it}."""
+        feeder = self.drone.feeder
+
+        def settled():
+            return all(not self.graph.subscribers(t) or feeder.connections(name) > 0 or t in self.refusals.refused()
+                       for t, name in inputs.items())
+        wait_until(settled, timeout, period=0.1)
+        refused = self.refusals.refused()
+        adapted = {t: refused[t]['wanted'] for t in inputs
+                   if t in refused and refused[t]['wanted'] in VALUE_TYPES and refused[t]['wanted'] != 'std_msgs/Float32'}
+        # The node's subscriber may still hold the refused connection when the master tells it of the new
+        # publisher (rospy then skips a publisher it thinks it is connected to): a publisher not
+        # connected within RETYPE_S is registered anew, until SUBSCRIBE_S.
+        deadline = time.time() + SUBSCRIBE_S
+        waiting = sorted(adapted)
+        while waiting and time.time() < deadline:
+            for topic in waiting:
+                feeder.retype(inputs[topic], VALUE_TYPES[adapted[topic]])
+            wait_until(lambda: all(feeder.connections(inputs[t]) > 0 for t in waiting),
+                       min(RETYPE_S, max(0.0, deadline - time.time())), period=0.05)
+            waiting = [t for t in waiting if feeder.connections(inputs[t]) == 0]
+        out = {}
+        for topic, name in sorted(inputs.items()):
+            connected = feeder.connections(name) > 0
+            if topic in refused:
+                out[topic] = {'type': refused[topic]['wanted'], 'connected': connected,
+                              'refused': 'rospy refused the connection: the node asked for %s, the drone '
+                                         'publishes %s' % (refused[topic]['wanted'], refused[topic]['published']),
+                              'published': refused[topic]['published'],
+                              'adapted': adapted[topic] if topic in adapted and connected else None}
+            elif self.graph.subscribers(topic):
+                out[topic] = {'type': 'std_msgs/Float32' if connected else None, 'connected': connected,
+                              'refused': None, 'adapted': None}
+        return out
+
+    def find_output(self, recorder):
+        """The probe's result's ``output`` (the topic the node's value is read from: the sheet's, or
+        else the likeliest numeric one it publishes) and the recorder that reads it: ``recorder`` (the
+        drone's, of the sheet's topic in Float32), a new one for another topic or type, None for a type
+        the probe cannot read values from."""
+        expected = rospy.resolve_name(self.plan['output'])
+        found = wait_until(lambda: expected in self.graph.publications(), OUTPUT_S, period=0.1)
+        publications = self.graph.publications()
+        output = {'expected': expected, 'topic': None, 'type': None,
+                  'candidates': sorted(publications)}
+        if found:
+            output.update(topic=expected, type=publications[expected])
+        else:
+            candidates = sorted(t for t, kind in publications.items() if kind in VALUE_TYPES)
+            preferred = [t for t in candidates if self.plan['output'][:3] in t.lower()] or candidates
+            if preferred:
+                output.update(topic=preferred[0], type=publications[preferred[0]])
+        topic, kind = output['topic'], output['type']
+        if topic is not None and (topic != expected or kind != 'std_msgs/Float32') and kind in VALUE_TYPES:
+            recorder.close()
+            recorder = TopicRecorder(topic, msg_type=VALUE_TYPES[kind], clock=time.time)
+        elif topic is not None and kind not in VALUE_TYPES:
+            recorder = None  # a type the probe cannot read values from
+        return output, recorder
