@@ -15,22 +15,26 @@ is printed). No ROS, no sandbox, no root: it reads records only.
 """
 import argparse
 import glob
-import json
 import os
 import sys
 
 from exam_lab.grader.publish import feedback, hand, moodle
-from exam_lab.grader.score import safe_text
+from exam_lab.grader.score import kept, safe_text
+from exam_lab.grader.score.schema import RecordError
 
 
 def records_in(out):
-    """The grade records of a run's OUT: one per student folder, or the single submission's."""
+    """The grade records of a run's OUT: one per student folder, or the single submission's, each read
+    as a :class:`~exam_lab.grader.score.kept.GradeRecord` (capped, checked, one of an older grader
+    brought to today's shape); raises RecordError naming the file of one that is not a grade."""
     paths = sorted(glob.glob(os.path.join(out, '*', 'grade.json'))) or \
         [p for p in [os.path.join(out, 'grade.json')] if os.path.isfile(p)]
     records = []
     for path in paths:
-        with open(path) as f:
-            records.append(json.load(f))
+        try:
+            records.append(kept.GradeRecord.read(path).value)
+        except RecordError as err:
+            raise RecordError('%s: %s' % (os.path.relpath(path, out), err))
     return records
 
 
@@ -39,7 +43,14 @@ def main(argv=None):
     parser.add_argument('--out', required=True, help='the folder make grade wrote (grade.json files, hand.csv)')
     parser.add_argument('--worksheet', required=True, help="Moodle's offline grading worksheet (CSV)")
     args = parser.parse_args(argv)
-    records = records_in(args.out)
+    try:
+        records = records_in(args.out)
+    except RecordError as err:
+        # Filled from a grade that is not one, a row could be wrong: nothing is written until it is
+        # graded or rescored again.
+        print('worksheet: NOT filled: %s (make rescore, or make grade for that student)'
+              % safe_text.clean(str(err)), file=sys.stderr)
+        return 1
     if not records:
         print('worksheet: no grade.json in %s: run make grade first' % args.out, file=sys.stderr)
         return 1

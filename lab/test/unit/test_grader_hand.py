@@ -4,15 +4,16 @@ import csv
 
 import pytest
 
-from exam_lab.grader.publish import hand
+from exam_lab.grader.publish import hand, report
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 
 
 def record(student, total, participant=None):
+    """A grade record as the grader makes it (:func:`report.grade_record`): the machine's items, the
+    last one short of ``17 - total``."""
     items = [{'id': item, 'points': top, 'max': top, 'evidence': 'ok'} for item, (top, _) in ITEMS.items()]
     items[-1]['points'] -= 17.0 - total
-    return {'student': student, 'sheet': 'altitude', 'total': total, 'max': 17.0, 'items': items,
-            'participant': participant, 'status': 'graded'}
+    return report.grade_record(student, 'altitude', items, [], {'participant': participant})
 
 
 def fill(path, cells, delimiter=','):
@@ -174,6 +175,27 @@ def test_a_badly_filled_hand_csv_stops_the_worksheet_with_every_problem(tmp_path
     assert not (out / 'ws-whole.csv').exists()
 
 
+def test_a_grade_json_that_is_no_grade_stops_the_worksheet_naming_it(tmp_path, capsys):
+    """make worksheet reads each grade.json as the grader's record (capped, checked): one edited by
+    hand or cut short stops it, naming the file and the field, and nothing is written."""
+    import json
+    out = tmp_path / 'out'
+    jane, paul = record('Jane Doe', 17.0, 101), record('Paul Martin', 15.5, 102)
+    for r in (jane, paul):
+        (out / r['student']).mkdir(parents=True)
+        (out / r['student'] / 'grade.json').write_text(json.dumps(r))
+    hand.write(str(out / hand.FILE), [jane, paul])
+    (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8', newline='')
+    (out / 'Paul Martin' / 'grade.json').write_text(json.dumps(dict(paul, total='15.5 points')))
+    assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
+    err = capsys.readouterr().err
+    assert 'NOT filled: Paul Martin/grade.json: grade.json.total' in err, err
+    assert not (out / 'ws-whole.csv').exists()
+    (out / 'Paul Martin' / 'grade.json').write_text(json.dumps(paul)[:40])
+    assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
+    assert 'NOT filled: Paul Martin/grade.json' in capsys.readouterr().err
+
+
 
 def moodle_record(folder, total):
     """A class student's record as a run makes it: the name cleaned from Moodle's folder name (the
@@ -297,7 +319,7 @@ def test_a_name_no_spreadsheet_runs_and_read_back_exactly(tmp_path, name):
     from exam_lab.grader.publish import cells, report
     from exam_lab.grader.score import safe_text
     path = str(tmp_path / hand.FILE)
-    student = record(name, 15.0, 7)
+    student = dict(record('Jane', 15.0, 7), student=name)  # the name as given, before any cleaning
     hand.write(path, [student])
     fill(path, {(cells.cell(name), 'remark'): '=1+1'})  # typed in a spreadsheet, saved as text
     for _ in range(2):
