@@ -135,13 +135,9 @@ WORKSHEET = '\ufeff' + '\r\n'.join([
 
 
 def test_the_whole_grade_on_the_worksheets_scale_and_nothing_missing_taken_as_zero(tmp_path, capsys):
-    import json
     out = tmp_path / 'out'
     jane, paul = record('Jane Doe', 17.0, 101), record('Paul Martin', 15.5, 102)
-    for r in (jane, paul):
-        (out / r['student']).mkdir(parents=True)
-        (out / r['student'] / 'grade.json').write_text(json.dumps(r))
-    hand.write(str(out / hand.FILE), [jane, paul])
+    write_run(out, [jane, paul])
     cells = {('Jane Doe', item): str(top) for item, (top, _) in HAND_ITEMS.items()}
     cells[('Jane Doe', 'quality')] = '1'
     cells[('Paul Martin', 'Q4')] = '1'
@@ -181,10 +177,7 @@ def test_a_grade_json_that_is_no_grade_stops_the_worksheet_naming_it(tmp_path, c
     import json
     out = tmp_path / 'out'
     jane, paul = record('Jane Doe', 17.0, 101), record('Paul Martin', 15.5, 102)
-    for r in (jane, paul):
-        (out / r['student']).mkdir(parents=True)
-        (out / r['student'] / 'grade.json').write_text(json.dumps(r))
-    hand.write(str(out / hand.FILE), [jane, paul])
+    write_run(out, [jane, paul])
     (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8', newline='')
     (out / 'Paul Martin' / 'grade.json').write_text(json.dumps(dict(paul, total='15.5 points')))
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
