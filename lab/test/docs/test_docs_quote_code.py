@@ -564,8 +564,8 @@ def synthetic_grade(total_before=None):
     record = report.grade_record('late', 'altitude', [{'id': i, 'points': p, 'max': p, 'evidence': 'ok'}
                                                       for i, (p, _) in ITEMS.items()], [])
     if total_before is not None:
-        record['provenance'] = {'how': 'rescore', 'grader': 'abc', 'rubric': 'def', 'machine': 'vm', 'date': 'd'}
-        record['previous'] = {'total': total_before, 'status': 'graded'}
+        record = dict(record, provenance={'how': 'rescore', 'grader': 'abc', 'rubric': 'def', 'machine': 'vm', 'date': 'd'},
+                      previous={'total': total_before, 'status': 'graded'})
     return record
 
 

@@ -10,7 +10,7 @@ from exam_lab.grader.boxed import derive, launch, source
 from exam_lab.grader.host import session
 from exam_lab.grader.judge import legs, pilot
 
-from exam_lab.grader.score import flight, rubric, tolerances, verdict
+from exam_lab.grader.score import flight, records, rubric, tolerances, verdict
 
 from exam_lab.grader.publish import report
 
@@ -322,7 +322,9 @@ def synthetic_flight(monkeypatch, node, clock, rates, warned_before=False):
     monkeypatch.setattr(wait, 'time', clock)
     drone = type('Drone', (), {'rates': rates, 'service': type('Service', (), {'calls': node.calls})()})()
     graph = type('Graph', (), {'student_nodes': lambda self: ['/exam']})()
-    flying = pilot.Flight({'threshold': 1300.0, 'delay': 5.0, 'late_warning': 60.0}, node.fly, node, drone, graph)
+    plan = records.PlanRecord.make({'kind': 'main', 'sheet': 'altitude', 'threshold': 1300.0, 'margin': 130.0, 'delay': 5.0,
+                                    'start_timeout': 20.0, 'output': '/altitude', 'late_warning': 60.0})
+    flying = pilot.Flight(plan, node.fly, node, drone, graph)
     if warned_before:
         node.fly(1430.0)
         clock.sleep(6.0)

@@ -100,3 +100,47 @@ def test_the_rubric_reads_a_session_as_kept_or_as_its_view():
     assert rubric.score('altitude', viewed[1], viewed[0]) == rubric.score('altitude', static, session)
     assert rubric.status(viewed[1], viewed[0]) == rubric.status(static, session)
     assert rubric.doubts(viewed[1], viewed[0]) == rubric.doubts(static, session)
+
+
+def _session():
+    return records.SessionRecord.make({'outcome': 'ran', 'build': None, 'runs': [], 'error': 'x',
+                                       'launch_check': {'file': 'a.launch', 'status': 0, 'refused': '', 'warnings': ['w'],
+                                                        'nodes': ['/exam']}})
+
+
+def test_a_record_is_frozen_as_a_frozen_dataclass_is_and_deeper():
+    """What a stage hands on is what the next one reads: no field set, no object or list of it changed."""
+    import copy
+    import pickle
+    record = _session()
+    with pytest.raises(AttributeError, match='read-only'):
+        record.error = 'other'
+    with pytest.raises(AttributeError, match='read-only'):
+        del record.error
+    with pytest.raises(AttributeError, match='no field'):
+        record.eror  # a misspelt field is an error, as on a view
+    changes = (lambda v: v.__setitem__('error', 'y'), lambda v: v.update(error='y'), lambda v: v.pop('error'),
+               lambda v: v.setdefault('refused', True), lambda v: v['launch_check'].__setitem__('status', 1),
+               lambda v: v['launch_check']['warnings'].append('more'), lambda v: v['runs'].extend([{}]),
+               lambda v: v['launch_check']['nodes'].__setitem__(0, '/x'), lambda v: v.clear())
+    for change in changes:
+        with pytest.raises(TypeError, match='read-only'):
+            change(record.value)
+    assert record == _session() and record.launch_check['warnings'] == ['w']
+    # Read as plain data: a new dict of it, a deep copy, JSON, a pickle (a thread pool's) are plain or equal.
+    assert dict(record.value, error='y')['error'] == 'y' and record.error == 'x'
+    thawed = copy.deepcopy(record.value)
+    thawed['launch_check']['warnings'].append('more')
+    assert type(thawed) is dict and record.launch_check['warnings'] == ['w']
+    assert pickle.loads(pickle.dumps(record.value)) == record.value
+    assert records.SessionRecord.from_json(record.to_json().encode()) == record
+
+
+def test_a_record_replaced_is_a_new_record_checked_again():
+    record = _session()
+    other = record.replaced(survivors=3)
+    assert other.survivors == 3 and record.survivors is None and other.outcome is records.Outcome.RAN
+    with pytest.raises(records.RecordError, match='survivors'):
+        record.replaced(survivors=-1)
+    with pytest.raises(records.RecordError, match='unexpected key'):
+        record.replaced(surviviors=3)

@@ -2,6 +2,7 @@
 grade.json carry a version and are read back through their types (capped, checked), a file kept before
 today's version brought to it; one that does not match stops that student's rescore, never the
 class's; the session's outcome an enum whose members are their strings."""
+import copy
 import json
 import math
 import os
@@ -105,7 +106,7 @@ def test_a_kept_record_round_trips_through_json():
         for record_type in (MeasurementsRecord, GradeRecord):
             record = record_type.read(os.path.join(KEPT, shape, record_type.FILE))
             assert record_type.from_json(record.to_json().encode()) == record
-    value = MeasurementsRecord.read(os.path.join(KEPT, 'before-version', MEASUREMENTS)).value
+    value = copy.deepcopy(MeasurementsRecord.read(os.path.join(KEPT, 'before-version', MEASUREMENTS)).value)
     value['session']['runs'][0]['probe']['formula'][0]['published'] = float('nan')
     record = MeasurementsRecord.make(value)
     again = MeasurementsRecord.from_json(record.to_json().encode())
@@ -161,7 +162,7 @@ def test_the_outcome_is_an_enum_whose_members_are_their_strings():
     assert json.dumps({'outcome': Outcome.NO_NODE}, indent=1) == json.dumps({'outcome': 'no_node'}, indent=1)
     assert '%s' % Outcome.REFUSED == 'refused' and '{}'.format(Outcome.REFUSED) == 'refused'
     assert {Outcome.RAN: 1}['ran'] == 1
-    assert grades.no_session(Outcome.REFUSED, 'why')['outcome'] is Outcome.REFUSED
+    assert grades.no_session(Outcome.REFUSED, 'why').outcome is Outcome.REFUSED
     made = SessionRecord.make(dict(MeasurementsRecord.read(os.path.join(KEPT, 'before-version', MEASUREMENTS)).session))
     assert made.outcome is Outcome.RAN and made.value['outcome'] is Outcome.RAN
     assert SessionRecord.from_json(made.to_json().encode()).outcome is Outcome.RAN

@@ -387,7 +387,7 @@ def test_the_threshold_run_value_is_drawn_once_written_and_planned(tmp_path, dra
     again = derive.threshold_param(launch.analyse(derived, os.path.join(str(ws), 'src', 'exam')), 'altitude')[0]
     assert (again.name, launch.as_number(again.value)) == ('--threshold', value)
     job = runner.plan_job(records.InspectRecord(records.check(found, records.InspectRecord.SCHEMA)))
-    main, threshold = [run['plan'] for run in job['runs']]
+    main, threshold = [run['plan'] for run in job.runs]
     assert threshold == dict(main, kind='threshold', threshold=value), 'the main run\'s plan around the new value'
     with pytest.raises(ValueError):
         sheets.threshold_run_value(1300.0, 1.0)

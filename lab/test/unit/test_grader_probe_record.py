@@ -122,7 +122,7 @@ def test_the_outcome_is_one_of_fixed_values():
     assert 'session.json: outcome is missing' in refused({k: v for k, v in real_session().items() if k != 'outcome'},
                                                         SessionRecord)
     for outcome in records.OUTCOMES:
-        assert grades.no_session(outcome, 'why')['outcome'] == outcome
+        assert grades.no_session(outcome, 'why').outcome == outcome
 
 
 def write(path, text):
@@ -158,17 +158,17 @@ def test_the_runner_reads_the_sessions_record_capped_and_checked(tmp_path):
     log_dir = str(tmp_path)
     write(os.path.join(log_dir, 'session.json'), SessionRecord.make(real_session()).to_json())
     got = runner.session_outcome(log_dir, 0, '', 100.0, 2)
-    assert got['outcome'] == 'ran' and got['survivors'] == 2 and got['runs'][0]['probe'] == real_probe()
+    assert got.outcome == 'ran' and got.survivors == 2 and got.runs[0]['probe'] == real_probe()
     write(os.path.join(log_dir, 'session.json'), json.dumps(dict(real_session(), outcome='fine')))
     got = runner.session_outcome(log_dir, 0, '', 100.0, 0)
-    assert got['outcome'] == 'session_failed' and got['runs'] == []
-    assert got['error'].startswith("the session's record was refused: session.json.outcome: 'fine' is not one of")
+    assert got.outcome == 'session_failed' and got.runs == []
+    assert got.error.startswith("the session's record was refused: session.json.outcome: 'fine' is not one of")
     os.remove(os.path.join(log_dir, 'session.json'))
-    assert runner.session_outcome(log_dir, 0, '', 100.0, 0)['error'] == \
+    assert runner.session_outcome(log_dir, 0, '', 100.0, 0).error == \
         "the session's record was refused: session.json: missing"
-    assert runner.session_outcome(log_dir, None, '', 100.0, 0)['outcome'] == 'session_killed'
+    assert runner.session_outcome(log_dir, None, '', 100.0, 0).outcome == 'session_killed'
     got = runner.session_outcome(log_dir, 1, 'Traceback\nboom\x1b[2J', 100.0, 0)
-    assert got['outcome'] == 'session_failed' and got['error'] == 'the session failed (exit 1): Traceback\nboom'
+    assert got.outcome == 'session_failed' and got.error == 'the session failed (exit 1): Traceback\nboom'
 
 
 def test_a_rescore_reads_back_the_session_record_the_run_kept(tmp_path):
@@ -190,3 +190,35 @@ def test_a_rescore_reads_back_the_session_record_the_run_kept(tmp_path):
     assert again.to_json() == SessionRecord.make(session_).to_json()
     rescored, changes = grades.rescore(str(tmp_path))
     assert changes == [] and [i['points'] for i in rescored[0]['items']] == [i['points'] for i in graded['items']]
+
+
+def inspected(**change):
+    """An inspection's record of a package with a threshold run (the parts plan_job reads)."""
+    value = {'uid': 1000, 'refused': None, 'sheet': 'altitude', 'notes': [], 'fixes': [], 'static': None,
+             'threshold_value': 1300.0, 'calls_service': True, 'namespace': '/', 'main_launch': 'grader/main.launch',
+             'threshold_launch': 'grader/threshold.launch', 'threshold_run_value': 900.0, 'handed_in_launch': None,
+             'comments': None, 'facts': {'participant': None, 'folder': 'Ann', 'documents': []}}
+    return records.InspectRecord.make(dict(value, **change))
+
+
+def test_the_job_and_its_plans_are_records_that_round_trip(tmp_path, capsys):
+    """The plan (runner), the job as the session reads it (job.json) and each run's plan as the judge
+    reads it (plan-<tag>.json) are checked records: what the runner made is what they read."""
+    job = runner.plan_job(inspected())
+    assert isinstance(job, records.JobRecord) and [run['tag'] for run in job.runs] == ['main', 'threshold']
+    main, threshold = (records.PlanRecord.make(run['plan']) for run in job.runs)
+    assert (main.threshold, threshold.threshold, threshold.margin) == (1300.0, 900.0, 130.0) and main.late_warning > 0
+    assert records.JobRecord.from_json(job.to_json().encode()) == job
+    assert runner.plan_job(inspected(calls_service=False)).runs[0]['plan']['late_warning'] == 0.0
+    assert runner.plan_job(inspected(main_launch=None, threshold_launch=None, threshold_run_value=None)) is None
+    with pytest.raises(RecordError, match='main run, then the threshold run'):
+        job.replaced(runs=list(reversed(job.runs)))
+    with pytest.raises(RecordError, match='the threshold run with a plan of a main run'):
+        job.replaced(runs=[job.runs[0], dict(job.runs[1], plan=job.runs[0]['plan'])])
+    with pytest.raises(RecordError, match='late_warning'):
+        main.replaced(late_warning=-1.0)
+    # The session refuses a job that is not one, naming the field, and writes no record.
+    bad = tmp_path / 'job.json'
+    bad.write_text(json.dumps(dict(json.loads(job.to_json()), run_timeout='90')))
+    assert session.main([str(bad)]) == 1
+    assert 'job.json.run_timeout: a number expected' in capsys.readouterr().err

@@ -63,15 +63,15 @@ def test_a_run_whose_node_set_the_time_is_refused():
     plan = {'kind': 'main', 'delay': 5.0}
     real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0},
             'clock': CLEAN_CLOCK}
-    assert session.probe_problem(real, plan, 99.0, 131.0) is None
+    assert session.probe_problem(real, 99.0, 131.0, **plan) is None
     sim = dict(real, clock=dict(CLEAN_CLOCK, use_sim_time=[True, True]))
-    assert '/use_sim_time was set' in session.probe_problem(sim, plan, 99.0, 131.0)
+    assert '/use_sim_time was set' in session.probe_problem(sim, 99.0, 131.0, **plan)
     late = dict(real, clock=dict(CLEAN_CLOCK, use_sim_time=[None, True]))
-    assert '/use_sim_time was set' in session.probe_problem(late, plan, 99.0, 131.0)
+    assert '/use_sim_time was set' in session.probe_problem(late, 99.0, 131.0, **plan)
     ticking = dict(real, clock=dict(CLEAN_CLOCK, messages=40, publishers=['/exam']))
-    assert '/clock was published (40 messages by /exam)' in session.probe_problem(ticking, plan, 99.0, 131.0)
+    assert '/clock was published (40 messages by /exam)' in session.probe_problem(ticking, 99.0, 131.0, **plan)
     unwatched = {k: v for k, v in real.items() if k != 'clock'}
-    assert 'did not say' in session.probe_problem(unwatched, plan, 99.0, 131.0)
+    assert 'did not say' in session.probe_problem(unwatched, 99.0, 131.0, **plan)
 
 
 def test_a_run_whose_master_went_over_its_memory_is_refused():

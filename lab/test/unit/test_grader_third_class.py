@@ -251,9 +251,9 @@ def test_roslaunch_verdict_on_the_file_as_handed_in(tmp_path):
                                        '<parm name="threshold" value="1"/></node></launch>')
     here, env = _Here(), dict(os.environ)
     job = {'workspace': str(tmp_path), 'handed_in_launch': 'exam/launch/dup.launch'}
-    refused = session.launch_verdict(here, job, env, here)
+    refused = session.launch_verdict(here, here, env, **job)
     assert refused['status'] == 1 and refused['file'] == 'launch/dup.launch'
     assert 'multiple nodes named [/mydrone]' in refused['refused'], refused
-    odd = session.launch_verdict(here, dict(job, handed_in_launch='exam/launch/odd.launch'), env, here)
+    odd = session.launch_verdict(here, here, env, **dict(job, handed_in_launch='exam/launch/odd.launch'))
     assert odd['status'] == 0 and odd['refused'] == '' and odd['nodes'] == ['/exam'], odd
     assert any("unrecognized 'parm'" in w for w in odd['warnings']), odd

@@ -31,7 +31,7 @@ def test_an_environment_hook_cannot_answer_for_roslaunch(tmp_path):
     job = refused_workspace(tmp_path)
     (tmp_path / 'devel' / 'etc' / 'catkin' / 'profile.d').mkdir(parents=True)
     (tmp_path / 'devel' / 'setup.bash').write_text('echo /exam; exit 0\n')
-    verdict = session.launch_verdict(_Here(), job, dict(os.environ), _Here())
+    verdict = session.launch_verdict(_Here(), _Here(), dict(os.environ), **job)
     assert verdict['status'] == 1 and 'multiple nodes named [/exam]' in verdict['refused'], verdict
 
 
@@ -50,7 +50,7 @@ def test_a_module_left_in_the_workspace_cannot_answer_for_roslaunch(tmp_path):
     here.workspace = str(tmp_path)
     (tmp_path / 'devel').mkdir()
     (tmp_path / 'devel' / 'setup.bash').write_text('true\n')
-    verdict = session.launch_verdict(here, job, dict(os.environ), here)
+    verdict = session.launch_verdict(here, here, dict(os.environ), **job)
     assert verdict['status'] == 1 and 'multiple nodes named [/exam]' in verdict['refused'], verdict
 
 

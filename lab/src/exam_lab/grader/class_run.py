@@ -159,7 +159,7 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
         record = grades.could_not_grade(name, sheet, '%r' % err,
                                         [grades.bug_note()])
         moodle_name = os.path.basename(os.path.abspath(folder).rstrip('/'))
-        record.update(participant=identity.participant_number(moodle_name), folder=moodle_name)  # who, even so
+        record = dict(record, participant=identity.participant_number(moodle_name), folder=moodle_name)  # who, even so
         try:
             report.write_grade(os.path.join(out_dir, name), record)
         except OSError:
@@ -172,7 +172,7 @@ def _refused_at_intake(name, folder, out_dir, sheet, why):
     folder_name = os.path.basename(folder)
     measured = {'student': name, 'sheet': sheet or 'altitude', 'static': {}, 'notes': [], 'fixes': [],
                 'comments': None, 'isolate': None, 'how_run': None,
-                'session': grades.no_session(records.Outcome.REFUSED, 'submission refused: %s' % why, refused=True),
+                'session': grades.no_session(records.Outcome.REFUSED, 'submission refused: %s' % why, refused=True).value,
                 'extra': {'participant': identity.participant_number(folder_name), 'folder': folder_name,
                           'documents': [], 'seconds': 0.0}}
     os.makedirs(out_dir, exist_ok=True)
@@ -209,8 +209,8 @@ def class_similarity(klass, out, records_):
                 json.dump(job, f)
             result = boxed.run('exam_lab.grader.boxed.similarity', ['--class', boxed.path(f.name)],
                                records.SimilarityRecord, SIMILARITY_BOUNDS, python=python).value
-        result['notes'] = ['%s: not compared (its files were refused: %s)' % (name, refused[folder])
-                           for name, folder in listed if folder in refused] + result.get('notes', [])
+        result = dict(result, notes=['%s: not compared (its files were refused: %s)' % (name, refused[folder])
+                                     for name, folder in listed if folder in refused] + result['notes'])
     except Exception as err:  # a bug of the check, or its box failing, must not cost the class its page
         result = {'error': str(err) if isinstance(err, (InspectionFailed, archives.UnpackError)) else repr(err)}
     finally:

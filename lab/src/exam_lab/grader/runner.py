@@ -24,7 +24,6 @@ A class is graded by :mod:`~exam_lab.grader.class_run`, each student by :func:`g
 simulators are an underlay built once (:mod:`~exam_lab.grader.host.underlay`); each student's package
 is built alone in an overlay of its own on top of it.
 """
-import json
 import os
 import random
 import shutil
@@ -118,7 +117,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
             session = grades.no_session(Outcome.GRADER_FAILED, 'the grader failed on this submission: %r' % err)
             notes.append(grades.bug_note())
         notes.extend(keep_logs(work, out_dir))
-        measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session,
+        measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session.value,
                     'notes': notes, 'fixes': fixes, 'comments': comments, 'isolate': isolate, 'how_run': how_run,
                     'extra': dict(facts, **dict(extra or {}, seconds=round(time.monotonic() - start, 1)))}
         return publish(out_dir, measured)
@@ -151,9 +150,9 @@ def inspect(box, work, upload, wanted_sheet, timeout=None):
 
 
 def plan_job(record):
-    """The session's job (:mod:`exam_lab.grader.host.session`) from a checked inspection record: the
-    runs' plans are computed here, from its numbers; the launch files stay relative to the workspace.
-    None when there is nothing to run."""
+    """The session's job (a :class:`~exam_lab.grader.score.records.JobRecord`) from a checked inspection
+    record: the runs' plans are computed here, from its numbers; the launch files stay relative to the
+    workspace. None when there is nothing to run."""
     if record.main_launch is None:
         return None
     sheet, threshold = record.sheet, record.threshold_value
@@ -167,13 +166,13 @@ def plan_job(record):
         # sheets.threshold_run_value), flown as the main run around it, with the main run's margin.
         runs.append({'tag': 'threshold', 'launch': record.threshold_launch,
                      'plan': dict(plan, kind='threshold', threshold=record.threshold_run_value)})
-    return {'namespace': record.namespace, 'build_timeout': BUILD_TIMEOUT, 'run_timeout': RUN_TIMEOUT, 'runs': runs,
-            'handed_in_launch': record.handed_in_launch}
+    return records.JobRecord.make({'namespace': record.namespace, 'build_timeout': BUILD_TIMEOUT,
+                                   'run_timeout': RUN_TIMEOUT, 'runs': runs, 'handed_in_launch': record.handed_in_launch})
 
 
 def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BUDGET):
     """Run the session of one submission, its student steps in ``box``; return what it measured (or
-    why it could not).
+    why it could not): its :class:`~exam_lab.grader.score.records.SessionRecord`.
 
     :param left: seconds left of the student's budget: the session's own (it stops its steps in time),
         and killed SESSION_KILL_S after.
@@ -186,12 +185,12 @@ def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BU
     judge_home = os.path.join(work, 'judge')
     for folder in (log_dir, judge_home):
         os.makedirs(folder, mode=0o700, exist_ok=True)
-    runs = [dict(run, launch=os.path.join(box.workspace, run['launch'])) for run in job['runs']]
-    job = dict(job, workspace=box.workspace, runs=runs, underlay=underlay, log_dir=log_dir,
-               judge_home=judge_home, box=box.describe(), budget=left, student_budget=STUDENT_BUDGET)
-    job_path = os.path.join(work, 'job.json')
+    runs = [dict(run, launch=os.path.join(box.workspace, run['launch'])) for run in job.runs]
+    job = job.replaced(workspace=box.workspace, runs=runs, underlay=underlay, log_dir=log_dir, judge_home=judge_home,
+                       box=box.describe(), budget=left, student_budget=STUDENT_BUDGET)
+    job_path = os.path.join(work, records.JobRecord.FILE)
     with open(job_path, 'w') as f:
-        json.dump(job, f, indent=1, sort_keys=True)
+        f.write(job.to_json())
     argv = [sys.executable, '-m', 'exam_lab.grader.host.session', job_path]
     if isolate:
         argv = bwrap.network_namespace(argv)
@@ -203,19 +202,18 @@ def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BU
 
 
 def session_outcome(log_dir, status, output, left, survivors):
-    """The session's record (a :class:`~exam_lab.grader.score.records.SessionRecord`'s value): the one
+    """The session's record (a :class:`~exam_lab.grader.score.records.SessionRecord`): the one
     it wrote in ``log_dir`` when it ended well (``status`` 0), read through
     :func:`~exam_lab.grader.host.egress.read_record` (capped, checked), else why there is none;
     ``survivors`` (processes of the box's uid found after it) added to its count."""
     if status == 0:
         try:
             result = egress.read_record(os.path.join(log_dir, records.SessionRecord.FILE), records.SessionRecord,
-                                        records.SessionRecord.MAX_BYTES).value
+                                        records.SessionRecord.MAX_BYTES)
         except records.RecordError as err:
             return grades.no_session(Outcome.SESSION_FAILED, 'the session\'s record was refused: %s' % err,
                                      survivors=survivors)
-        result['survivors'] = result.get('survivors', 0) + survivors
-        return result
+        return result.replaced(survivors=(result.survivors or 0) + survivors)
     if status is None:
         why = budget_sentence(STUDENT_BUDGET, 'the session was killed after %.0f s' % (left + SESSION_KILL_S))
         return grades.no_session(Outcome.SESSION_KILLED, why, budget_used=why, survivors=survivors)

@@ -188,8 +188,8 @@ def run_task(manifest, index, out_dir, sheet=None, unsandboxed=False):
     record = class_run.grade_student(entry['student'], entry['submission'], out_dir, sheet, unsandboxed=unsandboxed,
                                   refused=entry.get('refused'))
     # Which node graded it (a lost node's students are graded again elsewhere): in grade.json too.
-    record['graded_on'] = os.environ.get('SLURMD_NODENAME') or socket.gethostname()
-    report.write_grade(os.path.join(out_dir, entry['student']), record)
+    record = report.write_grade(os.path.join(out_dir, entry['student']),
+                                dict(record, graded_on=os.environ.get('SLURMD_NODENAME') or socket.gethostname()))
     _write_json(os.path.join(os.path.dirname(manifest), 'results', '%d.json' % index), record)
     return record
 

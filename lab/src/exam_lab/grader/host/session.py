@@ -41,7 +41,8 @@ import time
 from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
 from exam_lab.grader.host.egress import read_capped, read_record
 from exam_lab.grader.host.sandbox import Box
-from exam_lab.grader.score.records import MAX_ENDED, MAX_LOG_TEXT, Outcome, ProbeRecord, RecordError, SessionRecord
+from exam_lab.grader.score.records import (
+    MAX_ENDED, MAX_LOG_TEXT, JobRecord, Outcome, PlanRecord, ProbeRecord, RecordError, SessionRecord)
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
@@ -135,11 +136,11 @@ def clock_problem(clock):
     return None
 
 
-def probe_problem(result, plan, started, finished):
+def probe_problem(result, started, finished, *, kind, delay):
     """Why the probe's ``result`` cannot be this run's measurement, or None: it has times, nobody set
     the time (:func:`clock_problem`), every time it records (wall clock) must lie between the probe's
-    start and the result's arrival, and the flight must have lasted its schedule (the long excursion at
-    least the delay)."""
+    start and the result's arrival, and the flight must have lasted its schedule (in a ``kind``
+    'main' run, the long excursion at least the rule's ``delay``)."""
     schedule = result.get('schedule') or {}
     times = [t for t in [result.get('t0')] + list(schedule.values()) if isinstance(t, (int, float))]
     if not times:
@@ -150,10 +151,10 @@ def probe_problem(result, plan, started, finished):
     if min(times) < started - 1.0 or max(times) > finished + 1.0:
         return 'the probe\'s times (%.1f to %.1f) are not within its run (%.1f to %.1f)' % (
             min(times), max(times), started, finished)
-    if plan.get('kind') == 'main' and 'long_up' in schedule and 'long_down' in schedule \
-            and schedule['long_down'] - schedule['long_up'] < plan['delay']:
+    if kind == 'main' and 'long_up' in schedule and 'long_down' in schedule \
+            and schedule['long_down'] - schedule['long_up'] < delay:
         return 'the long excursion lasted %.1f s, less than the %.1f s delay' % (
-            schedule['long_down'] - schedule['long_up'], plan['delay'])
+            schedule['long_down'] - schedule['long_up'], delay)
     return None
 
 
@@ -187,9 +188,9 @@ for node in config.nodes:
 '''
 
 
-def launch_verdict(sup, job, base_env, box, timeout=LAUNCH_CHECK_TIMEOUT):
-    """roslaunch's verdict on the student's launch file as handed in (``job["handed_in_launch"]``, in
-    the workspace's src/), read by roslaunch's own loader (:data:`_LAUNCH_CHECK`) in the box before
+def launch_verdict(sup, box, base_env, *, workspace, handed_in_launch, timeout=LAUNCH_CHECK_TIMEOUT):
+    """roslaunch's verdict on the student's launch file as handed in (``handed_in_launch``, in the
+    ``workspace``'s src/), read by roslaunch's own loader (:data:`_LAUNCH_CHECK`) in the box before
     anything of the student's has run: the session asks for it before the build, with the underlay's
     environment and the package's folder on ROS_PACKAGE_PATH (all ``$(find exam)`` needs), never the
     student's devel/setup.bash (its environment hooks would run first and could answer for roslaunch),
@@ -197,15 +198,15 @@ def launch_verdict(sup, job, base_env, box, timeout=LAUNCH_CHECK_TIMEOUT):
     can write the workspace's). ``{"file" (in the package), "status" (exit code, None when it did not
     finish), "refused" (roslaunch's words, '' when accepted), "warnings" [lines], "nodes" [names]}``;
     None without a launch file. The output comes from the box: capped, read as text."""
-    relative = job.get('handed_in_launch')
+    relative = handed_in_launch
     if not relative:
         return None
-    path = os.path.join(job['workspace'], 'src', relative)
-    packages = ':'.join(p for p in (os.path.join(job['workspace'], 'src'), base_env.get('ROS_PACKAGE_PATH')) if p)
+    path = os.path.join(workspace, 'src', relative)
+    packages = ':'.join(p for p in (os.path.join(workspace, 'src'), base_env.get('ROS_PACKAGE_PATH')) if p)
     env = dict(base_env, ROS_PACKAGE_PATH=packages, ROS_HOME=os.path.join(box.home, 'ros-check'))
     status, output, _ = sup.run('launch-check', box.argv(['/usr/bin/python3', '-c', _LAUNCH_CHECK, path], env,
                                                          cwd=box.home), timeout=timeout)
-    lines = [l.strip()[:300] for l in clean_text(output).replace(job['workspace'].rstrip('/') + '/src/', '')
+    lines = [l.strip()[:300] for l in clean_text(output).replace(workspace.rstrip('/') + '/src/', '')
              .splitlines() if l.strip()]
     words = [l for l in lines if not l.startswith('/')]
     return {'file': relative.split('/', 1)[-1], 'status': status,
@@ -289,7 +290,7 @@ def run_one(sup, job, run, base_env, box, budget):
     """Start a master, the student's launch (in the box) and the probe; return the run's record. The
     probe is waited for at most the run's limit or what is left of the ``budget``."""
     tag = run['tag']
-    log_dir, judge_dir = sup.log_dir, job['judge_home']
+    log_dir, judge_dir = sup.log_dir, job.judge_home
     reset_memory_peak(box.judge_cgroups.get('master', []))
     killed_before = (memory_use(box.judge_cgroups.get('master', [])) or {}).get('oom_kills', 0)
     master = sup.start_master(name='master-%s' % tag, wrap=box.judge_argv([], 'master'),
@@ -298,20 +299,21 @@ def run_one(sup, job, run, base_env, box, budget):
     launch_env = ros_env(base_env, master.uri, os.path.join(box.home, 'ros-%s' % tag), ip='127.0.0.1')
     launch = sup.start('launch-%s' % tag, box.argv(
         ['bash', '-c', 'source "$1/devel/setup.bash" && exec roslaunch --screen "$2"', 'bash',
-         job['workspace'], run['launch']], launch_env))
+         job.workspace, run['launch']], launch_env))
     plan_path = os.path.join(judge_dir, 'plan-%s.json' % tag)
     result_path = os.path.join(judge_dir, 'probe-%s.json' % tag)
+    plan = PlanRecord.make(run['plan'])
     for path in (plan_path, os.path.join(log_dir, 'plan-%s.json' % tag)):  # the judge's, and the progress's
         with open(path, 'w') as f:
-            json.dump(run['plan'], f, indent=1, sort_keys=True)
+            f.write(plan.to_json())
     probe_env = ros_env(master.env, master.uri, os.path.join(judge_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')
-    probe_env['ROS_NAMESPACE'] = job.get('namespace', '/')
+    probe_env['ROS_NAMESPACE'] = job.namespace or '/'
     started, started_wall = time.monotonic(), time.time()
     probe = sup.start('probe-%s' % tag, box.judge_argv(
         [sys.executable, '-m', 'exam_lab.grader.judge.probe', plan_path, result_path], 'probe'), probe_env)
     # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
     # nothing it does when its drone goes away (a failed service call, a crash) is counted.
-    limit, by_budget = budget.limit(job['run_timeout'], RUN_STOP_S)
+    limit, by_budget = budget.limit(job.run_timeout, RUN_STOP_S)
     wait_until(lambda: os.path.isfile(result_path) or probe.poll() is not None or master.proc.poll() is not None,
                limit, period=0.1)
     record['seconds'] = time.monotonic() - started
@@ -321,7 +323,7 @@ def run_one(sup, job, run, base_env, box, budget):
     record['launch_running'] = launch.poll() is None
     master_died = master.proc.poll() is not None
     # Read before stopping: what the nodes print when the grader stops them is not their doing.
-    record['launch'] = launch_outcome(capped_log(sup, 'launch-%s' % tag), job['workspace'])
+    record['launch'] = launch_outcome(capped_log(sup, 'launch-%s' % tag), job.workspace)
     sup.stop(launch)
     record['survivors'] = box.end()
     if os.path.lexists(result_path):
@@ -332,13 +334,13 @@ def run_one(sup, job, run, base_env, box, budget):
         record['launch']['ended'].extend(watched_deaths(record['probe']))  # whether or not the run is refused
         with open(os.path.join(log_dir, 'probe-%s.json' % tag), 'w') as f:
             json.dump(record['probe'], f, indent=1, sort_keys=True)
-        problem = probe_problem(record['probe'], run['plan'], started_wall, time.time())
+        problem = probe_problem(record['probe'], started_wall, time.time(), kind=plan.kind, delay=plan.delay)
         if problem:
             refuse(record, problem)
     elif 'probe_error' not in record and record.get('budget'):
         record['probe_error'] = record['budget']
     elif 'probe_error' not in record:
-        record['probe_error'] = ('no result within the run\'s time limit (%.0f s); ' % job['run_timeout']
+        record['probe_error'] = ('no result within the run\'s time limit (%.0f s); ' % job.run_timeout
                                  if probe.poll() is None else
                                  'exit %s; ' % probe.poll()) + tail(sup.output('probe-%s' % tag), 15)
     record['probe_status'] = sup.stop(probe, grace=5.0)
@@ -376,31 +378,32 @@ def session(job):
     """Check, build and run one submission (the module's docstring); returns the value of its
     :class:`~exam_lab.grader.score.records.SessionRecord`."""
     result = {'outcome': Outcome.RAN, 'build': None, 'runs': [], 'survivors': 0}
-    box = Box.attached(job['box'])
+    box = Box.attached(job.box)
     # The judge keeps the grader's environment, with a HOME and ROS folders of its own the box cannot
     # see; its folder is its own (0700), where it writes as its uid.
-    judge_dir = job['judge_home']
+    judge_dir = job.judge_home
     if box.judge_uid is not None:
         os.chown(judge_dir, box.judge_uid, box.judge_uid)
     os.chmod(judge_dir, 0o700)
     judge_env = dict(os.environ, ROS_IP='127.0.0.1', HOME=judge_dir, PYTHONNOUSERSITE='1',
                      ROS_LOG_DIR=os.path.join(judge_dir, 'ros_log'), ROS_HOME=os.path.join(judge_dir, 'ros_home'))
-    budget = Budget(job['budget'], job['student_budget'])
-    with Supervisor(job['log_dir'], env=judge_env) as sup:
-        base_env = workspace_env(job['underlay'], {'PATH': os.environ.get('PATH', '/usr/bin:/bin'),
+    budget = Budget(job.budget, job.student_budget)
+    with Supervisor(job.log_dir, env=judge_env) as sup:
+        base_env = workspace_env(job.underlay, {'PATH': os.environ.get('PATH', '/usr/bin:/bin'),
                                                    'LANG': 'C.UTF-8'})
         # roslaunch's verdict first: nothing of the student's has run yet (no build, no environment hook).
         limit, by_budget = budget.limit(LAUNCH_CHECK_TIMEOUT, STEP_STOP_S)
-        result['launch_check'] = launch_verdict(sup, job, base_env, box, timeout=limit)
+        result['launch_check'] = launch_verdict(sup, box, base_env, workspace=job.workspace,
+                                                handed_in_launch=job.handed_in_launch, timeout=limit)
         result['survivors'] += box.end()
         if by_budget and (result['launch_check'] or {}).get('status', 0) is None:
             result['budget_used'] = result['error'] = budget.spend(
                 'roslaunch\'s check of the launch file was stopped after %.0f s' % limit)
             result['outcome'] = Outcome.CHECK_STOPPED
             return result
-        limit, by_budget = budget.limit(job['build_timeout'], STEP_STOP_S)
+        limit, by_budget = budget.limit(job.build_timeout, STEP_STOP_S)
         status, _, seconds = sup.run(
-            'build', box.argv(['catkin_make', '--directory', job['workspace'],
+            'build', box.argv(['catkin_make', '--directory', job.workspace,
                                '-DPYTHON_EXECUTABLE=/usr/bin/python3', '-DCATKIN_ENABLE_TESTING=OFF'],
                               dict(base_env, ROS_HOME=os.path.join(box.home, 'ros'))),
             timeout=limit)
@@ -414,14 +417,13 @@ def session(job):
             result['budget_used'] = budget.used
             result['outcome'] = Outcome.BUILD_STOPPED if status is None else Outcome.BUILD_FAILED
             return result
-        for run in job['runs']:
+        for run in job.runs:
             if run['tag'] == 'threshold':
                 main = result['runs'][0]['probe'] if result['runs'] else None
                 if not warned_in_long_excursion(main):
                     result['threshold_skipped'] = 'the node never warned in the main run'
                     break
-                run = dict(run, plan=dict(run['plan'], fit=main['calibration'].get('fit'),
-                                          warn_after=warning_latency(main)))
+                run = dict(run, plan=dict(run['plan'], warn_after=warning_latency(main)))
             if budget.left(RUN_STOP_S) < MIN_RUN_S:
                 budget.spend('the %s run was not started (%.0f s left)' % (run['tag'], budget.left()))
                 break
@@ -435,16 +437,19 @@ def main(argv):
     if len(argv) != 1:
         sys.stderr.write('usage: python3 -m exam_lab.grader.host.session JOB.json\n')
         return 2
-    with open(argv[0]) as f:
-        job = json.load(f)
+    try:
+        job = JobRecord.read(argv[0])
+    except RecordError as err:  # the grader's own bug, as below
+        sys.stderr.write('the job is not one: %s\n' % err)
+        return 1
     try:
         record = SessionRecord.make(session(job))
     except RecordError as err:  # the grader's own bug: the runner says the session failed, and why
         sys.stderr.write('the session\'s record is not one: %s\n' % err)
         return 1
-    with open(os.path.join(job['log_dir'], SessionRecord.FILE + '.part'), 'w') as f:
+    with open(os.path.join(job.log_dir, SessionRecord.FILE + '.part'), 'w') as f:
         f.write(record.to_json())
-    os.rename(os.path.join(job['log_dir'], SessionRecord.FILE + '.part'), os.path.join(job['log_dir'], SessionRecord.FILE))
+    os.rename(os.path.join(job.log_dir, SessionRecord.FILE + '.part'), os.path.join(job.log_dir, SessionRecord.FILE))
     return 0
 
 

@@ -33,7 +33,7 @@ class NodeFinder(object):
     def wait_for_node(self):
         """The probe's result's ``nodes`` (none when no node came within the plan's ``start_timeout``)
         and ``node_seen_s``; once a node came, also ``subscribed`` and ``input_types``."""
-        nodes = wait_until(lambda: self.graph.student_nodes() or None, self.plan['start_timeout'], period=0.1)
+        nodes = wait_until(lambda: self.graph.student_nodes() or None, self.plan.start_timeout, period=0.1)
         found = {'nodes': nodes or [], 'node_seen_s': None if not nodes else time.time() - self.t0}
         if not nodes:
             return found
@@ -92,7 +92,7 @@ class NodeFinder(object):
         else the likeliest numeric one it publishes) and the recorder that reads it: ``recorder`` (the
         drone's, of the sheet's topic in Float32), a new one for another topic or type, None for a type
         the probe cannot read values from."""
-        expected = rospy.resolve_name(self.plan['output'])
+        expected = rospy.resolve_name(self.plan.output)
         found = wait_until(lambda: expected in self.graph.publications(), OUTPUT_S, period=0.1)
         publications = self.graph.publications()
         output = {'expected': expected, 'topic': None, 'type': None,
@@ -101,7 +101,7 @@ class NodeFinder(object):
             output.update(topic=expected, type=publications[expected])
         else:
             candidates = sorted(t for t, kind in publications.items() if kind in VALUE_TYPES)
-            preferred = [t for t in candidates if self.plan['output'][:3] in t.lower()] or candidates
+            preferred = [t for t in candidates if self.plan.output[:3] in t.lower()] or candidates
             if preferred:
                 output.update(topic=preferred[0], type=publications[preferred[0]])
         topic, kind = output['topic'], output['type']

@@ -67,8 +67,8 @@ class Calibration(object):
     def formula(self):
         """Question 11's check points: (fixed input, oracle value) pairs; returns the probe's result's
         ``formula`` (one row a point) and the calibration points."""
-        drone, threshold, margin = self.inputs.drone, self.plan['threshold'], self.plan['margin']
-        sheet = self.plan['sheet']
+        drone, threshold, margin = self.inputs.drone, self.plan.threshold, self.plan.margin
+        sheet = self.plan.sheet
         other_fixed = {'altitude': -5.0, 'depth': 90000.0}[sheet]
         cases = [(drone.fixed_value, threshold - 2 * margin), (drone.fixed_value, threshold + 2 * margin),
                  (other_fixed, threshold)]
@@ -97,7 +97,7 @@ class Calibration(object):
         threshold: fits value = a*x + b through the check points, flies there, corrects with the
         fitted slope (twice at most). Falls back to the oracle's values when that fails. Returns the
         probe's result's ``calibration`` and the oracle values ``(lo, hi, near)`` to fly."""
-        threshold, margin = self.plan['threshold'], self.plan['margin']
+        threshold, margin = self.plan.threshold, self.plan.margin
         targets = {'lo': threshold - margin, 'hi': threshold + margin, 'near': threshold - NEAR_M}
         # How close to its target each value must come: the near one just below the threshold.
         close = {'lo': lambda v, t: abs(v - t) < margin / 3, 'hi': lambda v, t: abs(v - t) < margin / 3,
@@ -159,7 +159,7 @@ class Flight(object):
         since = self.fly(x)
         start = since
         if self.recorder is not None:
-            threshold = self.plan['threshold']
+            threshold = self.plan.threshold
             reached = wait_until(lambda: next((t for t, v in self.recorder.samples(since)
                                                if on_side(v, threshold, side)), None), REACH_S, period=0.05)
             start = reached if reached is not None else since
@@ -174,8 +174,8 @@ class Flight(object):
         """Fly every leg of FLIGHT_LEGS; returns the probe's result's ``schedule`` (each leg's input
         change, and the end), ``legs`` (each checked on the node's own values) and, when the output
         could be read, ``rate`` (how often the node published during the flight)."""
-        delay = self.plan['delay']
-        late = self.plan.get('late_warning', 0.0)
+        delay = self.plan.delay
+        late = self.plan.late_warning
         late_normal = normal_wait(delay, self.drone.rates)
         schedule = {}
         schedule['rest'] = self.leg(lo, 'below', REST_S, late_normal)[0]
@@ -207,6 +207,6 @@ class Flight(object):
         for name in names:
             end = schedule[keys[keys.index(name) + 1]]
             side = 'above' if name.endswith('up') or name == 'step' else 'below'
-            out[name] = leg_check(self.recorder.samples(schedule[name]), self.plan['threshold'], side,
+            out[name] = leg_check(self.recorder.samples(schedule[name]), self.plan.threshold, side,
                                   schedule[name], end)
         return out

@@ -55,6 +55,7 @@ from exam_lab.grader.judge.pilot import Calibration, Flight, Inputs
 from exam_lab.grader.judge.graph import ClockWatch, Graph, NodeWatch, RefusedConnections, node_pid, node_uri
 from exam_lab.grader.judge.legs import AFTER_S, trace
 from exam_lab.grader.judge.node import NodeFinder
+from exam_lab.grader.score.records import PlanRecord, RecordError
 from exam_lab.harness.fake_drone import Drone
 
 
@@ -64,8 +65,8 @@ class Probe(object):
 
     def __init__(self, plan):
         self.plan = plan
-        self.result = {'kind': plan['kind'], 'sheet': plan['sheet'], 'threshold': plan['threshold'],
-                       'margin': plan['margin'], 'delay': plan['delay'], 'start_timeout': plan['start_timeout']}
+        self.result = {'kind': plan.kind, 'sheet': plan.sheet, 'threshold': plan.threshold,
+                       'margin': plan.margin, 'delay': plan.delay, 'start_timeout': plan.start_timeout}
         self.graph = Graph()
         self.refusals = RefusedConnections()
         logging.getLogger('rosout').addHandler(self.refusals)
@@ -73,7 +74,7 @@ class Probe(object):
         # Handles of the watch's own: an XML-RPC connection is never shared between two threads.
         watched, lookups = Graph(), rosgraph.Master(rospy.get_name())
         self.watch = NodeWatch(watched.student_nodes, lambda name: node_uri(lookups, name), node_pid).start()
-        self.drone = Drone(plan['sheet'], clock=time.time, on_ticks=True)
+        self.drone = Drone(plan.sheet, clock=time.time, on_ticks=True)
         self.result['input_rates'] = dict(self.drone.rates)
         self.recorder = self.drone.output
         self.inputs = Inputs(self.drone)
@@ -86,16 +87,16 @@ class Probe(object):
         stays below the launch file's threshold. A WARNING that came late in the main run
         (``warn_after``) is waited for that long, no longer: a node that ignores the new value costs
         the long excursion, not the late window."""
-        warn_after = self.plan.get('warn_after')
+        warn_after = self.plan.warn_after
         if warn_after is not None:
-            self.plan['late_warning'] = min(self.plan.get('late_warning', 0.0),
-                                            max(warn_after, self.plan['delay']) + AFTER_S)
+            self.plan = self.plan.replaced(late_warning=min(self.plan.late_warning,
+                                                            max(warn_after, self.plan.delay) + AFTER_S))
         self.main_flight()
 
     def main_flight(self):
         """The scenario's steps 1 to 4: a step whose node, or whose readable output, is missing ends it."""
         # Inputs from the start: a node that waits for data before it subscribes to the rest still runs.
-        self.inputs.fly(self.plan['threshold'] - self.plan['margin'])
+        self.inputs.fly(self.plan.threshold - self.plan.margin)
         finder = NodeFinder(self.plan, self.graph, self.refusals, self.drone, self.t0)
         found = finder.wait_for_node()
         self.result.update(found)
@@ -110,7 +111,7 @@ class Probe(object):
         self.result.update(flight.fly_legs(lo, hi, near))
 
     def run(self):
-        if self.plan['kind'] == 'main':
+        if self.plan.kind == 'main':
             self.main_flight()
         else:
             self.threshold_check()
@@ -143,8 +144,11 @@ def main(argv):
     if len(argv) != 2:
         sys.stderr.write('usage: python3 -m exam_lab.grader.judge.probe PLAN.json RESULT.json\n')
         return 2
-    with open(argv[0]) as f:
-        plan = json.load(f)
+    try:
+        plan = PlanRecord.read(argv[0])
+    except RecordError as err:  # the grader's own bug: the session says the probe failed, and why
+        sys.stderr.write('the plan is not one: %s\n' % err)
+        return 2
     rospy.init_node('grader_probe', disable_signals=True)
     probe = Probe(plan)
     try:

@@ -86,8 +86,8 @@ def rescore(out):
             continue
         record = score(measured, how='rescore')
         before = {i['id']: i['points'] for i in old.get('items', [])}
-        record['previous'] = {'total': old.get('total'), 'status': old.get('status'), 'items': before,
-                              'provenance': old.get('provenance')}
+        record = dict(record, previous={'total': old.get('total'), 'status': old.get('status'), 'items': before,
+                                        'provenance': old.get('provenance')})
         moved = ['%s %s -> %s' % (i['id'], report.points_text(before.get(i['id'])), report.points_text(i['points']))
                  for i in record['items'] if before.get(i['id']) != i['points']]
         if old.get('status') != record['status']:
@@ -95,20 +95,19 @@ def rescore(out):
         if moved:
             changes.append('%s: %s -> %s (%s)' % (record['student'], report.points_text(old.get('total')),
                                                  report.points_text(record['total']), '; '.join(moved)))
-        report.write_grade(folder, record)
-        graded.append(record)
+        graded.append(report.write_grade(folder, record))
     if folders and folders != [out]:
         report.write_csv(os.path.join(out, 'grades.csv'), graded)
     return graded, changes
 
 
 def no_session(outcome, error, **more):
-    """The session's record (:class:`~exam_lab.grader.score.records.SessionRecord`'s value) of a grading
+    """The session's record (a :class:`~exam_lab.grader.score.records.SessionRecord`) of a grading
     whose session did not run or failed: its ``outcome`` (an
     :class:`~exam_lab.grader.score.records.Outcome`), ``error`` (why, for the teacher) and ``more``
     (``refused``, ``no_node``, ``budget_used``, ``survivors``)."""
     return records.SessionRecord.make(dict(more, outcome=outcome, build=None, runs=[],
-                                           error=error[:records.MAX_LOG_TEXT])).value
+                                           error=error[:records.MAX_LOG_TEXT]))
 
 
 def could_not_grade(student, sheet, why, notes=()):
@@ -116,7 +115,7 @@ def could_not_grade(student, sheet, why, notes=()):
     sheet = sheet or 'altitude'
     session = no_session(records.Outcome.GRADER_FAILED, 'could not grade: %s' % why)
     return report.grade_record(student, sheet, rubric.score(sheet, {}, session),
-                               list(notes) + [session['error']], {'seconds': 0.0, 'provenance': provenance.stamp()},
+                               list(notes) + [session.error], {'seconds': 0.0, 'provenance': provenance.stamp()},
                                rubric.status({}, session))
 
 

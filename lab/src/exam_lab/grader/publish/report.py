@@ -88,13 +88,15 @@ def markdown(record):
 
 
 def write_grade(out_dir, record):
-    """Write ``grade.json`` and ``grade.md`` into ``out_dir``."""
+    """Write ``grade.json`` and ``grade.md`` into ``out_dir``; return the grade as written (the value
+    of its :class:`~exam_lab.grader.score.kept.GradeRecord`: checked, read-only)."""
     os.makedirs(out_dir, exist_ok=True)
     record = kept.GradeRecord.make(record)
     with open(os.path.join(out_dir, kept.GradeRecord.FILE), 'w') as f:
         f.write(record.to_json() + '\n')
     with open(os.path.join(out_dir, 'grade.md'), 'w') as f:
         f.write(markdown(record.value))
+    return record.value
 
 
 def write_csv(path, records):

@@ -58,8 +58,9 @@ class MeasurementsRecord(Record):
         'extra': dict(_FACTS, seconds=Number(0)),
     }
 
-    def validate(self):
-        self.session['outcome'] = Outcome(self.session['outcome'])  # as the session's own record has it
+    @classmethod
+    def converted(cls, value):
+        return dict(value, session=SessionRecord.converted(value['session']))  # as the session's own record has it
 
     @classmethod
     def upgraded(cls, value):

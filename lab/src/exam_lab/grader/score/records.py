@@ -202,6 +202,59 @@ class ProbeRecord(Record):
     }
 
 
+#: A folder or file of the grader's machine (the session's work folders, the underlay).
+_PATH = Text(4096)
+
+
+class PlanRecord(Record):
+    """One run's plan, the judge's orders (``plan-<tag>.json``, :mod:`exam_lab.grader.judge.probe`):
+    the sheet, the threshold flown and its margin, the rule's delay, how long the node may take to
+    start, the output topic expected, how long a late WARNING is waited for (``late_warning``; 0 when
+    the code calls no service). Made by :func:`exam_lab.grader.runner.plan_job`; for the threshold run
+    the session adds the main run's calibration (``fit``) and the node's WARNING latency
+    (``warn_after``)."""
+    FILE = 'plan.json'
+    MAX_BYTES = 1 << 16
+    SCHEMA = {
+        'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
+        'margin': Number(0), 'delay': Number(0), 'start_timeout': Number(0), 'output': _NAME,
+        'late_warning': Number(0), 'fit': Optional(Maybe(Row(_VALUE, _VALUE))), 'warn_after': Optional(Maybe(Number())),
+    }
+
+
+#: A box as the runner opened it, for the session to make its command lines
+#: (:meth:`exam_lab.grader.host.sandbox.Box.describe`).
+_BOX = {'work': _PATH, 'bwrap': bool, 'cpus': Maybe(Number(0, 4096)), 'binds': [_PATH],
+        'slot': Maybe(Number(0, 1e6, integer=True)), 'cgroups': [_PATH], 'judge_cgroups': Map(Text(50), [_PATH], 10),
+        'rootless': bool, 'owner': Maybe(Number(0, 2 ** 32, integer=True)), 'netns': Maybe(Text(200))}
+
+
+class JobRecord(Record):
+    """The session's job (``job.json``, read by :mod:`exam_lab.grader.host.session`): the runs (each its
+    tag, its launch file, its :class:`PlanRecord`'s value), the student's namespace, the time limits, the
+    launch file as handed in (for roslaunch's check). :func:`~exam_lab.grader.runner.plan_job` makes it
+    from the inspection, the launch files relative to the workspace;
+    :func:`~exam_lab.grader.runner.run_session` adds where the session runs (``workspace``, the
+    ``underlay``, the folders, the ``box``) and the student's ``budget``, the launch files then absolute."""
+    FILE = 'job.json'
+    MAX_BYTES = 1 << 20
+    SCHEMA = {
+        'namespace': Text(1000), 'build_timeout': Number(0), 'run_timeout': Number(0),
+        'runs': Items({'tag': OneOf('main', 'threshold'), 'launch': _PATH, 'plan': PlanRecord.SCHEMA}, 2),
+        'handed_in_launch': Maybe(_PATH),
+        'workspace': Optional(_PATH), 'underlay': Optional(_PATH), 'log_dir': Optional(_PATH),
+        'judge_home': Optional(_PATH), 'box': Optional(_BOX), 'budget': Optional(Number()),
+        'student_budget': Optional(Number(0)),
+    }
+
+    def validate(self):
+        if [run['tag'] for run in self.runs] not in (['main'], ['main', 'threshold']):
+            raise RecordError('job.json.runs: the main run, then the threshold run if any')
+        for run in self.runs:
+            if run['plan']['kind'] != run['tag']:
+                raise RecordError('job.json.runs: the %s run with a plan of a %s run' % (run['tag'], run['plan']['kind']))
+
+
 class Outcome(str, enum.Enum):
     """How one grading ended (``outcome`` of :class:`SessionRecord`). A member is its string too: the
     JSON holds ``"ran"``, and ``Outcome.RAN == 'ran'``, so a reader of the old strings reads it the same."""
@@ -270,5 +323,6 @@ class SessionRecord(Record):
         'threshold_skipped': Optional(Text()), 'refused': Optional(bool), 'no_node': Optional(bool),
     }
 
-    def validate(self):
-        self.value['outcome'] = self.outcome = Outcome(self.outcome)
+    @classmethod
+    def converted(cls, value):
+        return dict(value, outcome=Outcome(value['outcome']))

@@ -187,10 +187,71 @@ def relative(path, where):
     return path
 
 
+class _ReadOnly(object):
+    """What :class:`Frozen` and :class:`FrozenList` share: every change refused, a copy itself, a deep
+    copy plain (:func:`thawed`), a pickle of the plain value."""
+    __slots__ = ()
+
+    def _refuse(self, *args, **kwargs):
+        raise TypeError('a record is read-only: make a new value (dict(value, key=...)) and a new record')
+
+    def __copy__(self):
+        return self
+
+    def __deepcopy__(self, memo):
+        return thawed(self)
+
+    def __reduce__(self):
+        return type(self), (self._PLAIN(self),)
+
+
+class Frozen(_ReadOnly, dict):
+    """An object of a record: read as a dict is (``json`` writes it, ``isinstance(x, dict)`` holds,
+    ``dict(x, key=...)`` is a new plain one), changed by nothing: a record made is the record every
+    later reader sees. ``copy.deepcopy`` gives a plain, changeable copy (:func:`thawed`)."""
+    __slots__ = ()
+    _PLAIN = dict
+    __setitem__ = __delitem__ = __ior__ = clear = pop = popitem = setdefault = update = _ReadOnly._refuse
+
+
+class FrozenList(_ReadOnly, list):
+    """A list of a record, read-only as :class:`Frozen` is (``list(x)`` or ``x + [...]`` is a new plain one)."""
+    __slots__ = ()
+    _PLAIN = list
+    __setitem__ = __delitem__ = __iadd__ = __imul__ = append = clear = extend = insert = pop = remove = reverse = \
+        sort = _ReadOnly._refuse
+
+
+def frozen(value):
+    """``value`` (JSON data) with every object a :class:`Frozen` and every list a :class:`FrozenList`."""
+    if isinstance(value, dict):
+        return value if isinstance(value, Frozen) and _all_frozen(value.values()) else \
+            Frozen((key, frozen(inner)) for key, inner in value.items())
+    if isinstance(value, (list, tuple)):
+        return FrozenList(frozen(inner) for inner in value)
+    return value
+
+
+def _all_frozen(values):
+    return all(not isinstance(v, (dict, list, tuple)) or isinstance(v, (Frozen, FrozenList)) for v in values)
+
+
+def thawed(value):
+    """A plain, changeable deep copy of ``value`` (a record's value or a part of one)."""
+    if isinstance(value, dict):
+        return {key: thawed(inner) for key, inner in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [thawed(inner) for inner in value]
+    return value
+
+
 class Record(object):
     """A record type: its file's name (``FILE``), its cap (``MAX_BYTES``), its ``SCHEMA``; a record's
     attributes are the schema's keys (None when an optional one is missing), ``value`` the whole
-    checked object; two records are equal when their JSON is (NaN included). A record type whose
+    checked object; two records are equal when their JSON is (NaN included). A record is frozen, as a
+    frozen dataclass is and deeper: no attribute can be set, and its objects and lists
+    (:class:`Frozen`, :class:`FrozenList`) refuse every change, so what a stage hands on is what the
+    next one reads; :meth:`replaced` makes a new record of changed fields, checked again. A record type whose
     files outlive the grader that wrote them (:mod:`exam_lab.grader.score.kept`) brings an older
     shape to its current one in :meth:`upgraded`, before the check. With ``CLEAN``, every string of the record, keys too, is
     :func:`~exam_lab.grader.score.safe_text.clean` once it matched its schema: the one place where
@@ -200,9 +261,26 @@ class Record(object):
     FILE = MAX_BYTES = SCHEMA = None
     CLEAN = NON_FINITE = False
 
+    __slots__ = ('value',)
+
     def __init__(self, value):
-        self.value = value
-        self.__dict__.update({key: value.get(key) for key in self.SCHEMA})
+        object.__setattr__(self, 'value', frozen(value))
+
+    def __getattr__(self, name):
+        if name in self.SCHEMA:
+            return self.value.get(name)
+        raise AttributeError('%s has no field %r' % (type(self).__name__, name))
+
+    def __setattr__(self, name, value):
+        raise AttributeError('a record is read-only: cannot set %r (replaced() makes a new one)' % name)
+
+    def __delattr__(self, name):
+        raise AttributeError('a record is read-only: cannot delete %r' % name)
+
+    def replaced(self, **changes):
+        """A new record of this type: this one's fields with ``changes``, checked as :meth:`make` checks
+        (as ``dataclasses.replace`` does for a dataclass)."""
+        return self.make(dict(self.value, **changes))
 
     def __eq__(self, other):
         return type(self) is type(other) and self.to_json() == other.to_json()
@@ -250,9 +328,14 @@ class Record(object):
             value = cleaned(value)
         elif cls.CLEAN:
             value = dict(value, **{key: cleaned(value[key]) for key in cls.CLEAN if key in value})
-        record = cls(value)
+        record = cls(cls.converted(value))
         record.validate()
         return record
+
+    @classmethod
+    def converted(cls, value):
+        """``value``, checked, with a field of its type made its Python type (a string its enum)."""
+        return value
 
     def to_json(self):
         """The record's JSON text: :meth:`from_json` of it gives the same record."""
