@@ -58,7 +58,7 @@ def main(argv=None):
         print('check: building the simulators (once: about a minute the first time)...')
         underlay = ensure_underlay(default_underlay())
         print('check: grading %s (about a minute)...' % args.package)
-        record = runner.grade_submission(args.package, out, args.sheet, student='your package', underlay=underlay,
+        record = runner.grade_submission(args.package, out, sheet=args.sheet, student='your package', underlay=underlay,
                                          on_step=progress.StepProgress(), unsandboxed=why is not None)
     except RuntimeError as err:
         sys.stderr.write('check: %s\n' % err)

@@ -70,7 +70,7 @@ def main(argv=None):
     out = os.path.abspath(args.out or os.path.join(workspace(), 'grades', name))
     try:
         if args.submission:
-            record = runner.grade_submission(args.submission, out, args.sheet, on_step=progress.StepProgress(),
+            record = runner.grade_submission(args.submission, out, sheet=args.sheet, on_step=progress.StepProgress(),
                                              unsandboxed=args.unsandboxed)
             say(report.table([record]))
             if record.get('status_reason'):
@@ -88,10 +88,10 @@ def main(argv=None):
             shown = progress.ClassProgress(jobs)
             try:
                 if args.engine == 'slurm':
-                    records = slurm.grade_class(args.klass, out, args.sheet, progress=shown,
+                    records = slurm.grade_class(args.klass, out, sheet=args.sheet, progress=shown,
                                                 unsandboxed=args.unsandboxed, sbatch_args=shlex.split(args.slurm_args))
                 else:
-                    records = class_run.grade_class(args.klass, out, args.sheet, jobs, progress=shown,
+                    records = class_run.grade_class(args.klass, out, sheet=args.sheet, jobs=jobs, progress=shown,
                                                  unsandboxed=args.unsandboxed)
             finally:
                 shown.close()

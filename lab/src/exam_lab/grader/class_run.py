@@ -141,7 +141,7 @@ def _unique(students, kept=None):
     return [(named[index], folder) for index, (_, folder) in enumerate(students)]
 
 
-def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None, on_step=None,
+def grade_student(name, folder, out_dir, *, sheet=None, underlay=None, isolate=None, on_step=None,
                   unsandboxed=False, jobs=1, refused=None):
     """Grade one student of a class into ``out_dir/name``; return the record. Anything the grader
     raises is this student's record ("could not grade"), never the class's. Both engines grade a
@@ -153,7 +153,8 @@ def grade_student(name, folder, out_dir, sheet=None, underlay=None, isolate=None
     if refused is not None:
         return _refused_at_intake(name, folder, os.path.join(out_dir, name), sheet, refused)
     try:
-        return runner.grade_submission(folder, os.path.join(out_dir, name), sheet, name, underlay, isolate,
+        return runner.grade_submission(folder, os.path.join(out_dir, name), sheet=sheet, student=name, underlay=underlay,
+                                       isolate=isolate,
                                        on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
     except Exception as err:  # anything: this student's row says so, the class goes on
         record = grades.could_not_grade(name, sheet, '%r' % err,
@@ -221,7 +222,7 @@ def class_similarity(klass, out, records_):
     return result
 
 
-def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progress=None, unsandboxed=False):
+def grade_class(class_path, out_dir, *, sheet=None, jobs=None, isolate=None, progress=None, unsandboxed=False):
     """Grade every student of a class, ``jobs`` side by side (default :func:`default_jobs`); write each
     one's grade and grades.csv. One student the grader cannot grade is that student's row ("could not
     grade"), never the class's.
@@ -246,9 +247,9 @@ def grade_class(class_path, out_dir, sheet=None, jobs=None, isolate=None, progre
             name, folder = students[index]
             if progress:
                 progress.started(name)
-            record = grade_student(name, folder, out_dir, sheet, underlay, isolate,
-                                   (lambda step: progress.step(name, step)) if progress else None, unsandboxed,
-                                   jobs=jobs, refused=refused.get(folder))
+            record = grade_student(name, folder, out_dir, sheet=sheet, underlay=underlay, isolate=isolate,
+                                   on_step=(lambda step: progress.step(name, step)) if progress else None,
+                                   unsandboxed=unsandboxed, jobs=jobs, refused=refused.get(folder))
             if progress:
                 progress.finished(record)
             return record

@@ -59,7 +59,7 @@ AFTER_BUDGET_S = 20.0
 SESSION_KILL_S = 5.0
 
 
-def grade_submission(submission, out_dir, sheet=None, student=None, underlay=None, isolate=None, keep=False,
+def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=None, isolate=None, keep=False,
                      on_step=None, extra=None, unsandboxed=False, jobs=1):
     """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
 
@@ -107,7 +107,7 @@ def grade_submission(submission, out_dir, sheet=None, student=None, underlay=Non
                     session = grades.no_session(Outcome.NOT_RUN, why, budget_used=why)
                 else:
                     how_run = teacher.how_run(box)
-                    session = run_session(job, work, underlay, isolate, box, on_step,
+                    session = run_session(job, work=work, underlay=underlay, isolate=isolate, box=box, on_step=on_step,
                                           left=deadline - time.monotonic())
         except (archives.UnpackError, staging.UploadRefused) as err:
             session = grades.no_session(Outcome.REFUSED, 'submission refused: %s' % err, refused=True)
@@ -170,7 +170,7 @@ def plan_job(record):
                                    'run_timeout': RUN_TIMEOUT, 'runs': runs, 'handed_in_launch': record.handed_in_launch})
 
 
-def run_session(job, work, underlay, isolate, box, on_step=None, left=STUDENT_BUDGET):
+def run_session(job, *, work, underlay, isolate, box, on_step=None, left=STUDENT_BUDGET):
     """Run the session of one submission, its student steps in ``box``; return what it measured (or
     why it could not): its :class:`~exam_lab.grader.score.records.SessionRecord`.
 

@@ -185,7 +185,7 @@ def run_task(manifest, index, out_dir, sheet=None, unsandboxed=False):
     # scancel and the time limit send SIGTERM: exit through the finally blocks, which end the
     # session's processes and remove the work folder.
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
-    record = class_run.grade_student(entry['student'], entry['submission'], out_dir, sheet, unsandboxed=unsandboxed,
+    record = class_run.grade_student(entry['student'], entry['submission'], out_dir, sheet=sheet, unsandboxed=unsandboxed,
                                   refused=entry.get('refused'))
     # Which node graded it (a lost node's students are graded again elsewhere): in grade.json too.
     record = report.write_grade(os.path.join(out_dir, entry['student']),
@@ -325,7 +325,7 @@ class _Array(object):
                     seconds, ', '.join(w for w in seen if w and w != 'None') if seen else 'never'))
 
 
-def grade_class(class_path, out_dir, sheet=None, progress=None, unsandboxed=False, sbatch_args=(),
+def grade_class(class_path, out_dir, *, sheet=None, progress=None, unsandboxed=False, sbatch_args=(),
                 poll_s=POLL_S, timeout=None):
     """Grade every student of a class on Slurm; write each one's grade and grades.csv as
     :func:`~exam_lab.grader.class_run.grade_class` does; return the records in the same order.
