@@ -1,16 +1,17 @@
 """Grading one submission, stage by stage (:func:`grade_submission`); each stage a call, a record in and a
 record out:
 
-1. **stage** (:func:`stage`): root copies the upload byte for byte into the box's work folder
-   (regular files, folders, links as links: :func:`~exam_lab.grader.host.staging.stage_upload`), never
-   parsing a student's bytes;
+1. **stage** (:func:`~exam_lab.grader.host.staging.stage_work`): root copies the upload byte for byte
+   into the box's work folder (regular files, folders, links as links:
+   :func:`~exam_lab.grader.host.staging.stage_upload`), never parsing a student's bytes;
 2. **inspect** (:func:`inspect`): :mod:`~exam_lab.grader.boxed.inspect` runs in the submission's
    :class:`~exam_lab.grader.host.sandbox.Box`, as the box's uid, without network, within
    :data:`~exam_lab.grader.host.boxed_run.INSPECT_BOUNDS` (unpacking, the package copied into the
    workspace, the teacher's fixes, launch and YAML analysis, the derived launch files, the source scan,
    PDF facts, comment statistics); root reads back one capped, checked
    :class:`~exam_lab.grader.score.records.InspectRecord` (:class:`~exam_lab.grader.host.boxed_run.Boxed`);
-3. **plan** (:func:`plan_job`): the session's job, computed once from that record;
+3. **plan** (:func:`plan_job`): the session's job, a :class:`~exam_lab.grader.score.records.JobRecord`
+   computed once from that record (each run's :class:`~exam_lab.grader.score.records.PlanRecord` the judge reads);
 4. **session** (:func:`run_session`): :mod:`exam_lab.grader.host.session` builds and runs the package in a
    network namespace with only loopback (:func:`~exam_lab.grader.host.bwrap.network_namespace`) under a
    :class:`~exam_lab.harness.supervisor.Supervisor` with the student's time limit; root reads back its
