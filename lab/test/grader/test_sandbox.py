@@ -180,6 +180,9 @@ def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
         for _, folder in students:
             assert folder.startswith(work_dirs[0] + '/') and os.stat(folder).st_uid >= uids.BOX_UID_BASE
             assert os.path.isfile(os.path.join(folder, 'exam', 'package.xml'))
+        # The teacher's CLASS= may be a link to the zip (a download kept elsewhere): the zip it names.
+        os.symlink(archive, str(tmp_path / 'latest.zip'))
+        assert [name for name, _ in class_run.class_students(str(tmp_path / 'latest.zip'), work_dirs)] == ['Bob', 'Jane Doe']
         with zipfile.ZipFile(archive, 'a') as zf:
             zf.writestr('../outside.txt', 'x')
         with pytest.raises(archives.UnpackError, match='unpacking it in its box failed'):

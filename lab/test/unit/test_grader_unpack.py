@@ -117,6 +117,25 @@ def test_student_folder_with_report_and_zip(tmp_path):
     assert package.package_name(os.path.join(found, 'package.xml')) == 'exam'
 
 
+def test_a_link_in_a_class_folder_is_never_followed_and_its_student_is_said(tmp_path):
+    """A student's folder that is a link (a teacher's class folder made of links to downloads kept
+    elsewhere) is that student's row, refused with why, never followed nor silently dropped; a link
+    not named as Moodle names a student is passed over."""
+    klass, elsewhere = tmp_path / 'class', tmp_path / 'elsewhere'
+    for folder in (klass / 'Ann_1_assignsubmission_file_', elsewhere / 'Bob_2_assignsubmission_file_'):
+        (folder / 'exam').mkdir(parents=True)
+        (folder / 'exam' / 'package.xml').write_text(PACKAGE_XML)
+    os.symlink(str(elsewhere / 'Bob_2_assignsubmission_file_'), str(klass / 'Bob_2_assignsubmission_file_'))
+    os.symlink(str(tmp_path / 'class.zip'), str(klass / 'Cy_3_assignsubmission_file_.zip'))
+    os.symlink(str(elsewhere), str(klass / 'latest'))
+    refused = {}
+    students = classlist.list_students(str(klass), None, refused)
+    assert [name for name, _ in students] == ['Ann', 'Bob', 'Cy']
+    assert refused == {str(klass / 'Bob_2_assignsubmission_file_'): classlist.LINKED,
+                       str(klass / 'Cy_3_assignsubmission_file_.zip'): classlist.LINKED}
+    assert [name for name, _ in classlist.list_students(str(klass), None)] == ['Ann'], 'no refusals asked: passed over'
+
+
 def test_refused_zip_is_reported(tmp_path):
     folder = tmp_path / 'student'
     folder.mkdir()

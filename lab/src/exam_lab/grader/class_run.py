@@ -57,13 +57,15 @@ def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
     its own (INTAKE_BOUNDS), in a work folder made in ``scratch`` (default: the system's temp folder) and
     appended to ``work_dirs`` (the caller removes it once the students are graded). ``refused`` (a
     dict) receives ``{folder: why}`` of the students whose files the intake refused by their own
-    bounds (:func:`grade_student`'s ``refused``).
+    bounds, or whose entry of a class folder is a link (:func:`grade_student`'s ``refused``).
 
     :raises archives.UnpackError: the archive could not be unpacked (why, and the end of the box's log).
     """
-    class_path = os.path.abspath(class_path)
+    # The teacher's path, followed (as a submission's is): a link to the class's zip is that zip. Its
+    # entries are not: a link in a class folder is passed over (classlist.list_students).
+    class_path = os.path.realpath(class_path)
     if not os.path.isfile(class_path):
-        return _unique(classlist.list_students(class_path, None), kept_folders(out))
+        return _unique(classlist.list_students(class_path, None, refused), kept_folders(out))
     if scratch:
         os.makedirs(scratch, mode=0o711, exist_ok=True)
     # One file, bounded as a class (a class of 60 with its PDFs is more than one upload may be).

@@ -30,6 +30,11 @@ CLASS_READ_BYTES = 4 * CLASS_BYTES
 _KEPT_END = 60
 
 
+#: Why a student's entry of a class folder that is a link is not graded (:func:`list_students`).
+LINKED = ('a link in the class folder, not a folder: the grader follows no link inside a class (put the '
+          'folder itself there, or grade it alone: make grade SUBMISSION=...)')
+
+
 def list_students(class_path, scratch, refused=None):
     """``[(student, folder or archive)]`` of a class: one sub-folder per student, as "download all"
     gives.
@@ -38,7 +43,8 @@ def list_students(class_path, scratch, refused=None):
     class's bounds as a whole, each student's files by the student's own; a student whose files are
     refused is listed all the same (an empty folder or file in its place) and ``refused`` (a dict)
     receives ``{its path: why}``. A class whose top holds archives instead of folders counts each
-    archive as one student (named after it).
+    archive as one student (named after it). A link is never followed; one named as Moodle names a
+    student's folder is listed and refused (:data:`LINKED`) when ``refused`` is given.
     """
     class_path = os.path.abspath(class_path)
     if os.path.isfile(class_path):
@@ -46,7 +52,14 @@ def list_students(class_path, scratch, refused=None):
     students = []
     for entry in sorted(os.listdir(class_path)):
         full = os.path.join(class_path, entry)
-        if _hidden(entry) or entry in SKIPPED_DIRS or os.path.islink(full):
+        if _hidden(entry) or entry in SKIPPED_DIRS:
+            continue
+        if os.path.islink(full):
+            # Never followed (what it names is nobody's upload); but one named as Moodle names a
+            # student's folder is that student's row, not graded, and why: never a student lost unsaid.
+            if refused is not None and participant_number(entry) is not None:
+                students.append((student_name(without_ending(entry)), full))
+                refused[full] = LINKED
             continue
         if os.path.isdir(full):
             students.append((student_name(entry), full))
