@@ -286,3 +286,13 @@ def test_a_garbled_manifest_line_stops_the_task_with_a_sentence(tmp_path, text, 
     with pytest.raises(RuntimeError) as raised:
         slurm.run_task(str(manifest), 1, str(tmp_path))
     assert str(raised.value).startswith('the Slurm manifest %s, line 2 ' % manifest) and said in str(raised.value)
+
+
+def test_the_task_says_in_one_line_why_its_manifest_line_cannot_be_graded(tmp_path, capsys):
+    """The task's log (kept in OUT/.slurm/logs/ and named in the student's row) holds the sentence."""
+    manifest = tmp_path / 'manifest.jsonl'
+    manifest.write_text('{"student": "Ann", "subm\n')
+    assert slurm.main(['task', str(manifest), '0', '--out', str(tmp_path)]) == 1
+    said = capsys.readouterr().err
+    assert said.startswith('exam_lab.grader.engine.slurm task 0: the Slurm manifest %s, line 1 cannot be read: '
+                           % manifest) and 'Traceback' not in said and said.count('\n') == 1

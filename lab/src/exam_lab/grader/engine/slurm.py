@@ -485,7 +485,11 @@ def main(argv=None):
     parser.add_argument('--sheet')
     parser.add_argument('--unsandboxed', action='store_true')
     args = parser.parse_args(argv)
-    run_task(args.manifest, args.index, args.out, args.sheet, args.unsandboxed)
+    try:
+        run_task(args.manifest, args.index, args.out, args.sheet, args.unsandboxed)
+    except RuntimeError as err:  # the manifest's line unusable: one sentence in the task's log
+        print('exam_lab.grader.engine.slurm task %d: %s' % (args.index, err), file=sys.stderr)
+        return 1
     return 0
 
 
