@@ -13,7 +13,6 @@ sandbox, no root. A change of the rubric that needs measurements
 the run did not make (a new flight, another input) needs make grade again (docs/grading.md).
 """
 import argparse
-import json
 import os
 import sys
 
@@ -45,10 +44,9 @@ def main(argv=None):
         for line in refused:
             print('  ' + safe_text.one_line(line))
     single = grades.graded_folders(out) == [out]
-    similar = None
-    if not single and os.path.isfile(os.path.join(out, 'similarity.json')):
-        with open(os.path.join(out, 'similarity.json')) as f:
-            similar = json.load(f)
+    # The run's similarity check, read as its record (capped, checked, its text clean); one that is
+    # not is said where its pairs would be.
+    similar = None if single else desk.read_similarity(out)
     for line in desk.finish(out, records, single=single, similar=similar, worksheet=args.worksheet,
                             scale=args.worksheet_scale):
         print(line)

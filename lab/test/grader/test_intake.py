@@ -122,7 +122,7 @@ def graded(tmp_path_factory):
     before = {r['student']: r for r in records}
     rescore = runpy.run_path(os.path.join(REPO, 'lab', 'scripts', 'rescore.py'))
     status = rescore['main'](['--out', out])
-    return {'out': out, 'records': before, 'similar': similar, 'lines': lines, 'rescore': status,
+    return {'out': out, 'records': before, 'similar': similar.value, 'lines': lines, 'rescore': status,
             'staged': staged, 'class': klass}
 
 

@@ -19,11 +19,12 @@ import pytest
 
 from exam_lab.grader import class_run
 from exam_lab.grader.publish import grades, teacher
-from exam_lab.grader.score.records import MEASUREMENTS
+from exam_lab.grader.score.records import MEASUREMENTS, SimilarityRecord
 from exam_lab.grader.host import session
 
 from exam_lab.grader.publish import desk, flightplot, gradescope, moodle, page, progress, report
 from exam_lab.grader.score import safe_text
+from exam_lab.grader.score.kept import GradeRecord
 from exam_lab.grader.score.sheets import ITEMS
 from test_grader_desk import probe_result
 from test_grader_probe_record import keep_runs
@@ -105,21 +106,31 @@ def out_grades_csv(tmp_path, record, monkeypatch, capsys):
     return [text.replace('\r\n', '\n')] + [cell for row in csv.reader(io.StringIO(text)) for cell in row]
 
 
+def as_read(tmp_path, record):
+    """``record`` as every reader of a grade gets it (make worksheet, make rescore, the desk): its
+    grade.json (written raw here, as a later grader or a hand could) read as a
+    :class:`~exam_lab.grader.score.kept.GradeRecord`, the one place its text is made safe. The
+    publishers clean nothing again (issue 37 point 1)."""
+    with open(str(tmp_path / 'grade.json'), 'w') as f:
+        json.dump(record, f)
+    return GradeRecord.read(str(tmp_path / 'grade.json')).value
+
+
 def out_worksheet(tmp_path, record, monkeypatch, capsys):
-    filled, summary = moodle.fill(WORKSHEET, [dict(record, status='graded')])
+    filled, summary = moodle.fill(WORKSHEET, [dict(as_read(tmp_path, record), status='graded')])
     assert len(summary['graded']) == 1  # the feedback was written: the test sees it
     return [filled] + moodle.summary_lines(summary, 'ws-filled.csv')
 
 
 def out_gradescope(tmp_path, record, monkeypatch, capsys):
-    gradescope.write(str(tmp_path), record)
+    gradescope.write(str(tmp_path), as_read(tmp_path, record))
     return [_read(str(tmp_path / 'results.json'))] + list(strings(json.loads(_read(str(tmp_path / 'results.json')))))
 
 
 def out_page(tmp_path, record, monkeypatch, capsys):
     out = tmp_path / 'out'
     os.makedirs(str(out / record['student'] / 'logs'))
-    lines = desk.finish(str(out), [record], similar={'error': 'similarity failed on %s' % HOSTILE})
+    lines = desk.finish(str(out), [record], similar=SimilarityRecord.make({'error': 'similarity failed on %s' % HOSTILE, 'notes': []}))
     return lines + [_read(str(out / 'index.html'))]
 
 
@@ -128,7 +139,7 @@ def out_grade_script(tmp_path, record, monkeypatch, capsys):
     (tmp_path / 'class').mkdir()
     os.makedirs(str(tmp_path / 'out' / record['student']))
     monkeypatch.setattr(class_run, 'grade_class', lambda *args, **kwargs: [record])
-    monkeypatch.setattr(class_run, 'class_similarity', lambda *args: {'pairs': [], 'students': 1})
+    monkeypatch.setattr(class_run, 'class_similarity', lambda *args: SimilarityRecord.make({'pairs': [], 'students': 1, 'notes': []}))
     assert _grade_script().main(['--class', str(tmp_path / 'class'), '--out', str(tmp_path / 'out')]) == 0
     printed = capsys.readouterr()
     assert 'need the teacher' in printed.out and 'Eve' in printed.out
@@ -271,7 +282,7 @@ def test_the_desk_survives_one_student_whose_part_fails(part, tmp_path, monkeypa
         return real(*args)
 
     monkeypatch.setattr(module, name, failing)
-    lines = desk.finish(str(out), records, similar={'pairs': [], 'students': 3}, worksheet=worksheet)
+    lines = desk.finish(str(out), records, similar=SimilarityRecord.make({'pairs': [], 'students': 3, 'notes': []}), worksheet=worksheet)
     for student in ('Ada', 'Eve'):
         assert os.path.isfile(str(out / student / 'flight.png'))
         assert os.path.isfile(str(out / student / 'results.json'))
@@ -356,9 +367,66 @@ def test_the_class_outputs_never_name_a_student(tmp_path):
     from exam_lab.grader.score import identity
     out, records, worksheet = class_desk(tmp_path)
     report.write_csv(str(out / 'grades.csv'), records)
-    desk.finish(str(out), records, similar={'pairs': [], 'students': 3}, worksheet=worksheet, title='Class')
+    desk.finish(str(out), records, similar=SimilarityRecord.make({'pairs': [], 'students': 3, 'notes': []}), worksheet=worksheet, title='Class')
     written = [n for n in os.listdir(str(out)) if not os.path.isdir(str(out / n))]
     assert written and [n for n in written if not n.lower().endswith(identity.OUTPUT_ENDINGS)] == []
     for name in written + ['hand.csv.zip', 'Index.HTML', 'grades.csv_12_assignsubmission_file_']:
         shown = identity.student_name(name)
         assert shown not in written and not shown.lower().endswith(identity.OUTPUT_ENDINGS), (name, shown)
+
+
+def test_the_publishers_take_records_only_the_desk_makes_them(tmp_path):
+    """Issue 37 point 1: text is made safe once, where its record is made; the publishers clean
+    nothing again. A raw grade (never passed through a GradeRecord: every text field carries
+    HOSTILE) reaches results.json, the worksheet, the feedback zip and the page through the desk,
+    which makes each grade its record: none of them shows a control character. A similarity check
+    given as a plain dict is refused by the desk and the page alike (its text would reach the page
+    uncleaned, its HTML unchecked)."""
+    import zipfile
+    out = tmp_path / 'out'
+    raw = dict(hostile_record('Eve'), status='graded')  # a name of the class's listing: its folder
+    os.makedirs(str(out / 'Eve'))
+    worksheet = tmp_path / 'ws.csv'
+    worksheet.write_text(WORKSHEET, encoding='utf-8')
+    lines = desk.finish(str(out), [raw], worksheet=str(worksheet), show='evidence')
+    written = [_read(str(out / 'index.html')), _read(str(out / 'Eve' / 'results.json')), _read(str(out / 'ws-filled.csv'))]
+    with zipfile.ZipFile(str(out / 'moodle-feedback.zip')) as zf:
+        written += [zf.read(name).decode('utf-8') for name in zf.namelist()]
+    assert len(written) == 4 and all('most recent call last' in text for text in written), lines
+    assert [text[:80] for text in written if CONTROL.search(text)] == []
+    hostile = {'pairs': [], 'students': 1, 'notes': ['Eve: not compared (%s)' % HOSTILE]}
+    with pytest.raises(TypeError):
+        desk.finish(str(out), [raw], similar=hostile)
+    with pytest.raises(TypeError):
+        page.render([], 'Class', {}, hostile)
+
+
+def test_make_rescore_reads_the_runs_similarity_json_as_its_record(tmp_path, capsys):
+    """rescore.py shows the run's similarity check from its record (capped, checked, its text made
+    safe); one edited into markup other than the detector's highlight, or of another shape, is no
+    record: the page says so where its pairs would be, and every grade is rescored all the same."""
+    import runpy
+    from html import unescape
+    from test_grader_kept import kept_folder
+    out = tmp_path / 'out'
+    for name in ('Ann', 'Bob'):
+        kept_folder(out, 'before-version', name)
+    match = {'file_a': 'scripts/a.py', 'file_b': 'scripts/b.py', 'sim_a': 0.9, 'sim_b': 0.9,
+             'html_a': "<span class='highlight-red'>x = 1</span>", 'html_b': 'x = 1'}
+    check = {'pairs': [{'a': 'Ann', 'b': 'Bob', 'score_a': 0.9, 'score_b': 0.9, 'files': [match]}],
+             'students': 2, 'threshold': 0.5, 'notes': ['Cy: not compared (%s)' % HOSTILE]}
+    script = runpy.run_path(os.path.join(REPO, 'lab', 'scripts', 'rescore.py'))
+    for kept, said in ((check, 'Ann and Bob: 90 % / 90 % alike'),
+                       (dict(check, pairs=[dict(check['pairs'][0], files=[dict(match, html_b='<img src=x onerror=alert(1)>')])]),
+                        "similarity check not run: the run's similarity.json cannot be read (make grade checks the class "
+                        "again): similarity.json.pairs[0].files[0].html_b: markup other than the detector's highlight"),
+                       ({'error': 'the box failed'}, 'similarity.json: notes is missing')):
+        (out / 'similarity.json').write_text(json.dumps(kept))
+        assert script['main'](['--out', str(out)]) == 0
+        html = _read(str(out / 'index.html'))
+        assert said in unescape(html) and CONTROL.search(html) is None and 'onerror' not in html
+    capsys.readouterr()
+    (out / 'similarity.json').write_text(json.dumps(check))
+    script['main'](['--out', str(out)])
+    html = _read(str(out / 'index.html'))
+    assert 'Cy: not compared (Traceback (most recent call last):17/17 graded' in html, 'its notes are on the page'

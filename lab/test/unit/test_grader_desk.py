@@ -13,6 +13,7 @@ import pytest
 from exam_lab.grader.boxed import documents
 
 from exam_lab.grader.publish import desk, flightplot, gradescope, hand, page, progress, report
+from exam_lab.grader.score.records import SimilarityRecord
 from exam_lab.grader.score.sheets import ITEMS
 from test_grader_probe_record import keep_runs
 
@@ -107,7 +108,8 @@ def test_page_has_one_row_per_student_and_the_teacher_first(tmp_path):
     pairs = [{'a': 'Jane Doe', 'b': 'Bob', 'score_a': 0.9, 'score_b': 0.8,
               'files': [{'file_a': 'scripts/n.py', 'file_b': 'scripts/m.py', 'sim_a': 0.9, 'sim_b': 0.8,
                          'html_a': "<span class='highlight-red'>x = 1</span>", 'html_b': 'y'}]}]
-    text = page.render(records, 'Class', entries, pairs, ['worksheet: 2 grades'])
+    text = page.render(records, 'Class', entries, SimilarityRecord.make({'pairs': pairs, 'notes': []}),
+                       ['worksheet: 2 grades'])
     got = parsed(text)
     assert got.rows == 4
     assert got.images == ['Jane Doe/flight.png']
@@ -158,7 +160,7 @@ def test_finish_writes_the_desk_for_a_class(tmp_path):
     worksheet = tmp_path / 'ws.csv'
     worksheet.write_text('\ufeffIdentifier,Full name,Grade,Maximum grade,Last modified (grade),Feedback comments\n'
                          '"Participant 101","Jane Doe",,17.00,-,\n', encoding='utf-8')
-    lines = desk.finish(out, records, similar={'pairs': [], 'students': 2}, worksheet=str(worksheet))
+    lines = desk.finish(out, records, similar=SimilarityRecord.make({'pairs': [], 'students': 2, 'notes': []}), worksheet=str(worksheet))
     assert any('1 grade(s) written' in l for l in lines)
     assert any('NOT MATCHED: Paul' in l for l in lines)
     for r in records:

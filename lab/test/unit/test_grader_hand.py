@@ -363,3 +363,24 @@ def test_a_late_classmate_of_the_same_name_never_takes_the_first_ones_folder(tmp
     for _, path in class_:
         (folders / path.split('/')[-1]).mkdir(parents=True)
     assert [name for name, _ in class_run.class_students(str(folders), [], out=str(out))] == ['Jane Doe_2', 'Jane Doe', 'Paul_2']
+
+
+def test_a_kept_file_of_any_shape_never_stops_the_class_nor_frees_a_folder_it_names(tmp_path):
+    """kept_folders is lenient on purpose (its docstring): a measurements.json that is no object (cut,
+    edited) gives way to the folder's grade.json; NaN (a measured value) is read; a number that is
+    true or a string is none; no kept file of any shape stops the class's listing."""
+    import json
+    from exam_lab.grader import class_run
+    from exam_lab.grader.score.records import MEASUREMENTS
+    out = tmp_path / 'out'
+    for name, measured, grade in (
+            ('Ann', '["not", "an", "object"]', {'participant': 11}),
+            ('Bob', '{"extra": {"participant": 12}, "session": {"value": NaN}}', None),
+            ('Cy', '{"extra": "no facts"}', {'folder': 'Cy_13_assignsubmission_file_'}),
+            ('Di', '{"extra": {"participant": true}}', None), ('Ed', '{"extra": {"participant": "14"}}', None),
+            ('Flo', '{"version": 1, "ext', {'participant': 16})):
+        (out / name).mkdir(parents=True)
+        (out / name / MEASUREMENTS).write_text(measured)
+        if grade is not None:
+            (out / name / 'grade.json').write_text(json.dumps(grade))
+    assert class_run.kept_folders(str(out)) == {11: 'Ann', 12: 'Bob', 13: 'Cy', 16: 'Flo'}

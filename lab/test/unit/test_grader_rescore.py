@@ -51,3 +51,24 @@ def test_a_student_the_grader_could_not_grade_keeps_its_participant(tmp_path, mo
     assert record['status'] == 'not graded' and 'a grader bug' in ' '.join(record['for_the_teacher'])
     assert (record['participant'], record['folder']) == (1001, 'Jane Doe._1001_assignsubmission_file_')
     assert json.loads((tmp_path / 'Jane Doe' / 'grade.json').read_text())['participant'] == 1001
+
+
+def test_every_similarity_json_the_class_run_writes_is_read_back_as_its_record(tmp_path, monkeypatch):
+    """Issue 37 point 1: a check that could not run left ``{"error"}`` without the record's ``notes``,
+    which make rescore (reading it as a SimilarityRecord) refused. Each file written now is one, a
+    failure's words cut to the record's length and made safe as the record makes them."""
+    import os
+    from exam_lab.grader.boxed import archives
+    from exam_lab.grader.score.records import SimilarityRecord
+    errors = []
+    for why in ('the archive failed on \x1b]0;owned\x07 entry 3', 'a failure ' + 'x' * 30000 + ' at its end'):
+        def fails(*args, **kwargs):
+            raise archives.UnpackError(why)
+        monkeypatch.setattr(class_run, 'class_students', fails)
+        result = class_run.class_similarity(str(tmp_path / 'class.zip'), str(tmp_path), [])
+        kept = SimilarityRecord.read(str(tmp_path / 'similarity.json'))
+        assert isinstance(result, SimilarityRecord) and kept == result and kept.notes == []
+        assert not [n for n in os.listdir(str(tmp_path)) if n.endswith('.part')]
+        errors.append(kept.error)
+    assert errors[0] == 'the archive failed on  entry 3'
+    assert len(kept.error) == SimilarityRecord.SCHEMA['error'].schema.limit and kept.error.endswith('x at its end')

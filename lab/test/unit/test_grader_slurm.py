@@ -10,7 +10,7 @@ import pytest
 
 from exam_lab.grader import class_run
 from exam_lab.grader.host import underlay
-from exam_lab.grader.publish import grades
+from exam_lab.grader.publish import grades, report
 from exam_lab.grader.engine import slurm
 
 
@@ -58,6 +58,15 @@ def test_the_state_line_counts_pending_running_and_done():
         'slurm job 12+13 (2 tasks submitted again): 2 pending, 1 running, 3 done of 8'
 
 
+#: How a scripted task may end besides leaving its grade (any other text: the result file it leaves).
+ENDS = ('record', 'queued') + slurm.ENDED
+
+
+def graded(name):
+    """A grade record as a task leaves it (report.grade_record's: a record of the grader)."""
+    return report.grade_record(name, 'altitude', [], [], {'seconds': 1.0})
+
+
 class ScriptedSlurm(object):
     """sbatch gives job ids 100, 101...; a task is in the queue for one look, then ends as ``ends``
     says for that attempt (``'record'``: it leaves its grade, as a good task does; ``'queued'``: it
@@ -88,11 +97,15 @@ class ScriptedSlurm(object):
                 self.queued.discard(key)
                 if end == 'record':
                     with open(os.path.join(self.base, 'results', '%d.json' % index), 'w') as f:
-                        json.dump({'student': 's%d' % index, 'status': 'graded'}, f)
+                        json.dump(graded('s%d' % index), f)
+                elif end not in ENDS:  # the task left this text as its result (then ended COMPLETED)
+                    with open(os.path.join(self.base, 'results', '%d.json' % index), 'w') as f:
+                        f.write(end)
             return 0, '\n'.join(lines), ''
         if argv[0] == 'scontrol':
             index = int(argv[-1].split('_')[1])
-            return 0, 'JobState=%s Reason=None ExitCode=0:9' % self.ends[index][self.attempt[index] - 1], ''
+            end = self.ends[index][self.attempt[index] - 1]
+            return 0, 'JobState=%s Reason=None ExitCode=0:9' % (end if end in ENDS else 'COMPLETED'), ''
         return 0, '', ''
 
 
@@ -224,3 +237,62 @@ def test_a_moodle_class_zip_is_graded_as_a_folder_is(tmp_path, monkeypatch):
     with open(str(out / 'grades.csv')) as f:
         assert [row['student'] for row in csv.DictReader(f)] == ['Ann Lee', 'Bob Ray']
     assert not (out / '.slurm').exists(), 'the unpacked class is removed with the rest'
+
+
+@pytest.mark.parametrize('left, why', [
+    ('{"student": "s1", "status": "graded"}', 'grade.json: sheet is missing'),  # of another shape
+    ('{"student": "s1", "tot', 'grade.json: not JSON'),                          # cut short
+    (json.dumps(graded('s0')), "grade.json: the grade of 's0', not of 's1'"),    # another student's
+    (json.dumps(dict(graded('s1'), total='17')), 'grade.json.total: a number expected, got str'),
+])
+def test_a_result_that_is_not_the_students_grade_stops_that_student_only(array, left, why):
+    """Issue 37 point 1: the host reads each task's result as a grade record (capped, checked); one
+    that is not (garbled, another shape, another student's) is that student's "not graded" row with
+    the reason, and the class goes on (it used to raise out of the array and cancel every task)."""
+    run, fake, lines = array([['record'], [left], ['record']])
+    run.submit(range(3))
+    for now in range(3):
+        run.look(float(now))
+    assert [r['status'] for r in run.records] == ['graded', 'not graded', 'graded']
+    reason = run.records[1]['status_reason']
+    assert reason.startswith('could not grade: its results/1.json is not its grade record: ') and why in reason, reason
+    assert any(line.startswith('slurm: s1 (task 100_1) left a grade that is not one: ') for line in lines)
+    assert sum(1 for c in fake.calls if c[0] == 'sbatch') == 1, 'the same grade would be written again: no retry'
+    assert 'scancel' not in [c[0] for c in fake.calls]
+
+
+def test_a_name_of_the_class_listing_is_the_name_its_grade_record_holds():
+    """The host compares a result's student with the name it gave the task, as the record holds it
+    (cleaned where made): every name the class's listing makes cleans to itself, so the record of a
+    student is found as that student's, never taken for another's."""
+    from exam_lab.grader.score import identity, safe_text
+    folders = ['Eve\x1b[2J\x1b[H\r\x85\u202e_1_assignsubmission_file_', 'n\udcff\udce9_2_assignsubmission_file_',
+               'Zoë Ünal_3_assignsubmission_file_', '\t.Anna\x00 Roy._4_assignsubmission_file_', 'grades.csv']
+    for folder in folders:
+        name = identity.student_name(folder)
+        assert safe_text.clean(name) == name and graded(name)['student'] == name, (folder, name)
+
+
+@pytest.mark.parametrize('text, said', [
+    ('{"student": "Ann", "submission": "/class/Ann"}\n', 'has no such line (1 line(s))'),
+    ('{"student": "Ann", "submission": "/class/Ann"}\n{"student": "Bob", "subm\n', 'cannot be read: '),
+    ('{"student": "Ann", "submission": "/class/Ann"}\n["Bob", "/class/Bob"]\n', 'is not a student\'s line'),
+    ('{"student": "Ann", "submission": "/class/Ann"}\n{"student": "Bob", "submission": null}\n',
+     'is not a student\'s line'),
+])
+def test_a_garbled_manifest_line_stops_the_task_with_a_sentence(tmp_path, text, said):
+    manifest = tmp_path / 'manifest.jsonl'
+    manifest.write_text(text)
+    with pytest.raises(RuntimeError) as raised:
+        slurm.run_task(str(manifest), 1, str(tmp_path))
+    assert str(raised.value).startswith('the Slurm manifest %s, line 2 ' % manifest) and said in str(raised.value)
+
+
+def test_the_task_says_in_one_line_why_its_manifest_line_cannot_be_graded(tmp_path, capsys):
+    """The task's log (kept in OUT/.slurm/logs/ and named in the student's row) holds the sentence."""
+    manifest = tmp_path / 'manifest.jsonl'
+    manifest.write_text('{"student": "Ann", "subm\n')
+    assert slurm.main(['task', str(manifest), '0', '--out', str(tmp_path)]) == 1
+    said = capsys.readouterr().err
+    assert said.startswith('exam_lab.grader.engine.slurm task 0: the Slurm manifest %s, line 1 cannot be read: '
+                           % manifest) and 'Traceback' not in said and said.count('\n') == 1

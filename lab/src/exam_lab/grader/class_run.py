@@ -9,13 +9,14 @@ import re
 import shutil
 
 from exam_lab.grader import runner
-from exam_lab.grader.boxed import archives, classlist, similarity
+from exam_lab.grader.boxed import archives, bounds, classlist, similarity
 from exam_lab.grader.host import sandbox, staging
 from exam_lab.grader.host.boxed_run import INTAKE_BOUNDS, SIMILARITY_BOUNDS, Boxed, InspectionFailed
 from exam_lab.grader.host.underlay import default_underlay, ensure_underlay
 from exam_lab.grader.host.bwrap import can_isolate
-from exam_lab.grader.publish import grades, report
-from exam_lab.grader.score import identity, records
+from exam_lab.grader.publish import desk, grades, report
+from exam_lab.grader.score import identity, records, schema
+from exam_lab.grader.score import kept as kept_records
 
 #: Gradings side by side per core when JOBS is not given. A grading mostly waits (its flight is timed),
 #: and each box's CPU is bounded to cores/JOBS, so two per core keep every point: measured by `make
@@ -93,25 +94,36 @@ def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
 
 def kept_folders(out):
     """``{participant number: folder name}`` of the students an earlier run graded into ``out`` (from
-    each folder's measurements.json, else its grade.json; written by the grader, never by a box)."""
+    each folder's measurements.json, else its grade.json; written by the grader, never by a box).
+
+    Lenient on purpose, unlike every other reader of these files: a file that is not a record of
+    today's grader (an older shape no upgrade knows, one edited by hand, one cut short by a full disk)
+    still says whose folder it is when it holds a participant number. Read strictly, it would free
+    that folder for a classmate of the same name, whose grading would then overwrite the kept
+    measurements and grade of another student. Only the number and Moodle's folder name are taken
+    from it (never shown, never a path: the folder's own name is), read up to the record's cap; a
+    file of any other shape holds none."""
     kept = {}
     if not out or not os.path.isdir(out):
         return kept
     for name in sorted(os.listdir(out)):
-        for kept_file in (records.MEASUREMENTS, 'grade.json'):
-            path = os.path.join(out, name, kept_file)
+        for record_type in (kept_records.MeasurementsRecord, kept_records.GradeRecord):
+            path = os.path.join(out, name, record_type.FILE)
             if not os.path.isfile(path):
                 continue
             try:
-                with open(path) as f:
-                    facts = json.load(f)
-            except (OSError, ValueError):
+                with open(path, 'rb') as f:
+                    facts = schema.load(f.read(record_type.MAX_BYTES + 1), record_type.FILE, constants=True)
+            except (OSError, records.RecordError):
                 continue
-            facts = facts.get('extra', {}) if kept_file == records.MEASUREMENTS else facts
+            if record_type is kept_records.MeasurementsRecord and isinstance(facts, dict):
+                facts = facts.get('extra')
+            if not isinstance(facts, dict):
+                continue
             number = facts.get('participant')
-            if number is None:
-                number = identity.participant_number(str(facts.get('folder') or ''))
-            if isinstance(number, int):
+            if number is None and isinstance(facts.get('folder'), str):
+                number = identity.participant_number(facts['folder'])
+            if isinstance(number, int) and not isinstance(number, bool):
                 kept.setdefault(number, name)
             break
     return kept
@@ -185,8 +197,11 @@ def _refused_at_intake(name, folder, out_dir, sheet, why):
 def class_similarity(klass, out, records_):
     """The similarity check over a class's submissions, each named as its grade record names it, run in
     a box (:mod:`exam_lab.grader.boxed.similarity` ``--class``: unpacking and comparing, SIMILARITY_BOUNDS)
-    and read back as a :class:`~exam_lab.grader.score.records.SimilarityRecord`; written to
-    ``out/similarity.json``. ``{"error"}`` when it could not run (the grades stand)."""
+    and read back as a :class:`~exam_lab.grader.score.records.SimilarityRecord`, with a note for each
+    student the intake refused; written to ``out/similarity.json`` and returned as that record (what
+    the desk and ``make rescore`` read: :func:`~exam_lab.grader.publish.desk.finish`). A record of
+    ``error`` when it could not run (the grades stand): every file written here is one
+    SimilarityRecord reads back."""
     work_dirs, refused = [], {}
     try:
         by_folder = {r.get('folder'): r['student'] for r in records_}
@@ -212,15 +227,20 @@ def class_similarity(klass, out, records_):
                 json.dump(job, f)
             result = boxed.run('exam_lab.grader.boxed.similarity', ['--class', boxed.path(f.name)],
                                records.SimilarityRecord, SIMILARITY_BOUNDS, python=python).value
-        result = dict(result, notes=['%s: not compared (its files were refused: %s)' % (name, refused[folder])
-                                     for name, folder in listed if folder in refused] + result['notes'])
+        # The intake's words of why (a student's file names among them) are made safe with the record.
+        refusals = ['%s: not compared (its files were refused: %s)' % (name, refused[folder])
+                    for name, folder in listed if folder in refused]
+        result = records.SimilarityRecord.make(dict(result, notes=bounds.closed(refusals + result['notes'])))
     except Exception as err:  # a bug of the check, or its box failing, must not cost the class its page
-        result = {'error': str(err) if isinstance(err, (InspectionFailed, archives.UnpackError)) else repr(err)}
+        why = str(err) if isinstance(err, (InspectionFailed, archives.UnpackError)) else repr(err)
+        result = desk.similarity_failed(why)
     finally:
         for work in work_dirs:
             shutil.rmtree(work, ignore_errors=True)
-    with open(os.path.join(out, 'similarity.json'), 'w') as f:
-        json.dump(result, f, indent=1, sort_keys=True)
+    partial = os.path.join(out, records.SimilarityRecord.FILE + '.part')
+    with open(partial, 'w') as f:
+        f.write(result.to_json() + '\n')
+    os.rename(partial, os.path.join(out, records.SimilarityRecord.FILE))
     return result
 
 

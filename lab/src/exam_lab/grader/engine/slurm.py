@@ -38,6 +38,8 @@ import time
 from exam_lab.grader import class_run, workspace
 from exam_lab.grader.host import sandbox, staging, underlay
 from exam_lab.grader.publish import grades, report
+from exam_lab.grader.score import kept, safe_text
+from exam_lab.grader.score.records import RecordError, shown
 
 #: Seconds between two looks at the queue: light on a shared controller, quick enough for a class.
 POLL_S = 5.0
@@ -177,11 +179,32 @@ def _write_json(path, data):
     os.rename(path + '.part', path)
 
 
+def manifest_entry(manifest, index):
+    """Line ``index`` of the manifest: ``{"student", "submission"[, "refused"]}``. The host wrote it
+    itself (:func:`_grade`, as whoever submits), of names it made (the class's listing) and folders it
+    chose: no box's record, so it is read as the host's own file, but a line that is missing, cut
+    short or of another shape (a manifest of another grader, a shared file system's error) stops
+    the task with a sentence naming the file and the line, never a bare traceback."""
+    where = '%s, line %d' % (manifest, index + 1)
+    try:
+        with open(manifest, encoding='utf-8') as f:
+            lines = f.read().splitlines()
+        entry = json.loads(lines[index]) if 0 <= index < len(lines) else None
+    except (OSError, UnicodeDecodeError, ValueError) as err:
+        raise RuntimeError('the Slurm manifest %s cannot be read: %s' % (where, err))
+    if entry is None:
+        raise RuntimeError('the Slurm manifest %s has no such line (%d line(s))' % (where, len(lines)))
+    if not (isinstance(entry, dict) and isinstance(entry.get('student'), str) and
+            isinstance(entry.get('submission'), str) and isinstance(entry.get('refused', ''), str)):
+        raise RuntimeError('the Slurm manifest %s is not a student\'s line ({"student", "submission"}): %s'
+                           % (where, safe_text.one_line(lines[index])[:200]))
+    return entry
+
+
 def run_task(manifest, index, out_dir, sheet=None, unsandboxed=False):
     """Grade line ``index`` of the manifest into ``out_dir/<name>``, as a local class run does, and leave
     the record for the host in ``results/<index>.json`` beside the manifest."""
-    with open(manifest) as f:
-        entry = json.loads(f.read().splitlines()[index])
+    entry = manifest_entry(manifest, index)
     # scancel and the time limit send SIGTERM: exit through the finally blocks, which end the
     # session's processes and remove the work folder.
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
@@ -241,24 +264,32 @@ class _Array(object):
         return dict((key, value) for key, value in parse_squeue(out).items() if key[0] in self.jobs)
 
     def _result(self, index):
+        """The grade the task left in ``results/<index>.json``, None while there is none. It is read
+        as the grader's record (:class:`~exam_lab.grader.score.kept.GradeRecord`: capped, checked, its
+        text clean, an older one upgraded): it holds a student's text, written on a node. A file that
+        is not that student's grade raises :class:`RecordError` saying why (that student is not
+        graded, the class goes on: :meth:`look`)."""
         path = os.path.join(self.base, 'results', '%d.json' % index)
         if not os.path.isfile(path):
             return None
-        with open(path) as f:
-            record = json.load(f)
-        if not isinstance(record, dict) or record.get('student') != self.students[index][0]:
-            raise RuntimeError('%s holds no record of %s' % (path, self.students[index][0]))
-        return record
+        record = kept.GradeRecord.read(path)
+        # The record's name is cleaned as it is made: compared as it would be (a name of the class's
+        # listing, letters, digits, space and -._, cleans to itself; identity.student_name).
+        name = self.students[index][0]
+        if record.student != safe_text.clean(name):
+            raise RecordError('%s: the grade of %s, not of %s' % (kept.GradeRecord.FILE, shown(record.student),
+                                                                 shown(name)))
+        return record.value
 
     def _finished(self, index, record):
         self.records[index] = record
         if self.progress:
             self.progress.finished(record)
 
-    def give_up(self, index, why):
+    def give_up(self, index, why, said='Slurm said'):
         name = self.students[index][0]
         log = os.path.join(self.base, 'logs', '%s_%d.out' % (self.where[index], index))
-        record = grades.could_not_grade(name, self.sheet, 'Slurm said: %s' % why,
+        record = grades.could_not_grade(name, self.sheet, '%s: %s' % (said, why),
                                         ['the task\'s output: %s' % log if os.path.isfile(log) else
                                          'the task left no output'])
         report.write_grade(os.path.join(self.out_dir, name), record)
@@ -274,7 +305,15 @@ class _Array(object):
         for index, (name, _) in enumerate(self.students):
             if self.records[index] is not None:
                 continue
-            record = self._result(index)
+            try:
+                record = self._result(index)
+            except RecordError as err:
+                # Written whole on the node, then renamed: a grade that does not match is no lag of
+                # the file system, and grading again would write the same. This student only.
+                self.say('slurm: %s (task %s_%d) left a grade that is not one: %s'
+                         % (name, self.where[index], index, err))
+                self.give_up(index, err, said='its results/%d.json is not its grade record' % index)
+                continue
             if record is not None:
                 self._finished(index, record)
                 continue
@@ -446,7 +485,11 @@ def main(argv=None):
     parser.add_argument('--sheet')
     parser.add_argument('--unsandboxed', action='store_true')
     args = parser.parse_args(argv)
-    run_task(args.manifest, args.index, args.out, args.sheet, args.unsandboxed)
+    try:
+        run_task(args.manifest, args.index, args.out, args.sheet, args.unsandboxed)
+    except RuntimeError as err:  # the manifest's line unusable: one sentence in the task's log
+        print('exam_lab.grader.engine.slurm task %d: %s' % (args.index, err), file=sys.stderr)
+        return 1
     return 0
 
 

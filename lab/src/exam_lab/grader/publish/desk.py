@@ -16,7 +16,7 @@ import os
 
 from exam_lab.grader.publish import feedback, flightplot, gradescope, hand, moodle, page, report
 from exam_lab.grader.score import kept, safe_text
-from exam_lab.grader.score.records import RecordError
+from exam_lab.grader.score.records import RecordError, SimilarityRecord
 
 
 def _grade_md(record):
@@ -45,6 +45,47 @@ def _grade_records(records):
             made.append(safe_text.cleaned(record))
             refused[id(made[-1])] = ['its grade is not a grade record (a grader bug, please report): %s' % _failure(err)]
     return made, refused
+
+
+def similarity_failed(why):
+    """The :class:`~exam_lab.grader.score.records.SimilarityRecord` of a check that could not run or
+    cannot be read: ``why``, its end kept when longer than the record holds (a traceback's last words)."""
+    limit = SimilarityRecord.SCHEMA['error'].schema.limit
+    return SimilarityRecord.make({'error': why if len(why) <= limit else '...' + why[3 - limit:], 'notes': []})
+
+
+def read_similarity(out):
+    """The class's similarity check as its run kept it (``out/similarity.json``, read as its
+    :class:`~exam_lab.grader.score.records.SimilarityRecord`: capped, checked, its text clean), for a
+    desk made again (``make rescore``); None when there is none. A file that is not that record (cut
+    short, edited) is the record of why: the page says so where its pairs would be."""
+    path = os.path.join(out, SimilarityRecord.FILE)
+    if not os.path.isfile(path):
+        return None
+    try:
+        return SimilarityRecord.read(path)
+    except RecordError as err:
+        return similarity_failed('the run\'s %s cannot be read (make grade checks the class again): %s'
+                                 % (SimilarityRecord.FILE, err))
+
+
+def _title(out, title):
+    """The class's name for the page, one line: the one given (the class's file name, the teacher's
+    choice: :func:`moodle.class_name`) kept in ``out/page.json`` for a page made again, else the one
+    kept there (the desk's own small file, read up to a few KB; one of another shape is no name), else
+    the output folder's name."""
+    named = os.path.join(out, 'page.json')
+    if title:
+        with open(named, 'w') as f:
+            json.dump({'title': title}, f)
+    elif os.path.isfile(named):
+        try:
+            with open(named, 'rb') as f:
+                kept_title = json.loads(f.read(8192).decode('utf-8')).get('title')
+        except (OSError, ValueError, AttributeError):
+            kept_title = None
+        title = kept_title if isinstance(kept_title, str) else None
+    return safe_text.one_line(title or os.path.basename(out))
 
 
 def _student(out, record, single):
@@ -76,12 +117,17 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
     """Write the desk's files for ``records`` graded into ``out``; return lines for the terminal.
 
     :param single: one submission (its results are in ``out`` itself, not ``out/<student>``).
-    :param similar: the similarity check's result (:func:`exam_lab.grader.boxed.similarity.check`) or None.
+    :param similar: the similarity check's record (a :class:`~exam_lab.grader.score.records.SimilarityRecord`:
+        :func:`exam_lab.grader.class_run.class_similarity`, :func:`read_similarity`) or None; a plain
+        dict is refused (TypeError): its text would reach the page uncleaned.
     :param worksheet: the Moodle worksheet to fill, or None.
     :param scale: scale the grades to the worksheet's maximum grade (:func:`moodle.fill`).
     :param title: the class's name (:func:`moodle.class_name`); the output folder's name when None.
     :param show: what the students' feedback pages show (:func:`feedback.write`); None: lab/check_visibility.ini.
     """
+    if similar is not None and not isinstance(similar, SimilarityRecord):
+        raise TypeError('the similarity check is given as its record (records.SimilarityRecord), not a %s'
+                        % type(similar).__name__)
     lines, notes, entries = [], [], {}
     records, refused = _grade_records(records)
     for record in records:
@@ -111,27 +157,21 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         lines += feedback.write(out, records, single, show)
     except Exception as err:  # the grades are written; the page must still say why the zip is not
         lines.append('moodle feedback NOT written (a grader bug, please report): %s' % _failure(err))
-    notes += lines
-    pairs = None
+    # The desk's lines quote a worksheet's cells, hand.csv's, an error's words: one line each, made
+    # safe here, where they are made, for the terminal and the page alike.
+    notes += [safe_text.one_line(line) for line in lines]
     if similar is not None:
-        pairs = similar.get('pairs', [])
-        if similar.get('error'):
-            notes.append('similarity check not run: %s' % similar['error'])
-            lines.append('similarity: not run: %s' % similar['error'])
-            pairs = None
+        if similar.error:
+            notes.append('similarity check not run: %s' % similar.error)
+            lines.append('similarity: not run: %s' % similar.error)
         else:
+            notes += similar.notes  # who was not compared, what was left out: the check's record's words
             lines.append('similarity: %d pair(s) flagged of %d student(s) (%s)'
-                         % (len(pairs), similar.get('students', 0), os.path.join(out, 'index.html#similarity')))
-    named = os.path.join(out, 'page.json')  # the class's name, for a page made again (make rescore)
-    if title:
-        with open(named, 'w') as f:
-            json.dump({'title': title}, f)
-    elif os.path.isfile(named):
-        with open(named) as f:
-            title = json.load(f).get('title')
-    title = 'Exam grades: %s' % (records[0]['student'] if single and records else title or os.path.basename(out))
+                         % (len(similar.pairs or []), similar.students or 0, os.path.join(out, 'index.html#similarity')))
+    title = _title(out, title)
+    title = 'Exam grades: %s' % (records[0]['student'] if single and records else title)
     try:
-        content = page.render(records, title, entries, pairs, notes)
+        content = page.render(records, title, entries, similar, notes)
     except Exception as err:  # not one student's: the page shrinks to what cannot fail, and says why
         problem = 'the page could not be made (a grader bug, please report): %s' % _failure(err)
         lines.append(problem)

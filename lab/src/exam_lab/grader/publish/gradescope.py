@@ -9,7 +9,6 @@ import json
 import os
 
 from exam_lab.grader.publish import student_view
-from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
 
 #: Statuses whose score is the grade; the others are shown to the teacher only until a hand grade.
@@ -17,7 +16,9 @@ GRADED = ('graded', 'graded with fixes')
 
 
 def results(record):
-    """The results.json of one graded record."""
+    """The results.json of one grade record: a :class:`~exam_lab.grader.score.kept.GradeRecord`'s value
+    (the desk's, :func:`exam_lab.grader.publish.desk.finish`), its text made safe where the record was
+    made; what is added here is the grader's own words, and the threshold run's value taken out."""
     status = record.get('status', 'graded')
     tests = []
     for entry in record['items']:
@@ -36,7 +37,7 @@ def results(record):
     if status not in GRADED:
         out['output'] = 'Needs the teacher (%s): %s' % (status, out['extra_data']['status_reason'])
         out['visibility'] = 'hidden'  # a grade only the teacher sees until it is settled by hand
-    return safe_text.cleaned(out)  # the student sees it: no control character of anyone's reaches it
+    return out
 
 
 def write(out_dir, record):

@@ -208,14 +208,17 @@ def feedback(record, maximum=None, scaled=None):
     """The feedback comment of one student (HTML, as Moodle's feedback comments are): the total, then
     one line per item with its points, and why for each point lost. With the worksheet's ``maximum``
     grade (a number) other than the machine's, it says on which scale the grade column is: ``scaled``
-    (the grade written) or the machine's points as they are."""
+    (the grade written) or the machine's points as they are. ``record`` is a
+    :class:`~exam_lab.grader.score.kept.GradeRecord`'s value (the desk's, or make worksheet's read from
+    grade.json, with :func:`~exam_lab.grader.publish.hand.combine`'s hand items): its text is clean
+    where the record was made; the teacher's remark from hand.csv is put on one line here."""
     lines = []
     for entry in record['items']:
         line = '%s %s/%s' % (entry['id'], _points(entry['points']), _points(entry['max']))
         if entry.get('by') == 'hand':
             line += ' (by hand)' if entry['id'] not in record.get('missing', ()) else ': not given yet'
         elif entry['points'] < entry['max'] and entry.get('evidence'):
-            why = safe_text.clean(student_view.item_words(entry, record)).split('\n', 1)[0]  # never the threshold run
+            why = student_view.item_words(entry, record).split('\n', 1)[0]  # never the threshold run
             line += ': ' + (why if len(why) <= 200 else why[:197] + '...')
         lines.append(line)
     if 'machine_total' in record:  # the whole grade (exam_lab.grader.publish.hand.combine)

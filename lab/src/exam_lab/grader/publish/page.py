@@ -11,6 +11,7 @@ import re
 
 from exam_lab.grader.publish import report
 from exam_lab.grader.score import safe_text
+from exam_lab.grader.score.records import SimilarityRecord
 from exam_lab.grader.score.sheets import ITEMS
 
 #: Flagged pairs shown with their fragments; the rest are listed by name and score.
@@ -148,24 +149,31 @@ def _status_cell(record):
         re.sub(r'\W+', '-', status), _e(record.get('status_reason', '')), _e(status))
 
 
-def render(records, title, entries, pairs=None, notes=None):
-    """The page's HTML.
+def render(records, title, entries, similar=None, notes=None):
+    """The page's HTML, of records only: every text it shows was made safe where it was made, and is
+    escaped here for HTML, never cleaned again.
 
-    :param records: the grade records (grade.json, as :func:`~exam_lab.grader.publish.report.grade_record`
-        or the desk made them: their text clean), in the table's order.
-    :param entries: per student: ``{"plot": relative path of the PNG or None, "grade_md": text,
-        "documents": [{"name", "pages"}], "folder": relative path of its results, "problems": what the
-        desk could not make for it, "plot_failed": its plot was not drawn for one of those}``.
-    :param pairs: the similarity check's flagged pairs (see :mod:`exam_lab.grader.boxed.similarity`), or
-        None when it did not run.
-    :param notes: lines for the top of the page (the worksheet's summary, the similarity's limits).
+    :param records: the grade records (each a :class:`~exam_lab.grader.score.kept.GradeRecord`'s value,
+        as :func:`~exam_lab.grader.publish.report.grade_record` or the desk made them: their text
+        clean), in the table's order.
+    :param title: the page's title, one line made safe by the desk (the class's name, a student's).
+    :param entries: per student, made by the desk of its record: ``{"plot": relative path of the PNG
+        or None, "grade_md": text, "documents": [{"name", "pages"}], "folder": relative path of its
+        results, "problems": what the desk could not make for it (one line each), "plot_failed": its
+        plot was not drawn for one of those}``.
+    :param similar: the similarity check's :class:`~exam_lab.grader.score.records.SimilarityRecord`
+        (its pairs, the detector's highlighted HTML shown as it is: the record allows no other markup),
+        or None when it did not run; a plain dict is refused (TypeError).
+    :param notes: lines for the top of the page, made safe by the desk (the worksheet's summary, the
+        similarity's notes).
 
-    Every other text is cleaned of control characters first (student-derived: the desk's lines, the
-    similarity's pairs); a student whose section cannot be made gets one that says why, and the
-    others theirs.
+    A student whose section cannot be made gets one that says why, and the others theirs.
     """
-    entries, pairs, notes = safe_text.cleaned(entries), safe_text.cleaned(pairs), safe_text.cleaned(notes)
-    title = safe_text.clean(title)
+    if similar is not None and not isinstance(similar, SimilarityRecord):
+        raise TypeError('the similarity check is shown from its record (records.SimilarityRecord), not a %s'
+                        % type(similar).__name__)
+    pairs = None if similar is None or similar.error else similar.pairs or []
+    entries = entries or {}
     parts = ['<!DOCTYPE html>', '<html lang="en"><head><meta charset="utf-8">',
              '<title>%s</title>' % _e(title), '<style>%s</style></head><body>' % _STYLE,
              '<h1>%s</h1>' % _e(title)]
