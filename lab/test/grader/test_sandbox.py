@@ -251,11 +251,11 @@ def test_probe_results_must_belong_to_the_run():
     plan = {'kind': 'main', 'delay': 5.0}
     real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0},
             'clock': {'use_sim_time': [None, None], 'messages': 0, 'publishers': []}}
-    assert probe_problem(real, plan, 99.0, 131.0) is None
-    assert 'not within' in probe_problem(real, plan, 200.0, 240.0)       # an old run's file
+    assert probe_problem(real, 99.0, 131.0, **plan) is None
+    assert 'not within' in probe_problem(real, 200.0, 240.0, **plan)       # an old run's file
     short = dict(real, schedule=dict(real['schedule'], long_down=121.0))
-    assert 'less than' in probe_problem(short, plan, 99.0, 131.0)        # the flight did not last
-    assert 'no times' in probe_problem({}, plan, 99.0, 131.0)
+    assert 'less than' in probe_problem(short, 99.0, 131.0, **plan)        # the flight did not last
+    assert 'no times' in probe_problem({}, 99.0, 131.0, **plan)
 
 
 def test_a_box_is_another_user_and_sees_only_its_own():
