@@ -136,6 +136,26 @@ def test_a_link_in_a_class_folder_is_never_followed_and_its_student_is_said(tmp_
     assert [name for name, _ in classlist.list_students(str(klass), None)] == ['Ann'], 'no refusals asked: passed over'
 
 
+def test_a_link_at_the_top_of_a_class_archive_is_its_students_refused_row(tmp_path):
+    """A class zip (or tar) whose student entry is a link, not a folder or an archive (a class folder
+    of links zipped again): that student's row says why, never silently dropped, never followed."""
+    archive = str(tmp_path / 'class.zip')
+    with zipfile.ZipFile(archive, 'w') as zf:
+        zf.writestr('Ann_1_assignsubmission_file_/exam/package.xml', PACKAGE_XML)
+        for name, target in (('Bob_2_assignsubmission_file_', '/etc'), ('Cy_3_assignsubmission_file_.zip', '/x.zip')):
+            info = zipfile.ZipInfo(name)
+            info.create_system, info.external_attr = 3, (stat.S_IFLNK | 0o777) << 16
+            zf.writestr(info, target)
+    refused = {}
+    students = classlist.list_students(archive, str(tmp_path / 'scratch'), refused)
+    assert [name for name, _ in students] == ['Ann', 'Bob', 'Cy']
+    assert sorted(os.path.basename(path) for path in refused) == ['Bob_2_assignsubmission_file_',
+                                                                  'Cy_3_assignsubmission_file_.zip']
+    assert all('is a link in the class archive, not a folder or an archive: never followed' in why
+               for why in refused.values())
+    assert not any(os.path.islink(path) or os.path.getsize(path) for _, path in students[1:])
+
+
 def test_refused_zip_is_reported(tmp_path):
     folder = tmp_path / 'student'
     folder.mkdir()

@@ -63,7 +63,8 @@ def list_students(class_path, scratch, refused=None):
             continue
         if os.path.isdir(full):
             students.append((student_name(entry), full))
-        elif entry.lower().endswith(ARCHIVE_ENDINGS):
+        elif entry.lower().endswith(ARCHIVE_ENDINGS) or (refused is not None and full in refused):
+            # (a refused student's place is an empty file when its entry was not a folder)
             students.append((student_name(without_ending(entry)), full))
     return students
 
@@ -201,6 +202,9 @@ def _students_of(entries):
 
 def _student_plan(key, members):
     """The checked plan of one student's files, paid by its own budget; UnpackError when they fail."""
+    if all(len(parts) == 1 and entry[2] in ('link', 'special') for entry, parts in members):
+        raise UnpackError('%s is a %s in the class archive, not a folder or an archive: never followed'
+                          % (shown_name(key), members[0][0][2]))
     plan = Plan(key)
     for (member, name, kind, size, link), parts in members:
         if len(parts) == 1 and kind != 'dir':
