@@ -156,6 +156,22 @@ def test_a_link_at_the_top_of_a_class_archive_is_its_students_refused_row(tmp_pa
     assert not any(os.path.islink(path) or os.path.getsize(path) for _, path in students[1:])
 
 
+def test_a_flat_download_student_without_an_archive_still_has_a_row(tmp_path):
+    """Moodle's flat download (no folders): a student who handed in a report only (or an online text)
+    is listed, its first file its submission; one with an archive too is listed once, by its archive."""
+    klass = tmp_path / 'class'
+    klass.mkdir()
+    prefix = 'Ann Roy_7_assignsubmission_file_'
+    make_zip(klass / (prefix + 'exam.zip'), [('exam/package.xml', PACKAGE_XML)])
+    (klass / (prefix + 'report.pdf')).write_bytes(b'%PDF-1.4')
+    (klass / 'Bob Li_8_assignsubmission_onlinetext_onlinetext.html').write_text('<p>see attached</p>')
+    (klass / 'Bob Li_8_assignsubmission_file_report.pdf').write_bytes(b'%PDF-1.4')
+    (klass / 'grading-worksheet.csv').write_text('x')  # the teacher's own file: nobody's
+    listed = classlist.list_students(str(klass), None)
+    assert [(name, os.path.basename(path)) for name, path in listed] == [
+        ('Ann Roy', prefix + 'exam.zip'), ('Bob Li', 'Bob Li_8_assignsubmission_file_report.pdf')]
+
+
 def test_refused_zip_is_reported(tmp_path):
     folder = tmp_path / 'student'
     folder.mkdir()

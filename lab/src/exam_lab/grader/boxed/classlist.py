@@ -66,7 +66,24 @@ def list_students(class_path, scratch, refused=None):
         elif entry.lower().endswith(ARCHIVE_ENDINGS) or (refused is not None and full in refused):
             # (a refused student's place is an empty file when its entry was not a folder)
             students.append((student_name(without_ending(entry)), full))
-    return students
+    return students + _flat_without_archive(class_path, students)
+
+
+def _flat_without_archive(class_path, students):
+    """The students of a flat download (Moodle's "Download submissions in folders" off: each file
+    ``<name>_<number>_assignsubmission_<plugin>_<file>`` at the top) none of whose files is an archive
+    (a report only, an online text): each its row all the same, its first file its submission (graded
+    "not graded", saying what it handed in), never left out unsaid."""
+    numbers = set(participant_number(os.path.basename(path)) for _, path in students)
+    found = []
+    for entry in sorted(os.listdir(class_path)):
+        full = os.path.join(class_path, entry)
+        number = participant_number(entry)
+        if number is None or number in numbers or _hidden(entry) or os.path.islink(full) or not os.path.isfile(full):
+            continue
+        numbers.add(number)
+        found.append((student_name(entry), full))
+    return found
 
 
 def _hidden(entry):
