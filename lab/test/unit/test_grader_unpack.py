@@ -159,17 +159,21 @@ def test_a_link_at_the_top_of_a_class_archive_is_its_students_refused_row(tmp_pa
 def test_a_flat_download_student_without_an_archive_still_has_a_row(tmp_path):
     """Moodle's flat download (no folders): a student who handed in a report only (or an online text)
     is listed, its first file its submission; one with an archive too is listed once, by its archive."""
+    from test_grader_moodle_names import download_path  # downloader.php's names, ported
     klass = tmp_path / 'class'
     klass.mkdir()
-    prefix = 'Ann Roy_7_assignsubmission_file_'
-    make_zip(klass / (prefix + 'exam.zip'), [('exam/package.xml', PACKAGE_XML)])
-    (klass / (prefix + 'report.pdf')).write_bytes(b'%PDF-1.4')
-    (klass / 'Bob Li_8_assignsubmission_onlinetext_onlinetext.html').write_text('<p>see attached</p>')
-    (klass / 'Bob Li_8_assignsubmission_file_report.pdf').write_bytes(b'%PDF-1.4')
+    ann_zip, ann_pdf, bob_pdf = (download_path(name, number, filename, 'flat') for name, number, filename in
+                                 (('Ann Roy', 7, 'exam.zip'), ('Ann Roy', 7, 'report.pdf'), ('Bob Li', 8, 'report.pdf')))
+    make_zip(klass / ann_zip, [('exam/package.xml', PACKAGE_XML)])
+    (klass / ann_pdf).write_bytes(b'%PDF-1.4')
+    (klass / bob_pdf).write_bytes(b'%PDF-1.4')
+    # The online text plugin's file, named as downloader.php names any plugin's (subtype, type, file):
+    # 'onlinetext.html' is assignsubmission_onlinetext's string 'onlinetextfilename'.
+    (klass / bob_pdf.replace('_assignsubmission_file_report.pdf',
+                             '_assignsubmission_onlinetext_onlinetext.html')).write_text('<p>see attached</p>')
     (klass / 'grading-worksheet.csv').write_text('x')  # the teacher's own file: nobody's
     listed = classlist.list_students(str(klass), None)
-    assert [(name, os.path.basename(path)) for name, path in listed] == [
-        ('Ann Roy', prefix + 'exam.zip'), ('Bob Li', 'Bob Li_8_assignsubmission_file_report.pdf')]
+    assert [(name, os.path.basename(path)) for name, path in listed] == [('Ann Roy', ann_zip), ('Bob Li', bob_pdf)]
 
 
 def test_refused_zip_is_reported(tmp_path):
