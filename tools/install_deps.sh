@@ -20,6 +20,11 @@ packages=(
   chromium python3-venv
   # the report's page limit is read from its PDF (pdftohtml) by the docs tests
   poppler-utils
+  # students' reports are read in a box: the text layer (poppler), OCR of scans and screenshots
+  # (tesseract, French and English), an .odt or .docx handed in instead of a PDF (LibreOffice headless)
+  tesseract-ocr tesseract-ocr-fra tesseract-ocr-eng libreoffice-writer-nogui
+  # class zips are tested as the usual tools make them (Info-ZIP, bsdtar, 7-Zip)
+  zip unzip libarchive-tools p7zip-full
   "$@"
 )
 
