@@ -23,8 +23,9 @@ packages=(
   # students' reports are read in a box: the text layer (poppler), OCR of scans and screenshots
   # (tesseract, French and English), an .odt or .docx handed in instead of a PDF (LibreOffice headless)
   tesseract-ocr tesseract-ocr-fra tesseract-ocr-eng libreoffice-writer-nogui
-  # class zips are tested as the usual tools make them (Info-ZIP, bsdtar, 7-Zip)
-  zip unzip libarchive-tools p7zip-full
+  # class zips are tested as the usual tools make them (Info-ZIP, bsdtar, 7-Zip), in the locales they
+  # run in (a UTF-8 one and a Latin-1 one, made by localedef from the locales package's sources)
+  zip unzip libarchive-tools p7zip-full locales
   "$@"
 )
 

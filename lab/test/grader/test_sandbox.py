@@ -192,6 +192,35 @@ def test_a_class_archive_is_unpacked_in_a_box(tmp_path):
             shutil.rmtree(work, ignore_errors=True)
 
 
+def test_a_class_zipped_by_info_zip_is_listed_by_its_box_as_named(tmp_path):
+    """Issue 45 point 4, through the intake's box: a class folder zipped again by Info-ZIP's ``zip -r``
+    where it finds no UTF-8 locale (its folders' own entries, UTF-8 names unflagged) gives every
+    student, each named as Moodle's folder says ("Zoé DArc", not "Zo├⌐ DArc" nor "Zo__ DArc"), none
+    refused (test_grader_unpack.py has the other tools and locales)."""
+    if os.geteuid() != 0 or sandbox.check() is not None:
+        pytest.skip('boxes need root and bubblewrap: %s' % sandbox.check())
+    import zipfile
+    klass = tmp_path / 'Robotique-Examen-1234'
+    for folder in ('Zoé DArc_42_assignsubmission_file', 'Bob Late_43_assignsubmission_file'):
+        (klass / folder).mkdir(parents=True)
+        with zipfile.ZipFile(str(klass / folder / 'exam.zip'), 'w') as zf:
+            zf.writestr('exam/package.xml', '<package><name>exam</name></package>')
+    (tmp_path / 'no-locale').mkdir()
+    subprocess.run(['zip', '-q', '-r', 'class.zip', klass.name], cwd=str(tmp_path), check=True, timeout=60,
+                   env={'PATH': os.environ['PATH'], 'LC_ALL': 'C', 'LOCPATH': str(tmp_path / 'no-locale')})
+    with zipfile.ZipFile(str(tmp_path / 'class.zip')) as zf:
+        assert "Robotique-Examen-1234/Zo\u251c\u2310 DArc_42_assignsubmission_file/" in zf.namelist()
+    work_dirs, refused = [], {}
+    try:
+        students = class_run.class_students(str(tmp_path / 'class.zip'), work_dirs, refused=refused)
+        assert [name for name, _ in students] == ['Bob Late', 'Zoé DArc'] and refused == {}
+        for _, folder in students:
+            assert os.listdir(folder) == ['exam.zip']
+    finally:
+        for work in work_dirs:
+            shutil.rmtree(work, ignore_errors=True)
+
+
 def test_an_upload_is_staged_as_bytes_never_followed(tmp_path):
     """What root does with an upload before its box reads it: a copy of its regular files, folders and
     links (as links: never followed, even to a root-only file), no FIFO, within a size budget."""

@@ -2,7 +2,11 @@
 import io
 import os
 import re
+import shutil
 import stat
+import struct
+import subprocess
+import sys
 import tarfile
 import zipfile
 
@@ -410,3 +414,273 @@ def test_every_box_s_work_folder_is_laid_out_alike(tmp_path):
     again = staging.new_work('exam-test-', str(tmp_path))
     with pytest.raises(staging.UploadRefused):
         staging.stage_work(again, [('big.zip', str(big))], (16, 10))
+
+
+# Class zips as the usual tools make them (issue 45 point 4): each zip below is made by the real tool on
+# this machine (tools/install_deps.sh installs Info-ZIP's zip, bsdtar, 7-Zip), from a class folder laid
+# out as Moodle names it; what each tool wrote is checked first, so that a test says what it tests.
+
+#: Students of the class, each a name in Moodle and a participant number: accents in Latin-1, and
+#: (for the tools that write UTF-8) a name no single-byte code page holds.
+LATIN1_CLASS = (("Zoé D'Arc", 42), ('Bob Late', 43), ('Jürgen Groß', 44))
+UTF8_CLASS = LATIN1_CLASS + (('Анна Петрова', 45),)
+#: A class folder as a teacher names what they unpacked Moodle's zip into.
+CLASS_FOLDER = 'Robotique-Examen-1234'
+
+
+@pytest.fixture(scope='module')
+def locales(tmp_path_factory):
+    """``{locale: LOCPATH}``: 'C' with no other locale at all (a server's or a container's: Info-ZIP's
+    zip then writes UTF-8 names unflagged), 'en_US.UTF-8' (a desktop's, the locale Info-ZIP's zip looks
+    for) and 'fr_FR.ISO-8859-1' (an older system's, a code page as Windows' are), each made by
+    localedef from Debian's locale sources (package locales)."""
+    missing = [tool for tool in ('zip', 'bsdtar', '7z', 'localedef') if shutil.which(tool) is None]
+    assert not missing, 'tools/install_deps.sh installs them: %s' % missing
+    base = tmp_path_factory.mktemp('locales')
+    (base / 'none').mkdir()
+    for name in ('en_US.UTF-8', 'fr_FR.ISO-8859-1'):
+        source, charmap = name.split('.')
+        subprocess.run(['localedef', '-i', source, '-f', charmap, str(base / name)], check=True, timeout=120,
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    return {'C': str(base / 'none'), 'en_US.UTF-8': str(base), 'fr_FR.ISO-8859-1': str(base)}
+
+
+def run_tool(argv, cwd, locales, locale):
+    """Run an archiver in ``locale`` and only it (LOCPATH: no locale of this machine's is seen)."""
+    env = {'PATH': os.environ['PATH'], 'HOME': str(cwd), 'LC_ALL': locale, 'LOCPATH': locales[locale]}
+    subprocess.run(argv, cwd=str(cwd), env=env, check=True, timeout=120, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+
+
+def moodle_class_folder(base, students, layout='4.1', encoding='utf-8'):
+    """The class folder as Moodle's "download all submissions" unpacks: ``<folder as downloader.php names
+    it>/exam.zip``, each a package (made by Python's zipfile), its file names in ``encoding`` as a system
+    of that code page keeps them. Returns ``(the folder, {student's folder name: its exam.zip's bytes})``."""
+    from test_grader_moodle_names import download_path  # downloader.php's names, ported
+    klass = base / CLASS_FOLDER
+    uploads = {}
+    for name, number in students:
+        folder = download_path(name, number, 'exam.zip', layout).split('/')[0]
+        path = os.path.join(str(klass).encode(), folder.encode(encoding))
+        os.makedirs(path)
+        upload = io.BytesIO()
+        with zipfile.ZipFile(upload, 'w') as zf:
+            zf.writestr('exam/package.xml', PACKAGE_XML)
+            zf.writestr('exam/scripts/exam_node.py', '# %s\n' % name)
+        uploads[folder] = upload.getvalue()
+        with open(os.path.join(path, b'exam.zip'), 'wb') as f:
+            f.write(uploads[folder])
+    return klass, uploads
+
+
+def raw_entries(archive):
+    """``[(the name field's bytes, flagged UTF-8, extra field ids)]`` of a zip, as it is written."""
+    out = []
+    with zipfile.ZipFile(str(archive)) as zf:
+        for info in zf.infolist():
+            raw = info.orig_filename.encode('utf-8' if info.flag_bits & 0x800 else 'cp437')
+            extra, ids = info.extra, []
+            while len(extra) >= 4:
+                kind, size = struct.unpack('<HH', extra[:4])
+                ids.append(kind)
+                extra = extra[4 + size:]
+            out.append((raw, bool(info.flag_bits & 0x800), ids))
+    return out
+
+
+def assert_class_read(archive, uploads, tmp_path):
+    """Every student listed under the name Moodle's folder gives (:func:`identity.student_name`), with its
+    participant number, none refused, each one's upload unpacked as it was handed in."""
+    refused = {}
+    students = classlist.list_students(str(archive), str(tmp_path / 'intake'), refused)
+    assert refused == {}
+    assert sorted(name for name, _ in students) == sorted(identity.student_name(f) for f in uploads)
+    for name, path in students:
+        folder = [f for f in uploads if identity.student_name(f) == name][0]
+        assert identity.participant_number(os.path.basename(path)) == identity.participant_number(folder)
+        assert os.listdir(path) == ['exam.zip'], name
+        assert open(os.path.join(path, 'exam.zip'), 'rb').read() == uploads[folder], name
+    return [name for name, _ in students]
+
+
+#: How each tool is run on the class folder, from inside it ('.', the students at the top) or from its
+#: parent (the class folder a directory entry at the top, as Moodle's "download in folders" zipped
+#: again), in which locale, and what it writes (checked): directory entries, names flagged or not.
+CLASS_ZIPS = {
+    'zip -r, C locale': (['zip', '-q', '-r', '../class.zip', '.'], 'inside', 'C', 'dirs unflagged'),
+    'zip -r, UTF-8 locale': (['zip', '-q', '-r', 'class.zip', CLASS_FOLDER], 'parent', 'en_US.UTF-8', 'dirs flagged'),
+    'zip -r -D (no directory entries)': (['zip', '-q', '-r', '-D', 'class.zip', CLASS_FOLDER], 'parent', 'C',
+                                         'unflagged'),
+    'bsdtar, C locale': (['bsdtar', '-a', '-cf', '../class.zip', '.'], 'inside', 'C', 'dirs unflagged'),
+    'bsdtar, UTF-8 locale': (['bsdtar', '-a', '-cf', 'class.zip', CLASS_FOLDER], 'parent', 'en_US.UTF-8',
+                             'dirs flagged'),
+    '7z a': (['7z', 'a', '-bd', '-tzip', '../class.zip', '.'], 'inside', 'C', 'dirs flagged'),
+    '7z a -mcl=on (local code page, Unicode Path field)': (
+        ['7z', 'a', '-bd', '-tzip', '-mcl=on', 'class.zip', CLASS_FOLDER], 'parent', 'en_US.UTF-8',
+        'dirs unflagged unicode-path'),
+    "Python's zipfile -c": ([sys.executable, '-m', 'zipfile', '-c', 'class.zip', CLASS_FOLDER], 'parent', 'C',
+                            'dirs flagged'),
+}
+
+
+@pytest.mark.parametrize('how', sorted(CLASS_ZIPS))
+def test_a_class_zip_made_by_the_usual_tools_grades_every_student(tmp_path, locales, how):
+    """Issue 45 point 4: a class folder zipped again by the teacher, by each usual tool, in a C or a UTF-8
+    locale: its folders' own entries are folders (they refused every student: "'Bob Late_43_
+    assignsubmission_file' is both a file and a folder"), its names read as the tool wrote them, UTF-8
+    flagged or not ("Zo├⌐ DArc", then "Zo__ DArc" on the teacher's page, when read as cp437)."""
+    argv, where, locale, wrote = CLASS_ZIPS[how]
+    klass, uploads = moodle_class_folder(tmp_path, UTF8_CLASS)
+    run_tool(argv, klass if where == 'inside' else tmp_path, locales, locale)
+    entries = raw_entries(tmp_path / 'class.zip')
+    accented = [(flagged, ids) for raw, flagged, ids in entries if 'Zoé'.encode() in raw]
+    assert accented, 'the names are written in UTF-8'
+    assert all(flagged == ('unflagged' not in wrote) for flagged, _ in accented), entries
+    assert all((0x7075 in ids) == ('unicode-path' in wrote) for _, ids in accented), entries
+    assert any(raw.endswith(b'/') for raw, _, _ in entries) == ('dirs' in wrote), entries
+    names = assert_class_read(tmp_path / 'class.zip', uploads, tmp_path)
+    assert "Zoé DArc" in names and 'Анна Петрова' in names and 'Jürgen Groß' in names
+
+
+def test_a_class_zip_in_a_code_page_reads_its_names_as_written(tmp_path, locales):
+    """Names in a single-byte code page, as Windows' tools and older systems write them (here by the real
+    tools on this machine, in a Latin-1 locale or with their code page option): 7-Zip's Unicode Path
+    Extra Field gives the name when it stands for the name field (its CRC-32) and is UTF-8; names that
+    are not UTF-8 are cp437 (APPNOTE.TXT's, and Windows Explorer's in Western Europe agrees with it on
+    é, ü, ß: cp850); a field that is not UTF-8 is passed over; a name flagged UTF-8 that is not refuses
+    the zip (zipfile cannot list it) with why, for the teacher to zip it again."""
+    klass, uploads = moodle_class_folder(tmp_path, LATIN1_CLASS, encoding='latin-1')
+    run_tool(['7z', 'a', '-bd', '-tzip', '-mcl=on', '../7z-latin1.zip', '.'], klass, locales, 'fr_FR.ISO-8859-1')
+    written = [(raw, ids) for raw, _, ids in raw_entries(tmp_path / '7z-latin1.zip') if b'Zo\xe9' in raw]
+    assert written and all(0x7075 in ids for _, ids in written), 'Latin-1 names, each with its UTF-8 field'
+    assert "Zoé DArc" in assert_class_read(tmp_path / '7z-latin1.zip', uploads, tmp_path / 'a')
+
+    utf8_class, utf8_uploads = moodle_class_folder(tmp_path / 'utf8', LATIN1_CLASS)
+    run_tool(['bsdtar', '--options', 'zip:hdrcharset=CP850', '-a', '-cf', '../../cp850.zip', '.'], utf8_class,
+             locales, 'en_US.UTF-8')
+    assert [raw for raw, flagged, _ in raw_entries(tmp_path / 'cp850.zip') if b'Zo\x82' in raw and not flagged]
+    names = assert_class_read(tmp_path / 'cp850.zip', utf8_uploads, tmp_path / 'b')
+    assert "Zoé DArc" in names and 'Jürgen Groß' in names
+
+    run_tool(['7z', 'a', '-bd', '-tzip', '-mcl=on', '../7z-c.zip', '.'], klass, locales, 'C')
+    with zipfile.ZipFile(str(tmp_path / '7z-c.zip')) as zf:
+        fields = [info.extra for info in zf.infolist() if b'Zo\xe9' in info.orig_filename.encode('cp437')]
+    assert fields and all(b'Zo\xe9' in extra for extra in fields), "7-Zip's field holds the Latin-1 bytes"
+    refused = {}
+    students = classlist.list_students(str(tmp_path / '7z-c.zip'), str(tmp_path / 'c'), refused)
+    assert refused == {} and len(students) == 3, 'no student lost, each with its number'
+    assert sorted(identity.participant_number(os.path.basename(p)) for _, p in students) == [42, 43, 44]
+    assert 'ZoΘ DArc' in [name for name, _ in students], 'what cp437 makes of é in Latin-1, not UTF-8'
+
+    run_tool(['bsdtar', '-a', '-cf', '../flagged.zip', '.'], klass, locales, 'en_US.UTF-8')
+    assert [raw for raw, flagged, _ in raw_entries_unchecked(tmp_path / 'flagged.zip') if b'Zo\xe9' in raw and flagged]
+    with pytest.raises(archives.UnpackError, match=re.escape(
+            "flagged.zip is not a readable zip: an entry's name is said to be UTF-8 and is not (byte \\xe9; made by "
+            "a tool whose locale was not the names' own): ask for it zipped again")):
+        classlist.list_students(str(tmp_path / 'flagged.zip'), str(tmp_path / 'd'))
+    student = tmp_path / 'upload'
+    student.mkdir()
+    shutil.copy(str(tmp_path / 'flagged.zip'), str(student / 'exam.zip'))
+    with pytest.raises(archives.UnpackError, match=re.escape('exam.zip (refused: exam.zip is not a readable zip')):
+        package.open_submission(str(student), str(tmp_path / 'scratch'), [])
+
+
+def raw_entries_unchecked(archive):
+    """``[(name field's bytes, flagged UTF-8, None)]`` read from the central directory by its offsets
+    (APPNOTE.TXT 4.3.12, 4.3.16), for a zip whose names zipfile cannot decode."""
+    data = open(str(archive), 'rb').read()
+    end = data.rindex(b'PK\x05\x06')
+    count, _, start = struct.unpack('<HLL', data[end + 10:end + 20])
+    out = []
+    for _ in range(count):
+        flags, = struct.unpack('<H', data[start + 8:start + 10])
+        name_len, extra_len, comment_len = struct.unpack('<HHH', data[start + 28:start + 34])
+        out.append((data[start + 46:start + 46 + name_len], bool(flags & 0x800), None))
+        start += 46 + name_len + extra_len + comment_len
+    return out
+
+
+def test_a_class_zipped_on_a_mac_skips_its_finder_copies(tmp_path, locales):
+    """macOS's ``ditto -c -k --keepParent`` (Finder's "Compress") writes the class folder at the top, a
+    ``__MACOSX/`` folder of AppleDouble copies and, beside an entry with Finder data, its ``._<name>``
+    copy. No Mac here: the folder is laid out as ditto's zip holds it (the copies' bytes stand for Finder
+    data) and zipped by Info-ZIP's zip; none of the copies is a student, nor a second upload of one."""
+    klass, uploads = moodle_class_folder(tmp_path, LATIN1_CLASS)
+    for folder in uploads:
+        (klass / folder / '._exam.zip').write_bytes(b'Finder data, not a zip')
+        (klass / ('._' + folder)).write_bytes(b'Finder data')
+        sequestered = tmp_path / '__MACOSX' / CLASS_FOLDER / folder
+        sequestered.mkdir(parents=True)
+        (sequestered / '._exam.zip').write_bytes(b'Finder data, not a zip')
+    (tmp_path / ('._' + CLASS_FOLDER)).write_bytes(b'Finder data')
+    run_tool(['zip', '-q', '-r', 'class.zip', CLASS_FOLDER, '._' + CLASS_FOLDER, '__MACOSX'], tmp_path, locales, 'C')
+    names = [raw for raw, _, _ in raw_entries(tmp_path / 'class.zip')]
+    assert sum(raw.split(b'/')[-1].startswith(b'._') for raw in names) == 3 * len(uploads) + 1
+    assert "Zoé DArc" in assert_class_read(tmp_path / 'class.zip', uploads, tmp_path)
+    notes = []
+    students = dict(classlist.list_students(str(tmp_path / 'class.zip'), str(tmp_path / 'again')))
+    package.open_submission(students['Bob Late'], str(tmp_path / 'scratch'), notes)
+    assert notes == []
+
+
+def test_a_student_both_a_file_and_a_folder_is_refused_alone(tmp_path, locales):
+    """A name that really is a file and a folder in one class zip (an upload added to a zip that held
+    the student's folder, by Info-ZIP's zip run twice) refuses that student only: its row says why, the
+    others are graded; the class folder's own entry and the students' refuse no one."""
+    klass, uploads = moodle_class_folder(tmp_path, LATIN1_CLASS)
+    run_tool(['zip', '-q', '-r', '../class.zip', '.'], klass, locales, 'C')
+    (tmp_path / 'later').mkdir()
+    (tmp_path / 'later' / 'Bob Late_43_assignsubmission_file').write_bytes(uploads['Bob Late_43_assignsubmission_file'])
+    run_tool(['zip', '-q', '../class.zip', 'Bob Late_43_assignsubmission_file'], tmp_path / 'later', locales, 'C')
+    refused = {}
+    students = dict(classlist.list_students(str(tmp_path / 'class.zip'), str(tmp_path / 'intake'), refused))
+    assert sorted(students) == ['Bob Late', 'Jürgen Groß', "Zoé DArc"]
+    assert refused == {students['Bob Late']: "'Bob Late_43_assignsubmission_file' is both a file and a folder"}
+    assert os.listdir(students["Zoé DArc"]) == ['exam.zip'] and os.listdir(students['Jürgen Groß']) == ['exam.zip']
+
+
+@pytest.mark.parametrize('tool', ['zip', 'bsdtar', '7z'])
+def test_a_student_s_own_zip_is_read_as_the_class_s(tmp_path, locales, tool):
+    """A student's package zipped by the usual tools (its folders' entries, a file named in French,
+    Info-ZIP's zip under a C locale writing it unflagged, macOS's copies): the same reader as a class
+    zip's, so the package is found and its files keep their names."""
+    (tmp_path / 'exam' / 'scripts').mkdir(parents=True)
+    (tmp_path / 'exam' / 'package.xml').write_text(PACKAGE_XML)
+    (tmp_path / 'exam' / 'scripts' / 'réponse_q3.txt').write_text('12 m')
+    (tmp_path / 'exam' / '._package.xml').write_bytes(b'Finder data')
+    argv = {'zip': ['zip', '-q', '-r', 'exam.zip', 'exam'], 'bsdtar': ['bsdtar', '-a', '-cf', 'exam.zip', 'exam'],
+            '7z': ['7z', 'a', '-bd', '-tzip', '-mcl=on', 'exam.zip', 'exam']}[tool]
+    run_tool(argv, tmp_path, locales, 'C')
+    assert any(raw.endswith(b'/') for raw, _, _ in raw_entries(tmp_path / 'exam.zip'))
+    assert any(not flagged for raw, flagged, _ in raw_entries(tmp_path / 'exam.zip') if 'é'.encode() in raw)
+    notes = []
+    found = package.open_submission(str(tmp_path / 'exam.zip'), str(tmp_path / 'scratch'), notes)
+    assert sorted(os.listdir(found)) == ['package.xml', 'scripts'] and notes == []
+    assert os.listdir(os.path.join(found, 'scripts')) == ['réponse_q3.txt']
+
+
+def test_class_zips_of_other_shapes(tmp_path, locales):
+    """Cases of the same kind: names with Windows' backslashes (a Linux file name holding them, zipped
+    by Info-ZIP's zip, as some Windows tools write every separator), flagged and unflagged entries in one
+    zip (7-Zip adding a late student to a zip Info-ZIP's zip made under a C locale), and a class of one
+    student zipped with its folder at the top (a folder Moodle names a student's is never taken for a
+    class folder)."""
+    klass, uploads = moodle_class_folder(tmp_path, LATIN1_CLASS[:2])
+    run_tool(['zip', '-q', '-r', '../mixed.zip', '.'], klass, locales, 'C')
+    late, late_uploads = moodle_class_folder(tmp_path / 'late', (('Анна Петрова', 45),))
+    run_tool(['7z', 'a', '-bd', '-tzip', '../../mixed.zip', '.'], late, locales, 'C')
+    flags = set(flagged for raw, flagged, _ in raw_entries(tmp_path / 'mixed.zip') if not raw.isascii())
+    assert flags == {True, False}
+    uploads.update(late_uploads)
+    assert 'Анна Петрова' in assert_class_read(tmp_path / 'mixed.zip', uploads, tmp_path / 'a')
+
+    flat = tmp_path / 'windows'
+    flat.mkdir()
+    for folder, data in uploads.items():
+        (flat / (folder + '\\exam.zip')).write_bytes(data)
+    run_tool(['zip', '-q', '-r', '../windows.zip', '.'], flat, locales, 'C')
+    assert all(b'\\' in raw for raw, _, _ in raw_entries(tmp_path / 'windows.zip'))
+    assert_class_read(tmp_path / 'windows.zip', uploads, tmp_path / 'b')
+
+    zoe = 'Zoé DArc_42_assignsubmission_file'
+    run_tool(['zip', '-q', '-r', '../one.zip', zoe], klass, locales, 'C')
+    assert_class_read(tmp_path / 'one.zip', {zoe: uploads[zoe]}, tmp_path / 'c')

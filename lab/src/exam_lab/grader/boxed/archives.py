@@ -5,9 +5,11 @@ a whole, with the reason for the teacher, when an entry would land outside the t
 absolute path, a drive letter), when a name holds a control character or is beyond the file system's
 limits, or when the submission's one budget of bytes and files (every archive of it, nested ones
 included) would be exceeded or an entry expands like a zip bomb. What students really upload is not
-refused for its form: Windows names (backslashes) and missing Unix modes are read as meant, macOS's
-``__MACOSX/`` is skipped, a whole workspace's build products (``build/``, ``devel/``...) are dropped,
-links (catkin's ``src/CMakeLists.txt``) and special files are dropped, never followed; each is noted.
+refused for its form: Windows names (backslashes) and missing Unix modes are read as meant, a zip's
+names as its maker wrote them (:func:`zip_name`), its folders' own entries as folders
+(:func:`zip_entries`), macOS's ``__MACOSX/`` and ``._`` copies are skipped, a whole workspace's build
+products (``build/``, ``devel/``...) are dropped, links (catkin's ``src/CMakeLists.txt``) and special
+files are dropped, never followed; each is noted.
 
 Every archive is read in two passes: its entries are planned (:class:`Plan`: checked, charged,
 what is dropped noted) before anything is written (:func:`write_plan`).
@@ -15,6 +17,7 @@ what is dropped noted) before anything is written (:func:`write_plan`).
 import os
 import re
 import stat
+import struct
 import tarfile
 import zipfile
 import zlib
@@ -53,6 +56,11 @@ UNREADABLE = (zipfile.BadZipFile, tarfile.TarError, zlib.error, EOFError, OSErro
 _ESCAPED_BYTE = re.compile(r'(?<!\\)((?:\\\\)*)\\udc([89a-f][0-9a-f])')  # not after an escaped backslash
 #: At most this many notes of one kind (links dropped, duplicates) are listed; the rest are counted.
 MAX_LISTED = 5
+#: A zip entry's general purpose bit 11: its name (and comment) are UTF-8 (APPNOTE.TXT 4.4.4).
+_ZIP_UTF8 = 0x800
+#: The Info-ZIP Unicode Path Extra Field (APPNOTE.TXT 4.6.9): version 1, the CRC-32 of the name field
+#: it stands for, the name in UTF-8.
+_ZIP_UNICODE_PATH = 0x7075
 
 
 class UnpackError(Exception):
@@ -94,19 +102,26 @@ def listed(names):
     return shown + (' and %d more' % (len(names) - MAX_LISTED) if len(names) > MAX_LISTED else '')
 
 
+def name_parts(name):
+    """The parts of an archive entry's name as written, before any check, and whether it is rooted (an
+    absolute path, a drive letter). Archives made on Windows sometimes use backslashes: separators too
+    (a Linux name holding one is no student's)."""
+    path = name.replace('\\', '/')
+    return [p for p in path.split('/') if p not in ('', '.')], path.startswith('/') or path[1:2] == ':'
+
+
 def entry_path(name):
     """The parts of an archive entry's path, or raise UnpackError if it is unsafe or unwritable."""
     if any(ord(c) < 32 or ord(c) == 127 for c in name):
         raise UnpackError('entry %s has a control character in its name' % shown_name(name))
-    path = name.replace('\\', '/')  # archives made on Windows sometimes use backslashes
-    if path.startswith('/') or (len(path) > 1 and path[1] == ':'):
+    parts, rooted = name_parts(name)
+    if rooted:
         raise UnpackError('entry %s has an absolute path' % shown_name(name))
-    parts = [p for p in path.split('/') if p not in ('', '.')]
     if '..' in parts:
         raise UnpackError('entry %s climbs out of the folder (..)' % shown_name(name))
     if len(parts) > MAX_PARTS:
         raise UnpackError('entry %s is %d folders deep (at most %d)' % (shown_name(name), len(parts), MAX_PARTS))
-    if len(path.encode('utf-8', 'surrogateescape')) > PATH_MAX:
+    if len(name.encode('utf-8', 'surrogateescape')) > PATH_MAX:
         raise UnpackError('entry %s has a path of more than %d bytes' % (shown_name(name), PATH_MAX))
     for part in parts:
         if len(part.encode('utf-8', 'surrogateescape')) > NAME_MAX:
@@ -237,20 +252,77 @@ def open_archive(path, label):
             return kind, tarfile.open(path, 'r:*')
     except (zipfile.BadZipFile, tarfile.TarError, OSError, EOFError) as err:
         raise UnpackError('%s is not a readable %s: %s' % (label, _KIND_WORDS[kind], err))
+    except UnicodeDecodeError as err:  # zipfile reads every name as it opens: one flagged UTF-8 that is not
+        raise UnpackError('%s is not a readable zip: an entry\'s name is said to be UTF-8 and is not (byte \\x%02x; '
+                          'made by a tool whose locale was not the names\' own): ask for it zipped again'
+                          % (label, err.object[err.start]))
     raise UnpackError('%s is %s: the grader opens zip and tar archives (%s); ask for a zip'
                       % (label, what_it_is(path) or 'not a readable zip or tar archive', ', '.join(ARCHIVE_ENDINGS)))
 
 
 def zip_entries(zf, links=True):
     """``(member, name, kind, size, link target)`` of each entry of the open zip ``zf``; kind 'file',
-    'dir' or 'link' (the target read only when ``links``, else '?')."""
-    for info in zf.infolist():
+    'dir' or 'link' (the target read only when ``links``, else '?'); the name is :func:`zip_name`'s.
+
+    A folder's own entry (``zip -r``, Windows' "compressed folder", 7-Zip, macOS's ``ditto`` all write
+    one, its name ending with ``/``, ``\\`` on some Windows tools) is a 'dir', never a file. The
+    ``._<name>`` copy macOS's ``ditto`` writes beside an entry ``<name>`` (an AppleDouble file: its
+    Finder data, no content of the student's) is skipped, as its ``__MACOSX/`` folder is."""
+    infos = [(info, zip_name(info)) for info in zf.infolist()]
+    doubles = _apple_doubles([name for _, name in infos])
+    for info, name in infos:
+        if name in doubles:
+            continue
         if stat.S_ISLNK(_zip_mode(info, 0o170000)):
-            yield info, info.filename, 'link', 0, _zip_link_target(zf, info) if links else '?'
-        elif info.is_dir() or info.filename.endswith('\\'):
-            yield info, info.filename, 'dir', 0, ''
+            yield info, name, 'link', 0, _zip_link_target(zf, info) if links else '?'
+        elif name.endswith(('/', '\\')):
+            yield info, name, 'dir', 0, ''
         else:
-            yield info, info.filename, 'file', info.file_size, ''
+            yield info, name, 'file', info.file_size, ''
+
+
+def zip_name(info):
+    """The name of the zip entry ``info`` as its maker meant it, whatever Python's zipfile made of it.
+
+    A name flagged UTF-8 (bit 11) is UTF-8. Without the flag, APPNOTE.TXT says cp437 (zipfile decodes it
+    so), but the usual tools write the bytes of their own system: Info-ZIP's ``zip`` on Linux and macOS
+    writes UTF-8 unflagged when it finds no UTF-8 locale, tools on Windows a code page, 7-Zip (and
+    Info-ZIP's zip on Windows) with an Info-ZIP Unicode Path Extra Field holding the UTF-8 name. So:
+    that field when it is valid (version 1, its CRC-32 that of the name field, UTF-8), else the bytes as
+    UTF-8 when they are, else cp437. The name is zipfile's ``orig_filename``, whatever the Python
+    (3.12's reads that field itself) and not cut at a NUL byte (:func:`entry_path` refuses it)."""
+    if info.flag_bits & _ZIP_UTF8:
+        return info.orig_filename
+    raw = info.orig_filename.encode('cp437')  # zipfile decoded the name field as cp437: its bytes again
+    for name in (_unicode_path(info.extra, raw), raw):
+        if name is not None:
+            try:
+                return name.decode('utf-8')
+            except UnicodeDecodeError:
+                pass
+    return info.orig_filename
+
+
+def _unicode_path(extra, raw):
+    """The UTF-8 bytes of the Unicode Path Extra Field among a zip entry's ``extra`` fields that stands
+    for the name field ``raw``, or None (none, another version, or one written for another name: a tool
+    that renamed the entry and left the field)."""
+    while len(extra) >= 4:
+        kind, size = struct.unpack('<HH', extra[:4])
+        data, extra = extra[4:4 + size], extra[4 + size:]
+        if kind == _ZIP_UNICODE_PATH and len(data) > 5 and data[0] == 1 and \
+                struct.unpack('<L', data[1:5])[0] == zlib.crc32(raw) & 0xffffffff:
+            return data[5:]
+    return None
+
+
+def _apple_doubles(names):
+    """The names among an archive's ``names`` that are macOS's AppleDouble copies: ``<folder>/._<name>``
+    where ``<folder>/<name>`` is an entry (or a folder) of the same archive."""
+    split = [(name, tuple(name_parts(name)[0])) for name in names]
+    paths = set(parts[:i] for _, parts in split for i in range(1, len(parts) + 1))
+    return set(name for name, parts in split
+               if parts and parts[-1].startswith('._') and parts[:-1] + (parts[-1][2:],) in paths)
 
 
 def tar_entries(tf):
@@ -325,7 +397,7 @@ def _plan_zip(zf, label, max_ratio):
     for info, _, size in plan.files:
         if size > RATIO_FROM_BYTES and size > max_ratio * max(info.compress_size, 1024):
             raise UnpackError('entry %s unpacks %d bytes from %d: a zip bomb?'
-                              % (shown_name(info.filename), size, info.compress_size))
+                              % (shown_name(zip_name(info)), size, info.compress_size))
     return plan
 
 

@@ -120,13 +120,6 @@ def _class_entries(kind, opened, label):
     return entries
 
 
-def _raw_parts(name):
-    """The parts of an entry's name as written (before any check), and whether it is rooted."""
-    path = name.replace('\\', '/')
-    rooted = path.startswith('/') or (len(path) > 1 and path[1] == ':')
-    return [p for p in path.split('/') if p not in ('', '.')], rooted
-
-
 def unpack_class(archive, target, refused):
     """Unpack a class archive into ``target``; return the folder that holds one entry per student.
 
@@ -159,7 +152,7 @@ def unpack_class(archive, target, refused):
             raise UnpackError('the students\' files in %s come to %d bytes (at most %d for a class)'
                               % (label, total, CLASS_BYTES))
         for key, place, plan, members in plans:
-            archive_at_top = all(len(p) == 1 for _, p in members) and members[0][0][2] != 'dir'
+            archive_at_top = all(_file_at_top(*member) for member in members)
             if plan is not None:
                 try:
                     _write_student(opened, kind, top if archive_at_top else place, plan)
@@ -197,10 +190,11 @@ def _fitting(key):
 def _students_of(entries):
     """``({student's key: [(entry, parts below the class)]}, the class folder at the archive's top or
     '')``: the entries grouped by their top folder, or by the one below when the archive holds the class
-    folder (unless that folder is one package)."""
+    folder (unless that folder is one package, or one student's as Moodle names it). The class folder's
+    own entry (``zip -r``) is a folder's, not a student's (:func:`_file_at_top`)."""
     groups = {}
     for entry in entries:
-        parts, rooted = _raw_parts(entry[1])
+        parts, rooted = archives.name_parts(entry[1])
         if rooted or (parts and parts[0] == '..'):
             raise UnpackError('entry %s of the class archive lies outside it' % shown_name(entry[1]))
         if not parts or parts[0] == '__MACOSX':
@@ -208,13 +202,21 @@ def _students_of(entries):
         groups.setdefault(parts[0], []).append((entry, parts))
     if len(groups) == 1:
         (top, members), = groups.items()
-        if all(len(parts) > 1 for _, parts in members) and \
-                not any(parts[1:] == ['package.xml'] or parts[2:] == ['package.xml'] for _, parts in members):
+        below = [(entry, parts) for entry, parts in members if len(parts) > 1]
+        if below and not any(_file_at_top(entry, parts) for entry, parts in members) and \
+                participant_number(top) is None and \
+                not any(parts[1:] == ['package.xml'] or parts[2:] == ['package.xml'] for _, parts in below):
             inner = {}
-            for entry, parts in members:
+            for entry, parts in below:
                 inner.setdefault(parts[1], []).append((entry, parts[1:]))
             return inner, top
     return groups, ''
+
+
+def _file_at_top(entry, parts):
+    """Whether a class archive's entry (its ``parts`` below the class) is a file at the class's top (an
+    archive a student is), not a folder's own entry nor a file below a folder."""
+    return len(parts) == 1 and entry[2] != 'dir'
 
 
 def _student_plan(key, members):
@@ -228,7 +230,7 @@ def _student_plan(key, members):
             plan.add(member, parts[0], kind, size, link)
         else:
             plan.add(member, '/'.join(parts[1:]), kind, size, link)
-    if any(len(p) == 1 for _, p in members) and any(len(p) > 1 for _, p in members):
+    if any(_file_at_top(*member) for member in members) and not all(_file_at_top(*member) for member in members):
         raise UnpackError('%s is both a file and a folder' % shown_name(key))
     budget = archives.Budget(archives.MAX_BYTES, archives.MAX_FILES)  # read now: a test may lower them
     budget.take(len(plan.files), plan.nbytes, 'the files of %s' % shown_name(key))

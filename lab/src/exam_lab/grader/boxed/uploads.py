@@ -7,7 +7,7 @@ import re
 import tarfile
 import zipfile
 
-from exam_lab.grader.boxed.archives import archive_kind, without_ending
+from exam_lab.grader.boxed.archives import archive_kind, without_ending, zip_entries
 
 #: A version number at the end of an upload's name (its archive ending off): exam_v2, exam-2,
 #: exam (2) as Moodle or a browser names a second copy, examV3.
@@ -18,12 +18,14 @@ _NO_DATE = datetime.datetime(1980, 1, 2)
 
 def archive_date(path):
     """The newest modification date of the files in an archive (what the student's machine wrote when
-    it made it), or None when it has none the grader can read."""
+    it made it: its folders' entries and macOS's copies, as :func:`zip_entries` reads them, are none), or
+    None when it has none the grader can read."""
     dates = []
     try:
         if archive_kind(path) == 'zip':
             with zipfile.ZipFile(path) as zf:
-                dates = [datetime.datetime(*info.date_time) for info in zf.infolist() if not info.is_dir()]
+                dates = [datetime.datetime(*info.date_time) for info, _, kind, _, _ in zip_entries(zf, links=False)
+                         if kind == 'file']
         elif archive_kind(path) == 'tar':
             with tarfile.open(path, 'r:*') as tf:
                 dates = [datetime.datetime.utcfromtimestamp(m.mtime) for m in tf if m.isfile()]
