@@ -25,6 +25,8 @@ packages=(
   tesseract-ocr tesseract-ocr-fra tesseract-ocr-eng libreoffice-writer-nogui
   # class zips are tested as the usual tools make them (Info-ZIP, bsdtar, 7-Zip)
   zip unzip libarchive-tools p7zip-full
+  # the code-quality proposal's static check of the student's node (run in the inspection's box)
+  python3-pyflakes
   "$@"
 )
 

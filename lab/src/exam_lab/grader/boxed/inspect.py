@@ -111,7 +111,8 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     code = bounds.kept(source.student_code(pkg), 'Python files', capped, verb='read for comments', text=None)
     if code:
         comments, lines = source.comment_ratio(code)
-        record['comments'] = {'comments': comments, 'code': lines, 'files': [os.path.relpath(p, pkg) for p in code]}
+        record['comments'] = {'comments': comments, 'code': lines, 'files': [os.path.relpath(p, pkg) for p in code],
+                              'units': source.comment_units(code, pkg), 'quality': source.quality_signals(code, pkg)}
     if chosen is not None:
         exam = chosen.exam_nodes[0]
         static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),
