@@ -28,7 +28,7 @@ from exam_lab.grader.host.bwrap import can_isolate, network_namespace
 from exam_lab.grader.score.reference import ReferenceRecord, reference_file
 from exam_lab.grader.score.records import RecordError
 from exam_lab.grader.score.sheets import SHEETS
-from exam_lab.harness.supervisor import Supervisor, ros_env, workspace_env
+from exam_lab.harness.supervisor import Supervisor, end_pids, marked, ros_env, workspace_env
 from exam_lab.harness.wait import wait_until
 
 #: Seconds ``rostopic hz`` listens (the slowest sensor, 0.778 Hz, gives four periods in 6 s).
@@ -115,23 +115,34 @@ def ensure(sheet, underlay, out=None, timeout=CAPTURE_TIMEOUT):
     except RecordError:
         record = None
     if record is None:
-        scratch = tempfile.mkdtemp(prefix='exam-reference-')
-        try:
-            target = os.path.join(scratch, 'reference.json')
-            argv = [sys.executable, '-m', 'exam_lab.grader.host.reference', '--sheet', sheet, '--underlay', underlay,
-                    '--out', target, '--scratch', scratch]
-            done = subprocess.run(network_namespace(argv) if can_isolate() else argv, stdout=subprocess.PIPE,
-                                  stderr=subprocess.STDOUT, timeout=timeout)
-            if done.returncode != 0:
-                raise RuntimeError('the reference outputs of %s could not be captured: %s' % (
-                    SHEETS[sheet].drone_pkg, done.stdout.decode('utf-8', 'replace')[-2000:]))
-            record = ReferenceRecord.read(target)
-        finally:
-            shutil.rmtree(scratch, ignore_errors=True)
+        record = captured(sheet, underlay, timeout)
         _write(cached, record)
     if out:
         _write(os.path.join(out, reference_file(sheet)), record)
     return record
+
+
+def captured(sheet, underlay, timeout=CAPTURE_TIMEOUT):
+    """The :class:`~exam_lab.grader.score.reference.ReferenceRecord` of the ``sheet``'s drone captured
+    now (:func:`capture` in a network namespace of its own when one can be made), read back checked."""
+    scratch = tempfile.mkdtemp(prefix='exam-reference-')
+    try:
+        target = os.path.join(scratch, 'reference.json')
+        argv = [sys.executable, '-m', 'exam_lab.grader.host.reference', '--sheet', sheet, '--underlay', underlay,
+                '--out', target, '--scratch', scratch]
+        try:
+            done = subprocess.run(network_namespace(argv) if can_isolate() else argv, stdout=subprocess.PIPE,
+                                  stderr=subprocess.STDOUT, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            raise RuntimeError('capturing the reference outputs of %s took more than %.0f s'
+                               % (SHEETS[sheet].drone_pkg, timeout))
+        if done.returncode != 0:
+            raise RuntimeError('the reference outputs of %s could not be captured: %s' % (
+                SHEETS[sheet].drone_pkg, done.stdout.decode('utf-8', 'replace')[-2000:]))
+        return ReferenceRecord.read(target)
+    finally:
+        end_pids(marked(os.path.join(scratch, 'logs')))  # a capture stopped at its limit leaves no master behind
+        shutil.rmtree(scratch, ignore_errors=True)
 
 
 def keep_for(out, sheets, underlay=None):
