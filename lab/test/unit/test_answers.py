@@ -9,7 +9,7 @@ import os
 
 import pytest
 
-from exam_lab.grader.score import answers
+from exam_lab.grader.score import answers, code_items
 from exam_lab.grader.score.reference import ReferenceRecord, facts
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'data', 'answers')
@@ -278,7 +278,7 @@ def units(commented, total):
 
 @pytest.mark.parametrize('commented, points', [(10, 4.0), (8, 4.0), (5, 2.0), (3, 0.0)])
 def test_comments_mapped_onto_the_notes(commented, points):
-    proposal = answers.comments_proposal({'comments': 10, 'code': 50, 'files': ['scripts/exam_node.py'],
+    proposal = code_items.comments_proposal({'comments': 10, 'code': 50, 'files': ['scripts/exam_node.py'],
                                           'units': units(commented, 10), 'quality': []})
     assert proposal['points'] == points and proposal['state'] == 'to check'
     assert '%d of 10 functions and blocks' % commented in proposal['evidence']
@@ -289,15 +289,15 @@ def test_comments_mapped_onto_the_notes(commented, points):
 def test_quality_signals_cost_points_with_file_and_line():
     signals = [{'file': 'scripts/exam_node.py', 'line': 40, 'kind': 'service in a loop', 'detail': 'warn() each pass'},
                {'file': 'scripts/exam_node.py', 'line': 3, 'kind': 'pyflakes', 'detail': "'os' imported but unused"}]
-    proposal = answers.quality_proposal({'comments': 1, 'code': 1, 'files': [], 'units': [], 'quality': signals})
+    proposal = code_items.quality_proposal({'comments': 1, 'code': 1, 'files': [], 'units': [], 'quality': signals})
     assert proposal['points'] == 0.5 and proposal['state'] == 'to check'
     assert 'scripts/exam_node.py:40 service in a loop' in proposal['evidence']
-    clean = answers.quality_proposal({'comments': 1, 'code': 1, 'files': [], 'units': [], 'quality': []})
+    clean = code_items.quality_proposal({'comments': 1, 'code': 1, 'files': [], 'units': [], 'quality': []})
     assert clean['points'] == 2.0 and clean['state'] == 'to check'
 
 
 def test_eight_proposals_per_student_in_order(ref):
-    proposals = answers.student_proposals(english_report(), ref, None)
+    proposals = code_items.student_proposals(english_report(), ref, None)
     assert [p['item'] for p in proposals] == list(answers.QUESTIONS) + ['comments', 'quality']
     assert [p['max'] for p in proposals] == [1.0, 2.0, 1.0, 1.0, 1.0, 1.0, 4.0, 2.0]
     json.dumps(proposals)

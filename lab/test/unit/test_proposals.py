@@ -7,7 +7,7 @@ import shutil
 
 import pytest
 
-from exam_lab.grader.boxed import source
+from exam_lab.grader.boxed import code_quality, source
 from exam_lab.grader.publish import desk, grades, proposals
 from exam_lab.grader.score import records
 from exam_lab.grader.score.records import MEASUREMENTS
@@ -27,7 +27,7 @@ def student(out, name, report, code='every_cycle'):
     files = source.student_code(pkg)
     lines = source.comment_ratio(files)
     measured['comments'] = {'comments': lines[0], 'code': lines[1], 'files': [os.path.relpath(p, pkg) for p in files],
-                            'units': source.comment_units(files, pkg), 'quality': source.quality_signals(files, pkg)}
+                            'units': code_quality.comment_units(files, pkg), 'quality': code_quality.quality_signals(files, pkg)}
     with open(os.path.join(folder, MEASUREMENTS), 'w') as f:
         json.dump(measured, f)
     with open(os.path.join(folder, 'grade.json'), 'w') as f:
@@ -105,3 +105,25 @@ def test_a_cell_a_spreadsheet_would_run_is_quoted(tmp_path, kept_reports):
         names = {r[1] for r in list(csv.reader(f))[1:]}
     assert names == {"'=HYPERLINK"}
     assert {r['student'] for r in proposals.read(str(tmp_path / 'proposals.csv'))} == {'=HYPERLINK'}
+
+
+# --- make check: which answers the grader found, under the teacher's visibility setting ---------------
+
+def test_the_check_says_which_answers_were_not_found_never_their_points():
+    from exam_lab.grader.publish import student_view
+    from test_answers import out, page, report
+    text = 'Question 4\n%s\nDeux nœuds tournent, le drone et rosout.\nQuestion 6\n%s' % (
+        out('altitude', 'rosnode_list'), out('altitude', 'rostopic_list'))
+    shown = student_view.report_lines(report(page(text, number=2, unsure=['rosout'], confidence=80.0)), 'points')
+    assert shown[1:] == ['  Q4: found', '  Q5: no answer found (start it with "5." or "Question 5" on a line of its own)',
+                         '  Q6: found'] + ['  Q%d: no answer found (start it with "%d." or "Question %d" on a line of '
+                                           'its own)' % (n, n, n) for n in (7, 8, 9)]
+    evidence = student_view.report_lines(report(page(text, number=2, unsure=['rosout'], confidence=80.0)), 'evidence')
+    assert evidence[1] == '  Q4: found (p.2); read by OCR with low confidence: rosout'
+    assert not any('point' in line for line in shown + evidence)
+
+
+def test_the_check_says_why_a_report_was_not_read():
+    from exam_lab.grader.publish import student_view
+    (line,) = student_view.report_lines({'state': 'not read', 'why': 'encrypted PDF'}, 'points')
+    assert 'not read (encrypted PDF)' in line

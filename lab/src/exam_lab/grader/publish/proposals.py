@@ -18,7 +18,7 @@ import json
 import os
 
 from exam_lab.grader.publish import cells
-from exam_lab.grader.score import answers, kept, records, safe_text
+from exam_lab.grader.score import answers, code_items, kept, records, safe_text
 from exam_lab.grader.score.reference import ReferenceRecord, facts, reference_file
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
@@ -65,7 +65,7 @@ def read_comments(folder):
 def student_proposals(folder, sheet, reference):
     """The 8 proposals of the student graded in ``folder`` (``reference``: :func:`read_reference`'s pair)."""
     ref, why = reference
-    made = answers.student_proposals(read_report(folder), ref, read_comments(folder))
+    made = code_items.student_proposals(read_report(folder), ref, read_comments(folder))
     if ref is None:
         made = [dict(p, evidence='%s (%s)' % (p['evidence'], why)) if p['item'] in answers.QUESTIONS
                 and p['state'] == answers.TO_CHECK else p for p in made]

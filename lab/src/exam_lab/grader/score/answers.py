@@ -205,7 +205,8 @@ def _passage(pages, page_index, starts, start, stop, passage, how, doubts, sever
 
 # --- the checks of each question --------------------------------------------------------------------
 
-def _check(name, ok, detail):
+def named_check(name, ok, detail):
+    """One named check of a proposal: ``ok`` True, False or None (cannot say), and what it rests on."""
     return {'name': name, 'ok': ok, 'detail': detail}
 
 
@@ -221,17 +222,17 @@ def _names_in(text):
 def _comment_check(passage, item, name='comment'):
     sentences = own_sentences(passage, item)
     if sentences:
-        return _check(name, True, '"%s"' % _quote(sentences[0])), sentences
-    return _check(name, False, 'no sentence of the student\'s own (at least %d words beyond the commands, '
+        return named_check(name, True, '"%s"' % _quote(sentences[0])), sentences
+    return named_check(name, False, 'no sentence of the student\'s own (at least %d words beyond the commands, '
                                'their output and the question)' % SENTENCE_WORDS), sentences
 
 
 def _command_check(passage, pattern, shown):
     for command in commands_of(passage):
         if re.match(pattern, command):
-            return _check('command', True, '`%s`' % _quote(command, 60))
+            return named_check('command', True, '`%s`' % _quote(command, 60))
     said = commands_of(passage)
-    return _check('command', False, 'no `%s`%s' % (shown, ' (commands: %s)' % ', '.join(
+    return named_check('command', False, 'no `%s`%s' % (shown, ' (commands: %s)' % ', '.join(
         '`%s`' % _quote(c, 40) for c in said[:3]) if said else ''))
 
 
@@ -239,7 +240,7 @@ def _q4(passage, ref):
     command = _command_check(passage, r'rosnode\s+list\b', 'rosnode list')
     names = _names_in(passage)
     missing = [n for n in ref['nodes'] if n not in names]
-    nodes = _check('nodes', not missing, 'both nodes: %s' % ', '.join(ref['nodes']) if not missing
+    nodes = named_check('nodes', not missing, 'both nodes: %s' % ', '.join(ref['nodes']) if not missing
                    else 'missing %s (the drone shows %s)' % (', '.join(missing), ', '.join(ref['nodes'])))
     comment, _ = _comment_check(passage, 'Q4')
     if command['ok'] and nodes['ok']:
@@ -268,7 +269,7 @@ def _q5(passage, ref):
     names = _names_in(passage)
     missing = [t for t in ref['publications'] if t not in names]
     has_node = re.search(r'Node\s*\[\s*%s\s*\]' % node, passage) is not None
-    output = _check('output', has_node and not missing,
+    output = named_check('output', has_node and not missing,
                     'Node [%s] and its publications %s' % (ref['node'], ', '.join(ref['publications']))
                     if has_node and not missing else 'missing: %s' % ', '.join(
                         (['Node [%s]' % ref['node']] if not has_node else []) + missing))
@@ -276,7 +277,7 @@ def _q5(passage, ref):
     checks, unexplained = [command, output], []
     for part, words in Q5_PARTS:
         said = re.search(words, prose, re.I)
-        checks.append(_check('explains %s' % part, bool(said), 'explained' if said else 'not explained'))
+        checks.append(named_check('explains %s' % part, bool(said), 'explained' if said else 'not explained'))
         if not said:
             unexplained.append(part)
     doubts = []
@@ -303,13 +304,13 @@ def _q6(passage, ref):
     command = _command_check(passage, r'rostopic\s+list\b', 'rostopic list')
     names = _names_in(passage)
     missing = [t for t in ref['topics'] if t not in names]
-    topics = _check('topics', not missing, ', '.join(ref['topics']) if not missing
+    topics = named_check('topics', not missing, ', '.join(ref['topics']) if not missing
                     else 'missing %s' % ', '.join(missing))
     about = [s for s in own_sentences(passage, 'Q6') if re.search(r'rosout', s, re.I)]
     if not about:  # "Ce topic sert à ..." right after /rosout is named: any own sentence then
         about = own_sentences(passage, 'Q6')
     role = [s for s in about if re.search(ROSOUT_ROLE, s, re.I)]
-    rosout = _check('rosout role', bool(role), '"%s"' % _quote(role[0]) if role else
+    rosout = named_check('rosout role', bool(role), '"%s"' % _quote(role[0]) if role else
                     ('"%s": no word of logging in it' % _quote(about[0]) if about else '/rosout\'s role not explained'))
     doubts = []
     if role:
@@ -330,9 +331,9 @@ def _q7(passage, ref):
     fields = re.search(r'float32\s+data', passage)
     expected = ref['type'] or 'std_msgs/Float32'
     checks = [command,
-              _check('type', bool(kind or fields), '%s found' % ('float32 data' if fields else expected)
+              named_check('type', bool(kind or fields), '%s found' % ('float32 data' if fields else expected)
                      if kind or fields else 'neither %s nor float32 data' % expected),
-              _check('field', bool(fields), 'float32 data' if fields else 'the field float32 data not shown')]
+              named_check('field', bool(fields), 'float32 data' if fields else 'the field float32 data not shown')]
     comment, _ = _comment_check(passage, 'Q7')
     checks.append(comment)
     doubts = []
@@ -371,7 +372,7 @@ def _q8(passage, ref):
     topic = ref['topic']
     command = _command_check(passage, r'rostopic\s+echo\b.*%s(?![\w/])' % re.escape(topic), 'rostopic echo %s' % topic)
     values = re.findall(r'data\s*:\s*-?\d', passage)
-    checks = [command, _check('messages', bool(values), '%d message(s) pasted' % len(values) if values
+    checks = [command, named_check('messages', bool(values), '%d message(s) pasted' % len(values) if values
                               else 'no message (data: ...) pasted')]
     real = ref['rate']
     # the student's own hz: on which topic, and what it measured
@@ -386,26 +387,26 @@ def _q8(passage, ref):
     right = [v for v in candidates if _close(v, real)]
     period = [v for v in candidates if real and _close(v, 1.0 / real)]
     if right:
-        rate = _check('rate', True, '%s Hz %s (the drone: %s Hz, hz measured %s)' % (
-            _num(right[0]), 'stated' if stated else 'from the pasted hz', _num(real), _num(ref['measured'])))
+        rate = named_check('rate', True, '%s Hz %s (the drone: %s Hz, hz measured %s)' % (
+            shown_number(right[0]), 'stated' if stated else 'from the pasted hz', shown_number(real), shown_number(ref['measured'])))
     elif period:
-        rate = _check('rate', False, '%s is the period (s), not the rate: the drone publishes at %s Hz' % (
-            _num(period[0]), _num(real)))
+        rate = named_check('rate', False, '%s is the period (s), not the rate: the drone publishes at %s Hz' % (
+            shown_number(period[0]), shown_number(real)))
         doubts.append('a period given as a rate')
     elif candidates:
-        rate = _check('rate', False, '%s Hz stated, the drone publishes at %s Hz' % (
-            ', '.join(_num(v) for v in candidates), _num(real)))
+        rate = named_check('rate', False, '%s Hz stated, the drone publishes at %s Hz' % (
+            ', '.join(shown_number(v) for v in candidates), shown_number(real)))
         other = ref.get('other_rate')
         if any(_close(v, other) for v in candidates):
-            doubts.append('the rate stated is %s\'s (%s Hz)' % (ref['other_topic'], _num(other)))
+            doubts.append('the rate stated is %s\'s (%s Hz)' % (ref['other_topic'], shown_number(other)))
         if measured and any(_close(v, measured[-1]) for v in candidates) and not _close(measured[-1], real):
-            doubts.append('the rate stated is the student\'s own hz output (%s Hz), not the drone\'s' % _num(measured[-1]))
+            doubts.append('the rate stated is the student\'s own hz output (%s Hz), not the drone\'s' % shown_number(measured[-1]))
     else:
-        rate = _check('rate', False, 'no rate stated')
+        rate = named_check('rate', False, 'no rate stated')
     checks.append(rate)
     if measured:
-        checks.append(_check('own hz', _close(measured[-1], real), 'pasted hz: %s Hz on %s' % (
-            _num(measured[-1]), ', '.join(hz_topics) or '?')))
+        checks.append(named_check('own hz', _close(measured[-1], real), 'pasted hz: %s Hz on %s' % (
+            shown_number(measured[-1]), ', '.join(hz_topics) or '?')))
     if command['ok'] and rate['ok']:
         return checks, 1.0, doubts, 'echo and the rate: 1'
     if command['ok']:
@@ -416,7 +417,8 @@ def _q8(passage, ref):
     return checks, 0.0, doubts, 'neither the command nor the rate: 0'
 
 
-def _num(value):
+def shown_number(value):
+    """A number of points or Hz as the evidence writes it (``0.5``, ``2``, ``0.778``)."""
     return '?' if value is None else ('%.3f' % value).rstrip('0').rstrip('.')
 
 
@@ -425,7 +427,7 @@ def _q9(passage, ref):
     made = [c for c in commands_of(passage) if c.startswith('catkin_create_pkg')]
     wanted = {'rospy', 'std_msgs', drone}
     good = [c for c in made if c.split()[1:2] == ['exam'] and set(c.split()[2:]) == wanted]
-    command = _check('command', bool(good), '`%s`' % _quote(good[0], 60) if good else
+    command = named_check('command', bool(good), '`%s`' % _quote(good[0], 60) if good else
                      ('`%s`: not exam with rospy, std_msgs, %s' % (_quote(made[0], 60), drone) if made
                       else 'no `catkin_create_pkg exam rospy std_msgs %s`' % drone))
     explained, _ = _comment_check(passage, 'Q9', 'explained')
@@ -466,7 +468,7 @@ def judge(item, found, ref):
     checks, points, doubts, rule = JUDGES[item](found['text'], ref)
     doubts = list(found['doubts']) + list(doubts)
     state = TO_CHECK if doubts else PROPOSED
-    evidence = '%s: %s; rule %s: %s -> %s%s' % (where, _summary(checks), item, rule, _num(points),
+    evidence = '%s: %s; rule %s: %s -> %s%s' % (where, _summary(checks), item, rule, shown_number(points),
                                                '; to check: %s' % '; '.join(doubts) if doubts else '')
     return proposal(item, state, points, evidence, checks, found['page'], found['text'])
 
@@ -479,75 +481,3 @@ def report_proposals(report, ref):
         return [proposal(item, NOT_READ, None, 'report not read: %s' % why) for item in QUESTIONS]
     found = find_answers(report.get('pages') or [], report.get('files') or [])
     return [judge(item, found[item], ref) for item in QUESTIONS]
-
-
-# --- comments and code quality, from the inspection's measures ----------------------------------------
-
-#: Share of functions and blocks commented: "commenté partout" from this share on, "assez peu" from
-#: the next one on, "clairement pas assez" below it (sheet 000's notes: 4, 2, 0).
-EVERYWHERE, FEW = 0.8, 0.4
-
-
-def comments_proposal(comments):
-    """The comments item (4 points) from the inspection's ``comments`` (the measurements'): always
-    to check, whether the comments are clear is the teacher's call."""
-    if not comments:
-        return proposal('comments', TO_CHECK, None, 'no Python code was read: nothing to measure')
-    units = comments.get('units')
-    lines = '%d comment line(s) for %d code line(s)' % (comments['comments'], comments['code'])
-    if not units:
-        share = comments['comments'] / float(max(1, comments['code']))
-        return proposal('comments', TO_CHECK, None, '%s (%.0f %%); no function or block measured (kept before '
-                        'they were): the teacher judges' % (lines, 100 * share))
-    done = [u for u in units if u['commented']]
-    share = len(done) / float(len(units))
-    points, words = (4.0, 'commenté partout') if share >= EVERYWHERE else \
-        (2.0, 'assez peu') if share >= FEW else (0.0, 'clairement pas assez')
-    functions = [u for u in units if u['kind'] == 'function']
-    bare = ['%s:%d %s' % (u['file'], u['line'], u['name'] + '()' if u['kind'] == 'function' else u['kind'])
-            for u in units if not u['commented']]
-    checks = [_check('functions commented', None, '%d of %d' % (len([u for u in functions if u['commented']]),
-                                                             len(functions))),
-              _check('blocks commented', None, '%d of %d' % (len(done) - len([u for u in functions if u['commented']]),
-                                                          len(units) - len(functions))),
-              _check('comment lines', None, lines)]
-    evidence = ('%d of %d functions and blocks commented (%.0f %%) -> "%s": %s; %s%s; to check: whether the '
-                'comments are clear' % (len(done), len(units), 100 * share, words, _num(points), lines,
-                                        '; without a comment: %s' % ', '.join(bare[:12]) +
-                                        (' and %d more' % (len(bare) - 12) if len(bare) > 12 else '') if bare else ''))
-    return proposal('comments', TO_CHECK, points, evidence, checks)
-
-
-#: Signals that weigh half a point each kind (the others a point each kind).
-MINOR = ('global without need',)
-#: pyflakes' messages that are style, not a fault (half a point, as MINOR).
-_MINOR_FLAKES = re.compile(r'imported but unused|assigned to but never used|redefinition of unused|'
-                           r'unable to detect undefined names|f-string is missing placeholders')
-
-
-def quality_proposal(comments):
-    """The code-quality item (2 points) from the signals the inspection found, each with its file and
-    line; always to check."""
-    signals = [s for s in (comments or {}).get('quality') or [] if s['kind'] != 'note']
-    notes = [s['detail'] for s in (comments or {}).get('quality') or [] if s['kind'] == 'note']
-    if comments is None or 'quality' not in (comments or {}):
-        return proposal('quality', TO_CHECK, None, 'no code quality measured (no Python code read, or kept '
-                        'before it was): the teacher judges')
-    kinds = {}
-    for s in signals:
-        minor = s['kind'] in MINOR or s['kind'] == 'pyflakes' and _MINOR_FLAKES.search(s['detail'])
-        kinds.setdefault(('minor ' if minor else '') + s['kind'], []).append(s)
-    cost = sum(0.5 if kind.startswith('minor ') else 1.0 for kind in kinds)
-    points = max(0.0, 2.0 - cost)
-    checks = [_check(kind, False, '; '.join('%s:%d %s' % (s['file'], s['line'], s['detail']) for s in found[:5]))
-              for kind, found in sorted(kinds.items())]
-    listed = '; '.join('%s:%d %s: %s' % (s['file'], s['line'], s['kind'], s['detail']) for s in signals[:10])
-    evidence = ('%s -> %s (each kind of signal 1 point, a minor one 0.5)%s; to check: the algorithm itself' % (
-        listed or 'no signal found (pyflakes, service in a loop, busy wait, blocking call in a callback, global '
-        'without need)', _num(points), '; ' + '; '.join(notes) if notes else ''))
-    return proposal('quality', TO_CHECK, points, evidence, checks)
-
-
-def student_proposals(report, ref, comments):
-    """All 8 proposals of one student, in the contract's order (Q4-Q9, comments, quality)."""
-    return report_proposals(report, ref) + [comments_proposal(comments), quality_proposal(comments)]
