@@ -301,3 +301,18 @@ def test_eight_proposals_per_student_in_order(ref):
     assert [p['item'] for p in proposals] == list(answers.QUESTIONS) + ['comments', 'quality']
     assert [p['max'] for p in proposals] == [1.0, 2.0, 1.0, 1.0, 1.0, 1.0, 4.0, 2.0]
     json.dumps(proposals)
+
+
+def test_a_numbered_list_inside_an_answer_under_bare_number_headings(ref):
+    text = '\n'.join(['4.', out('altitude', 'rosnode_list'), 'Two nodes run: the drone and rosout here.',
+                      '5.', out('altitude', 'rosnode_info'), '1. Node is the name of the node we asked about.',
+                      '2. Publications are the topics the node publishes on.',
+                      '4. Services are what the node offers to call.', '6.', 'x'])
+    found = answers.find_answers([page(text)])
+    assert 'Publications are the topics' in found['Q5']['text'] and 'Services are what' in found['Q5']['text']
+    assert found['Q4']['text'].endswith('rosout here.') and found['Q6']['text'] == 'x'
+
+
+def test_q7_the_type_without_its_field_is_to_check(ref):
+    proposal = one('Q7', out('altitude', 'rostopic_type') + '\nThe topic carries a standard float message.', ref)
+    assert proposal['points'] == 1.0 and proposal['state'] == 'to check' and check(proposal, 'field') is False

@@ -203,12 +203,12 @@ def quality_signals(paths, package_dir):
                 signals.append({'file': f.rel, 'line': loop.lineno, 'kind': 'busy wait',
                                 'detail': 'this while loop waits without sleeping (no rate.sleep(), rospy.sleep() '
                                           'or spin()): it keeps a core busy'})
-        read = {n.id for n in ast.walk(f.tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)} | \
-            {n.target.id for n in ast.walk(f.tree) if isinstance(n, ast.AugAssign) and isinstance(n.target, ast.Name)}
+        # a value read somewhere (another function, the module's loop, this one's next call); ``x += 1``
+        # alone only writes it: a counter nothing compares is no state anyone needs
+        read = {n.id for n in ast.walk(f.tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
         for function in functions:
             for statement in (n for n in ast.walk(function) if isinstance(n, ast.Global)):
                 for name in statement.names:
-                    # read anywhere (another function, the module's loop, this one's next call: x += 1): shared
                     if name not in read:
                         signals.append({'file': f.rel, 'line': statement.lineno, 'kind': 'global without need',
                                         'detail': 'global %s in %s() is written, and read nowhere: nothing '
