@@ -6,6 +6,7 @@ those outputs (as a student pastes their terminal) around sentences of a student
 """
 import json
 import os
+import re
 
 import pytest
 
@@ -133,16 +134,57 @@ def test_a_list_inside_an_answer_is_not_a_heading(ref):
     assert 'Publications are the topics' in found['Q5']['text']
 
 
-def test_an_answer_in_a_table_cell_is_read_from_the_layout_and_to_check(ref):
-    # pdftotext -layout of a two-column table: the question's number, then its answer's cell
-    listing = reference('altitude').commands['rosnode_list']['output'].splitlines()
-    layout = '\n'.join(['  4      $ rosnode list                Two nodes run: the drone',
-                        '         %-28s  and rosout, with the master.' % listing[0],
-                        '         %s' % listing[1]])
-    text = 'Question\nAnswer\n4\n$ rosnode list\nTwo nodes run: the drone\n%s\nand rosout, with the master.' % listing[0]
-    proposal = by_item(answers.report_proposals(report(page(text.replace('4\n', ''), layout=layout)), ref))['Q4']
-    assert proposal['state'] == 'to check' and 'table' in proposal['evidence']
-    assert check(proposal, 'nodes') is True
+def pdf_pages(name):
+    """The pages of a report of data/answers/ (made by LibreOffice headless: make_table_reports.py)
+    as the report reader gives them: poppler's text in reading order and its -layout text."""
+    import shutil
+    import subprocess
+    if shutil.which('pdftotext') is None:
+        pytest.skip('poppler-utils (tools/install_deps.sh) is not installed')
+    path = os.path.join(DATA, name + '.pdf')
+    info = subprocess.run(['pdfinfo', path], stdout=subprocess.PIPE, check=True).stdout.decode()
+    count = int(re.search(r'^Pages:\s+(\d+)', info, re.M).group(1))
+
+    def text(number, *options):
+        return subprocess.run(['pdftotext'] + list(options) + ['-f', str(number), '-l', str(number), path, '-'],
+                              stdout=subprocess.PIPE, check=True).stdout.decode()
+    return [page(text(n), n, layout=text(n, '-layout')) for n in range(1, count + 1)]
+
+
+def test_a_table_with_cells_centred_on_their_row_french_out_of_order(ref):
+    proposals = by_item(answers.report_proposals(report(*pdf_pages('table_middle')), ref))
+    assert [proposals[q]['points'] for q in ('Q4', 'Q5', 'Q6', 'Q7', 'Q9')] == [1.0, 2.0, 1.0, 1.0, 1.0]
+    assert all(proposals[q]['state'] == 'to check' and 'table' in proposals[q]['evidence']
+               for q in ('Q4', 'Q5', 'Q6', 'Q7', 'Q9'))
+    assert proposals['Q8']['state'] == 'no answer found'
+    assert 'transport: TCPROS' in proposals['Q5']['passage'] and 'le protocole' in proposals['Q5']['passage']
+    assert 'rosnode list' in proposals['Q4']['passage'] and 'rostopic' not in proposals['Q4']['passage']
+    assert '/rosout_agg' in proposals['Q6']['passage'] and 'Deux' not in proposals['Q6']['passage']
+
+
+def test_a_table_with_cells_on_their_rows_top_and_a_wrapped_command(sub):
+    proposals = by_item(answers.report_proposals(report(*pdf_pages('table_top')), sub))
+    assert {q: proposals[q]['points'] for q in ('Q4', 'Q7', 'Q8')} == {'Q4': 1.0, 'Q7': 1.0, 'Q8': 1.0}
+    assert 'wrapped in a table' in proposals['Q8']['evidence']  # "rostopic echo -n" / "3" / "/pressure_robot"
+    assert 'published at 2 Hz' in proposals['Q8']['passage']  # its row's last line, not a row of question 3
+    assert [proposals[q]['state'] for q in ('Q6', 'Q9')] == ['no answer found'] * 2
+    # question 5's cell split by its output's blank lines is still its row's, up to its last line
+    assert 'transport: TCPROS' in proposals['Q5']['passage'] and 'Two nodes' not in proposals['Q5']['passage']
+    assert proposals['Q5']['state'] == 'to check'
+
+
+def test_a_heading_over_its_paragraph_is_no_table(ref):
+    text = 'Question 4\n%s\nDeux nœuds tournent : le drone et rosout.\n\nQuestion 6\n%s\nLe topic /rosout reçoit les logs.' % (
+        out('altitude', 'rosnode_list'), out('altitude', 'rostopic_list'))
+    proposals = by_item(answers.report_proposals(report(page(text, layout=text)), ref))
+    assert proposals['Q4']['state'] == 'proposed' and proposals['Q6']['state'] == 'proposed'
+
+
+def test_each_line_named_in_a_wrapped_paragraph_of_short_sentences(ref):
+    proposal = one('Q5', out('altitude', 'rosnode_info') + '\nNode [/mydrone] est le nom du nœud. Publications : les topics\n'
+                   'publiés. Subscriptions : aucun abonnement. Services : les services offerts.\n« contacting node » '
+                   'donne l\'adresse. Pid : le processus. Direction : sortante. Transport : TCPROS.', ref)
+    assert proposal['points'] == 2.0
 
 
 def test_a_low_confidence_ocr_word_in_the_passage_is_to_check(ref):
@@ -316,3 +358,7 @@ def test_a_numbered_list_inside_an_answer_under_bare_number_headings(ref):
 def test_q7_the_type_without_its_field_is_to_check(ref):
     proposal = one('Q7', out('altitude', 'rostopic_type') + '\nThe topic carries a standard float message.', ref)
     assert proposal['points'] == 1.0 and proposal['state'] == 'to check' and check(proposal, 'field') is False
+
+
+def test_a_sentence_wrapped_over_lines_is_one_sentence(ref):
+    assert one('Q4', out('altitude', 'rosnode_list') + '\nDeux nœuds tournent\navec le master.', ref)['points'] == 1.0

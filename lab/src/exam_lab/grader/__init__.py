@@ -42,7 +42,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   (the typed records that cross the boundary, with their schemas), :mod:`~.score.kept` (what a grading
   keeps, as records: its measurements and its grade, versioned), :mod:`~.score.schema` (a schema, its
   check, the base of every record), :mod:`~.score.answers` (the report's questions 4-9 found by their
-  headings and judged by named checks), :mod:`~.score.code_items` (the comments and the code quality
+  headings and judged by named checks), :mod:`~.score.report_tables` (a report's table read from its layout: the questions' rows, their
+  cells), :mod:`~.score.report_text` (what of a passage is the student's own: commands, output,
+  sentences), :mod:`~.score.code_items` (the comments and the code quality
   proposed from the inspection's measures), :mod:`~.score.reference`
   (the drone's reference outputs as a record, and what of them every run shares), :mod:`~.score.identity` (who a
   submission is: Moodle's participant number and folder, the student's name) and :mod:`~.score.boxenv`

@@ -20,14 +20,14 @@ confirms it (review page, hand.csv).
 import re
 
 from exam_lab.grader.score.reference import AVERAGE_RATE
+from exam_lab.grader.score.report_tables import continued, table_rows
+from exam_lab.grader.score.report_text import SENTENCE_WORDS, commands_of, own_sentences
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
 #: The report's questions the grader looks for.
 QUESTIONS = ('Q4', 'Q5', 'Q6', 'Q7', 'Q8', 'Q9')
 #: Proposal states (REPORT_CONTRACT.md).
 PROPOSED, TO_CHECK, NO_ANSWER, NOT_READ = 'proposed', 'to check', 'no answer found', 'not read'
-#: A sentence of the student's own has at least this many words.
-SENTENCE_WORDS = 4
 #: Longest passage kept in a proposal (the review page shows the page beside it).
 MAX_PASSAGE = 4000
 
@@ -37,88 +37,8 @@ _NAMED = re.compile(r'(?<![\w/])(?:Q(?:uestion)?|Exercice|Exercise|Ex|R[ée]pons
 #: A heading of a number alone: at a line's start (``4.``, ``4)``, ``4 -``, ``4:``), or after a
 #: sentence's end within a line (``... rosout. 5) ...``).
 _BARE = re.compile(r'(?:^|(?<=[.!?;]\s))[ \t>*•\-|]*(\d{1,2})\s*[.):\-–](?![\d.,]*\d)(?=\s|$)', re.M)
-#: A table row whose first cell is the question's number (pdftotext -layout: cells apart by 2+ spaces).
-_CELL = re.compile(r'^[ \t|]*(?:Q(?:uestion)?\s*)?(\d{1,2})[.)]?(?= {2,}|\t)', re.M | re.I)
-
-#: Lines of the tools' own output: never a sentence of the student's.
-_OUTPUT = re.compile(
-    r'^\s*(?:/[\w/]+\s*(?:\[[\w/]+\])?\s*$|\*\s|data\s*:|-{3,}|average rate|min\s*:|subscribed to|no new messages'
-    r'|Node \[|Publications\s*:|Subscriptions\s*:|Services\s*:|contacting node|Pid\s*:|Connections\s*:'
-    r'|direction\s*:|transport\s*:|to\s*:\s*/|topic\s*:\s*/|float32 data\s*$|std_msgs/\w+\s*$|Created (?:file|folder)'
-    r'|Successfully created|Type\s*:|Publishers\s*:|Subscribers\s*:|\[?(?:INFO|WARN|ERROR)\]?\s*\[)', re.I)
-#: A command line as pasted: a prompt, or a line that starts with one of the course's tools.
-_PROMPT = re.compile(r'^\s*(?:[\w.-]+@[\w.-]+:[^$#]*[$#]|[$#>%])\s*')
-_TOOLS = ('rosnode', 'rostopic', 'rosmsg', 'rossrv', 'rosservice', 'rosrun', 'roslaunch', 'roscore',
-          'catkin_create_pkg', 'catkin_make', 'timeout', 'source', 'cd', 'ls')
-
-
-def _first_word(line):
-    words = line.split()
-    return words[0] if words else ''
-
-
-def is_command(line):
-    """Whether a line is a command as pasted (a prompt, or a line starting with a course's tool)."""
-    return bool(_PROMPT.match(line)) or _first_word(line) in _TOOLS
-
-
-def commands_of(text):
-    """The command lines of a passage, their prompt left out (``rosnode list``)."""
-    found = []
-    for line in text.splitlines():
-        stripped = _PROMPT.sub('', line, count=1).strip()
-        for tool in ('rosnode', 'rostopic', 'rosmsg', 'catkin_create_pkg'):
-            at = re.search(r'(?<![\w/])%s\b' % tool, stripped)
-            if at:
-                found.append(stripped[at.start():])
-                break
-    return found
-
-
-#: Each question's statement as the sheets put it, word for word where both sheets agree (the copy
-#: of a question in a report is not a sentence of the student's).
-STATEMENTS = {
-    'Q4': 'run the node from the package then list all the running nodes',
-    'Q5': 'list the information about the node explain each line of the output you get',
-    'Q6': 'list all the available topics explain the role of the rosout topic',
-    'Q7': 'what kind of message is available on the topic',
-    'Q8': 'display a few messages available on the topic at which rate are they published',
-    'Q9': 'create a package exam in your catkin workspace with dependencies to rospy std_msgs and',
-}
-
-
-#: The names the sheets' statements use (``the node mydrone_node from the package mydrone``).
-_SHEET_NAMES = ' mydrone submarinedrone submarine drone node temperature pressure robot remote'
-
-
-def _words(text):
-    return re.findall(r"[^\W\d_]+(?:'[^\W\d_]+)?", text.lower())
-
-
-def own_sentences(text, item):
-    """The sentences of a passage that are the student's own: not a command, not a line of output, at
-    least SENTENCE_WORDS words, not the sheet's statement of ``item`` copied (most of its words are
-    the statement's or the sheet's names, and it holds no number). The rule behind every "comment"
-    and "explained" check."""
-    statement = set(_words(STATEMENTS.get(item, '') + _SHEET_NAMES)) if item in STATEMENTS else set()
-    kept = []
-    for line in text.splitlines():
-        if not line.strip() or is_command(line) or _OUTPUT.match(line):
-            continue
-        for sentence in re.split(r'(?<=[.!?])\s+', line.strip()):
-            words = _words(sentence)
-            if len(words) < SENTENCE_WORDS:
-                continue
-            if statement and not re.search(r'\d', sentence) and sum(w in statement for w in words) >= 0.7 * len(words):
-                continue
-            kept.append(sentence.strip())
-    return kept
-
-
-def _headings(text, layout=False):
-    """``[(start, end, number, strong)]`` of the headings of a page's text (or its layout text)."""
-    if layout:
-        return [(m.start(), m.end(), int(m.group(1)), False) for m in _CELL.finditer(text)]
+def _headings(text):
+    """``[(start, end, number, strong)]`` of the headings of a page's text."""
     found = [(m.start(), m.end(), int(m.group(1)), True) for m in _NAMED.finditer(text)]
     taken = [(s, e) for s, e, _, _ in found]
     for m in _BARE.finditer(text):
@@ -149,7 +69,17 @@ def find_answers(pages, files=()):
     for page in pages:
         starts.append(len(text))
         text += (page.get('text') or '') + '\n\f\n'
-    heads = _headings(text)
+    tables = [table_rows(page.get('layout') or '') for page in pages]
+    for index in range(len(tables) - 1):  # a table's last row going on at the next page's top
+        more = continued(pages[index + 1].get('layout') or '') if tables[index] else ''
+        if more:
+            number, passage = tables[index][-1]
+            tables[index][-1] = (number, passage + '\n' + more)
+
+    def in_table(start, number):  # a heading of a page's table: its text's order is not the table's
+        index = max(i for i, s in enumerate(starts) if s <= start)
+        return any(n == number for n, _ in tables[index])
+    heads = [h for h in _headings(text) if not in_table(h[0], h[2])]
     strong = {n for _, _, n, s in heads if s and 4 <= n <= 9}
     if len(strong) >= 2:
         heads = [h for h in heads if h[3]]
@@ -174,19 +104,15 @@ def find_answers(pages, files=()):
             found[item]['doubts'].append('question %d has two headings in the report: the first is read' % number)
             continue
         found[item] = _passage(pages, page_index, starts, start, stop, passage, 'heading', doubts, several, files)
-    # A question no heading of the text names may sit in a table's cell: its page's layout text.
-    for page_index, page in enumerate(pages):
-        layout = page.get('layout') or ''
-        cells = _headings(layout, layout=True)
-        for index, (start, end, number, _) in enumerate(cells):
+    # A table whose first column names the questions: each row read from its page's layout text.
+    for page_index, rows in enumerate(tables):
+        for number, passage in rows:
             item = 'Q%d' % number
             if item not in QUESTIONS or item in found:
                 continue
-            stop = cells[index + 1][0] if index + 1 < len(cells) else len(layout)
-            rows = [re.sub(r'\s{2,}', ' | ', line.strip()) for line in layout[end:stop].splitlines()]
-            found[item] = _passage(pages, page_index, None, None, None, '\n'.join(r for r in rows if r.strip()),
-                                   'table', ['read from a table (the page\'s columns): the reading order of its '
-                                             'cells is to check'], several, files)
+            found[item] = _passage(pages, page_index, None, None, None, passage, 'table',
+                                   ['read from a table (its rows and columns from the page\'s layout): which '
+                                    'cell belongs to which question is to check'], several, files)
     return {item: found.get(item) for item in QUESTIONS}
 
 
@@ -227,17 +153,22 @@ def _comment_check(passage, item, name='comment'):
                                'their output and the question)' % SENTENCE_WORDS), sentences
 
 
-def _command_check(passage, pattern, shown):
+def _command_check(passage, pattern, shown, squashed=None):
+    """The ``command`` check: a command line of the passage matching ``pattern``; in a table's cell,
+    where a narrow column wraps it ("rosnode" / "info" / "/mydro" / "ne"), the ``squashed`` pattern
+    on the passage without its spaces."""
     for command in commands_of(passage):
         if re.match(pattern, command):
             return named_check('command', True, '`%s`' % _quote(command, 60))
+    if squashed and re.search(squashed, re.sub(r'\s+', '', passage)):
+        return named_check('command', True, '%s, its words wrapped in a table\'s cell' % shown)
     said = commands_of(passage)
     return named_check('command', False, 'no `%s`%s' % (shown, ' (commands: %s)' % ', '.join(
         '`%s`' % _quote(c, 40) for c in said[:3]) if said else ''))
 
 
-def _q4(passage, ref):
-    command = _command_check(passage, r'rosnode\s+list\b', 'rosnode list')
+def _q4(passage, ref, table=False):
+    command = _command_check(passage, r'rosnode\s+list\b', 'rosnode list', table and 'rosnodelist')
     names = _names_in(passage)
     missing = [n for n in ref['nodes'] if n not in names]
     nodes = named_check('nodes', not missing, 'both nodes: %s' % ', '.join(ref['nodes']) if not missing
@@ -263,9 +194,10 @@ Q5_PARTS = (
 )
 
 
-def _q5(passage, ref):
+def _q5(passage, ref, table=False):
     node = re.escape(ref['node'])
-    command = _command_check(passage, r'rosnode\s+info\s+%s\b' % node, 'rosnode info %s' % ref['node'])
+    command = _command_check(passage, r'rosnode\s+info\s+%s\b' % node, 'rosnode info %s' % ref['node'],
+                             table and 'rosnodeinfo' + node)
     names = _names_in(passage)
     missing = [t for t in ref['publications'] if t not in names]
     has_node = re.search(r'Node\s*\[\s*%s\s*\]' % node, passage) is not None
@@ -273,7 +205,9 @@ def _q5(passage, ref):
                     'Node [%s] and its publications %s' % (ref['node'], ', '.join(ref['publications']))
                     if has_node and not missing else 'missing: %s' % ', '.join(
                         (['Node [%s]' % ref['node']] if not has_node else []) + missing))
-    prose = ' '.join(own_sentences(passage, 'Q5'))
+    # each line named in the student's words: a short sentence ("Pid : le processus.") counts, once
+    # the answer has one sentence of its own at least
+    prose = ' '.join(own_sentences(passage, 'Q5', 1)) if own_sentences(passage, 'Q5') else ''
     checks, unexplained = [command, output], []
     for part, words in Q5_PARTS:
         said = re.search(words, prose, re.I)
@@ -300,8 +234,8 @@ def _q5(passage, ref):
 ROSOUT_ROLE = r'\blog|journal|messages?\b|console|debug|erreur|error|warn|info|centralis|agr[eé]g|aggreg|trace'
 
 
-def _q6(passage, ref):
-    command = _command_check(passage, r'rostopic\s+list\b', 'rostopic list')
+def _q6(passage, ref, table=False):
+    command = _command_check(passage, r'rostopic\s+list\b', 'rostopic list', table and 'rostopiclist')
     names = _names_in(passage)
     missing = [t for t in ref['topics'] if t not in names]
     topics = named_check('topics', not missing, ', '.join(ref['topics']) if not missing
@@ -324,10 +258,10 @@ def _q6(passage, ref):
     return [command, topics, rosout], points, doubts, rule
 
 
-def _q7(passage, ref):
+def _q7(passage, ref, table=False):
     command = _command_check(passage, r'(?:rostopic\s+(?:type|info)|rosmsg\s+(?:info|show))\b',
-                             'rostopic type / rosmsg info')
-    kind = re.search(r'std_msgs\s*/\s*Float32', passage, re.I)
+                             'rostopic type / rosmsg info', table and r'rostopic(?:type|info)|rosmsg(?:info|show)')
+    kind = re.search(r'std_msgs/Float32', re.sub(r'\s+', '', passage), re.I)  # a table's cell may wrap it
     fields = re.search(r'float32\s+data', passage)
     expected = ref['type'] or 'std_msgs/Float32'
     checks = [command,
@@ -368,9 +302,10 @@ def stated_rates(sentences):
     return found
 
 
-def _q8(passage, ref):
+def _q8(passage, ref, table=False):
     topic = ref['topic']
-    command = _command_check(passage, r'rostopic\s+echo\b.*%s(?![\w/])' % re.escape(topic), 'rostopic echo %s' % topic)
+    command = _command_check(passage, r'rostopic\s+echo\b.*%s(?![\w/])' % re.escape(topic), 'rostopic echo %s' % topic,
+                             table and r'rostopicecho.*%s' % re.escape(topic))
     values = re.findall(r'data\s*:\s*-?\d', passage)
     checks = [command, named_check('messages', bool(values), '%d message(s) pasted' % len(values) if values
                               else 'no message (data: ...) pasted')]
@@ -422,11 +357,14 @@ def shown_number(value):
     return '?' if value is None else ('%.3f' % value).rstrip('0').rstrip('.')
 
 
-def _q9(passage, ref):
+def _q9(passage, ref, table=False):
     drone = ref['drone']
     made = [c for c in commands_of(passage) if c.startswith('catkin_create_pkg')]
     wanted = {'rospy', 'std_msgs', drone}
     good = [c for c in made if c.split()[1:2] == ['exam'] and set(c.split()[2:]) == wanted]
+    squashed = re.sub(r'\s+', '', passage)
+    if not good and table and 'catkin_create_pkgexam' in squashed and all(w in squashed for w in wanted):
+        good = ['catkin_create_pkg exam rospy std_msgs %s (its words wrapped in a table\'s cell)' % drone]
     command = named_check('command', bool(good), '`%s`' % _quote(good[0], 60) if good else
                      ('`%s`: not exam with rospy, std_msgs, %s' % (_quote(made[0], 60), drone) if made
                       else 'no `catkin_create_pkg exam rospy std_msgs %s`' % drone))
@@ -465,7 +403,7 @@ def judge(item, found, ref):
     if ref is None:
         return proposal(item, TO_CHECK, None, '%s: the drone\'s reference outputs are missing, nothing was '
                         'compared' % where, page=found['page'], passage=found['text'])
-    checks, points, doubts, rule = JUDGES[item](found['text'], ref)
+    checks, points, doubts, rule = JUDGES[item](found['text'], ref, table=found['how'] == 'table')
     doubts = list(found['doubts']) + list(doubts)
     state = TO_CHECK if doubts else PROPOSED
     evidence = '%s: %s; rule %s: %s -> %s%s' % (where, _summary(checks), item, rule, shown_number(points),
