@@ -362,3 +362,8 @@ def test_q7_the_type_without_its_field_is_to_check(ref):
 
 def test_a_sentence_wrapped_over_lines_is_one_sentence(ref):
     assert one('Q4', out('altitude', 'rosnode_list') + '\nDeux nœuds tournent\navec le master.', ref)['points'] == 1.0
+
+
+def test_q8_a_rate_only_pasted_is_to_check(ref):
+    proposal = one('Q8', out('altitude', 'rostopic_echo') + '\n' + out('altitude', 'rostopic_hz'), ref)
+    assert proposal['points'] == 1.0 and proposal['state'] == 'to check' and 'no sentence states it' in proposal['evidence']

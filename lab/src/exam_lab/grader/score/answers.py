@@ -321,6 +321,8 @@ def _q8(passage, ref, table=False):
     candidates = stated or (measured[-1:] if measured and not doubts else [])
     right = [v for v in candidates if _close(v, real)]
     period = [v for v in candidates if real and _close(v, 1.0 / real)]
+    if right and not stated:
+        doubts.append('the rate is only in the pasted hz output, no sentence states it')
     if right:
         rate = named_check('rate', True, '%s Hz %s (the drone: %s Hz, hz measured %s)' % (
             shown_number(right[0]), 'stated' if stated else 'from the pasted hz', shown_number(real), shown_number(ref['measured'])))
