@@ -367,3 +367,10 @@ def test_a_sentence_wrapped_over_lines_is_one_sentence(ref):
 def test_q8_a_rate_only_pasted_is_to_check(ref):
     proposal = one('Q8', out('altitude', 'rostopic_echo') + '\n' + out('altitude', 'rostopic_hz'), ref)
     assert proposal['points'] == 1.0 and proposal['state'] == 'to check' and 'no sentence states it' in proposal['evidence']
+
+
+def test_q9_underscores_an_ocr_dropped_are_read_and_said(ref):
+    # tesseract's reading of a scanned report's line (lab/test/unit/data/reports/scan.pdf, reader47's fixture)
+    proposal = one('Q9', '$ catkin create pkg exam rospy std_msgs mydrone\nLa commande crée le paquet exam avec ses '
+                   'dépendances.', ref)
+    assert proposal['points'] == 1.0 and proposal['state'] == 'to check' and 'underscores' in proposal['evidence']

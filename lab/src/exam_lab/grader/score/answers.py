@@ -361,6 +361,11 @@ def shown_number(value):
 
 def _q9(passage, ref, table=False):
     drone = ref['drone']
+    # an OCR that lost the underscores ("catkin create pkg exam rospy std msgs"): read with them, said
+    mended = re.sub(r'std[ ]msgs', 'std_msgs', re.sub(r'catkin[ _]?create[ _]?pkg', 'catkin_create_pkg', passage))
+    doubts = ['read "catkin_create_pkg" and "std_msgs" where the text has spaces (an OCR drops underscores)'] \
+        if mended != passage else []
+    passage = mended
     made = [c for c in commands_of(passage) if c.startswith('catkin_create_pkg')]
     wanted = {'rospy', 'std_msgs', drone}
     good = [c for c in made if c.split()[1:2] == ['exam'] and set(c.split()[2:]) == wanted]
@@ -373,10 +378,10 @@ def _q9(passage, ref, table=False):
     explained, _ = _comment_check(passage, 'Q9', 'explained')
     checks = [command, explained]
     if not explained['ok']:
-        return checks, 0.0, [], 'nothing explained: 0'
+        return checks, 0.0, doubts, 'nothing explained: 0'
     if command['ok']:
-        return checks, 1.0, [], 'the command, explained: 1'
-    return checks, 0.5 if made else 0.0, ['the command is not the sheet\'s'], 'the command is not the sheet\'s'
+        return checks, 1.0, doubts, 'the command, explained: 1'
+    return checks, 0.5 if made else 0.0, doubts + ['the command is not the sheet\'s'], 'the command is not the sheet\'s'
 
 
 JUDGES = {'Q4': _q4, 'Q5': _q5, 'Q6': _q6, 'Q7': _q7, 'Q8': _q8, 'Q9': _q9}
