@@ -374,3 +374,10 @@ def test_q9_underscores_an_ocr_dropped_are_read_and_said(ref):
     proposal = one('Q9', '$ catkin create pkg exam rospy std_msgs mydrone\nLa commande crée le paquet exam avec ses '
                    'dépendances.', ref)
     assert proposal['points'] == 1.0 and proposal['state'] == 'to check' and 'underscores' in proposal['evidence']
+
+
+def test_the_readers_picture_lines_are_not_a_sentence(ref):
+    # the report reader puts a text page's screenshot, read by OCR, between these lines (ReportRecord)
+    body = '[picture 1, OCR]\n%s\n[end of picture 1]\nLes deux nœuds tournent.' % out('altitude', 'rostopic_type')
+    proposal = one('Q7', body, ref)
+    assert proposal['checks'][-1]['detail'] == '"Les deux nœuds tournent."'

@@ -15,6 +15,8 @@ _OUTPUT = re.compile(
     r'|Node \[|Publications\s*:|Subscriptions\s*:|Services\s*:|contacting node|Pid\s*:|Connections\s*:'
     r'|direction\s*:|transport\s*:|to\s*:\s*/|topic\s*:\s*/|float32 data\s*$|std_msgs/\w+\s*$|Created (?:file|folder)'
     r'|Successfully created|Type\s*:|Publishers\s*:|Subscribers\s*:|\[?(?:INFO|WARN|ERROR)\]?\s*\[)', re.I)
+#: The report reader's lines around the OCR of a picture on a text page (ReportRecord's ``text``).
+_PICTURE = re.compile(r'^\s*\[(?:picture \d+, OCR|end of picture \d+)\]\s*$')
 #: A command line as pasted: a prompt, or a line that starts with one of the course's tools.
 _PROMPT = re.compile(r'^\s*(?:[\w.-]+@[\w.-]+:[^$#]*[$#]|[$#>%])\s*')
 _TOOLS = ('rosnode', 'rostopic', 'rosmsg', 'rossrv', 'rosservice', 'rosrun', 'roslaunch', 'roscore',
@@ -69,7 +71,7 @@ def _paragraphs(text):
     one paragraph (a word processor wraps a sentence over lines)."""
     paragraphs, current = [], []
     for line in text.splitlines() + ['']:
-        if not line.strip() or is_command(line) or _OUTPUT.match(line):
+        if not line.strip() or is_command(line) or _OUTPUT.match(line) or _PICTURE.match(line):
             if current:
                 paragraphs.append(' '.join(current))
             current = []
