@@ -33,7 +33,7 @@ help:
 	@echo "make rescore OUT=<dir> [WORKSHEET=...]  today's rubric on a run's kept measurements (seconds, no ROS)"
 	@echo "make worksheet OUT=<dir> WORKSHEET=<Moodle grading worksheet.csv>"
 	@echo "                    the whole grade (machine + OUT/hand.csv) into the worksheet, on its scale"
-	@echo "make check PACKAGE=<dir|zip> [SHEET=altitude|depth]"
+	@echo "make check PACKAGE=<dir|zip> [SHEET=altitude|depth] [REPORT=<your report.pdf>]"
 	@echo "                    a student's own check of their package, as an ordinary user (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
 
@@ -100,12 +100,13 @@ rescore: build
 worksheet: build
 	@$(ENV) && exec python3 lab/scripts/worksheet.py --out "$(OUT)" --worksheet "$(WORKSHEET)"
 
-# make check PACKAGE=<dir or zip> [SHEET=altitude|depth]: a student's own check, without root or sudo.
+# make check PACKAGE=<dir or zip> [SHEET=altitude|depth] [REPORT=<pdf>]: a student's own check, without root or sudo.
 # It builds the workspace but installs nothing: a student's machine has ROS already, not the teacher's tools.
 check:
 	@$(if $(PACKAGE),,$(error make check needs PACKAGE=<your exam package: its folder or its zip>))
 	@tools/build_ws.sh
-	@$(ENV) && exec python3 lab/scripts/check.py --package "$(PACKAGE)" $(if $(SHEET),--sheet "$(SHEET)")
+	@$(ENV) && exec python3 lab/scripts/check.py --package "$(PACKAGE)" $(if $(SHEET),--sheet "$(SHEET)") \
+	  $(if $(REPORT),--report "$(REPORT)")
 
 clean:
 	rm -rf .ws

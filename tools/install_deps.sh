@@ -26,6 +26,8 @@ packages=(
   # class zips are tested as the usual tools make them (Info-ZIP, bsdtar, 7-Zip), in the locales they
   # run in (a UTF-8 one and a Latin-1 one, made by localedef from the locales package's sources)
   zip unzip libarchive-tools p7zip-full locales
+  # the code-quality proposal's static check of the student's node (run in the inspection's box)
+  python3-pyflakes
   "$@"
 )
 

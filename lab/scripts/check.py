@@ -1,14 +1,17 @@
 #!/usr/bin/env python3
 """A student's own check: grade one's exam package as the teacher's grader does, on one's own machine.
 
-    check.py --package DIR_OR_ZIP [--sheet altitude|depth]
+    check.py --package DIR_OR_ZIP [--sheet altitude|depth] [--report PDF]
 
 (``make check PACKAGE=<dir|zip> [SHEET=...]``; docs/grading.md, "A student's own check".) The same code
 as the teacher's grade (``runner.grade_submission``): the package built on top of the same drones'
 simulators, run against the same probe, scored by the same rubric, as an ordinary user without root
 or sudo, in about a minute (plus about a minute, once, to build the simulators). Prints only what the
 teacher chose to show (lab/check_visibility.ini: the points, or the points and the evidence; never the
-threshold run nor its hidden value) and keeps nothing of the grade.
+threshold run nor its hidden value) and keeps nothing of the grade. The report (in the package's
+folder or zip, or ``--report``) is read as the teacher's grader reads it, and the check says which of
+questions 4-9 have an answer found by its question's number and which have none, or why the report
+was not read (never the points proposed: the teacher confirms them).
 
 No sandbox is needed for one's own code on one's own machine: the grader's box is used where it can be
 made without root (bubblewrap, with unprivileged user namespaces, as on Debian 12 and Ubuntu 20.04),
@@ -28,6 +31,11 @@ from exam_lab.grader.host import sandbox
 from exam_lab.grader.host.underlay import default_underlay, ensure_underlay
 
 from exam_lab.grader.publish import progress, student_view
+
+try:  # the report reader (issue 47 point 1)
+    from exam_lab.grader.host import reports
+except ImportError:  # a grader without it: the check says nothing of the report
+    reports = None
 from exam_lab.grader.score.sheets import SHEETS
 
 #: The teacher's choice of what the check shows.
@@ -38,6 +46,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--package', required=True, help='your exam package: its folder, or the zip you upload')
     parser.add_argument('--sheet', choices=list(SHEETS), help='default: detected from the package')
+    parser.add_argument('--report', help='your report (its PDF), when it is not in the package\'s folder or zip')
     args = parser.parse_args(argv)
     if not os.path.exists(args.package):
         sys.stderr.write('check: %s does not exist\n' % args.package)
@@ -60,6 +69,10 @@ def main(argv=None):
         print('check: grading %s (about a minute)...' % args.package)
         record = runner.grade_submission(args.package, out, sheet=args.sheet, student='your package', underlay=underlay,
                                          on_step=progress.StepProgress(), unsandboxed=why is not None)
+        report = None
+        if reports is not None:
+            print('check: reading your report...')
+            report = reports.read_report(args.report or args.package, os.path.join(out, 'report')).value
     except RuntimeError as err:
         sys.stderr.write('check: %s\n' % err)
         return 1
@@ -68,6 +81,10 @@ def main(argv=None):
     print('\nyour package, sheet %s (%s):' % (SHEETS[record['sheet']].seed, record['sheet']))
     for line in student_view.lines(record, show):  # the threshold run, if any, is the record's
         print(line)
+    if reports is not None:
+        print('')
+        for line in student_view.report_lines(report, show):
+            print(line)
     return 0
 
 

@@ -6,7 +6,8 @@
              [--engine local|slurm [--slurm-args '--partition=... --account=...']]
 
 Besides the grades, OUT/index.html (the page for the teacher), each student's results.json
-(Gradescope) and flight.png, for a class the similarity check and, with --worksheet, Moodle's
+(Gradescope) and flight.png, the hand points proposed (OUT/proposals.csv, from the reference outputs
+of the sheet's drone, run once: OUT/reference-<sheet>.json), for a class the similarity check and, with --worksheet, Moodle's
 offline grading worksheet filled (the teacher's desk: lab/src/exam_lab/grader/publish/desk.py).
 
 Prints the score table (every line cleaned of control characters: it carries students' text);
@@ -23,6 +24,7 @@ from exam_lab.grader import class_run, runner, workspace
 
 from exam_lab.grader.boxed import archives
 from exam_lab.grader.engine import slurm
+from exam_lab.grader.host import reference
 
 from exam_lab.grader.publish import desk, moodle, progress, report
 from exam_lab.grader.score import safe_text
@@ -80,6 +82,8 @@ def main(argv=None):
             for line in report.evidence_lines(record):
                 say('  ' + line)
             say('grade.json and grade.md in %s' % out)
+            for line in reference.keep_for(out, [record.get('sheet') or 'altitude']):
+                say(line)
             for line in desk.finish(out, [record], single=True, worksheet=args.worksheet,
                                     scale=args.worksheet_scale):
                 say(line)
@@ -102,6 +106,8 @@ def main(argv=None):
                 for line in waiting:
                     say('  ' + line)
             say('grades.csv and one folder per student in %s' % out)
+            for line in reference.keep_for(out, [r.get('sheet') or 'altitude' for r in records]):
+                say(line)
             for line in desk.finish(out, records, similar=None if args.no_similarity else
                                     class_run.class_similarity(args.klass, out, records), worksheet=args.worksheet,
                                     scale=args.worksheet_scale, title=moodle.class_name(args.klass)):

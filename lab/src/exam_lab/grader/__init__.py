@@ -9,7 +9,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   archive unpacked after checking every entry), :mod:`~.boxed.package` (the package found in an upload,
   copied), :mod:`~.boxed.uploads` (which of several uploads is the last), :mod:`~.boxed.classlist` (a
   class's students, from a folder or an archive), :mod:`~.boxed.source` (what the sources say;
-  the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it),
+  the teacher's fixes before running), :mod:`~.boxed.code_quality` (the code's comments per function
+  and block, its signs of bad practice), :mod:`~.boxed.launch` (the launch file read without running it),
   :mod:`~.boxed.derive` (which launch file and threshold are run; the derived launch files the grader
   runs), :mod:`~.boxed.documents` (participant number, PDF
   reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own),
@@ -27,8 +28,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder),
   :mod:`~.host.egress` (the only reader of what a box leaves: its record, capped, never a link, checked
   against its schema; its logs, capped), :mod:`~.host.boxed_run` (one of the grader's modules run in a
-  box on student bytes, its record read back) and :mod:`~.host.underlay` (the simulators' workspace,
-  built once, under every student's package).
+  box on student bytes, its record read back), :mod:`~.host.underlay` (the simulators' workspace,
+  built once, under every student's package) and :mod:`~.host.reference` (the sheet's drone run alone
+  in a network namespace, the report's commands' outputs captured: the reference of questions 4-9).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima),
   :mod:`~.score.rubric` (points, evidence and status from the measurements: :func:`~.score.rubric.score`)
   and its parts: :mod:`~.score.tolerances` (each tolerance, one constant), :mod:`~.score.measured` (the
@@ -39,7 +41,12 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   (student-derived text without control characters, for every record and output), :mod:`~.score.records`
   (the typed records that cross the boundary, with their schemas), :mod:`~.score.kept` (what a grading
   keeps, as records: its measurements and its grade, versioned), :mod:`~.score.schema` (a schema, its
-  check, the base of every record), :mod:`~.score.identity` (who a
+  check, the base of every record), :mod:`~.score.answers` (the report's questions 4-9 found by their
+  headings and judged by named checks), :mod:`~.score.report_tables` (a report's table read from its layout: the questions' rows, their
+  cells), :mod:`~.score.report_text` (what of a passage is the student's own: commands, output,
+  sentences), :mod:`~.score.code_items` (the comments and the code quality
+  proposed from the inspection's measures), :mod:`~.score.reference`
+  (the drone's reference outputs as a record, and what of them every run shares), :mod:`~.score.identity` (who a
   submission is: Moodle's participant number and folder, the student's name) and :mod:`~.score.boxenv`
   (the paths and the environment a box's processes see).
 - ``publish/`` -- what the teacher reads, from records only: :mod:`~.publish.report` (grade.json,
@@ -48,7 +55,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   offline grading worksheet), :mod:`~.publish.gradescope` (results.json), :mod:`~.publish.progress`
   (k of n, the time left; a run's steps), :mod:`~.publish.hand` (the teacher's hand points, hand.csv),
   :mod:`~.publish.feedback` (each student's page for Moodle, moodle-feedback.zip), :mod:`~.publish.cells`
-  (a CSV cell a spreadsheet cannot run, read back exactly),
+  (a CSV cell a spreadsheet cannot run, read back exactly), :mod:`~.publish.proposals` (the hand points
+  proposed: proposals.csv, each student's proposals.json),
   :mod:`~.publish.provenance` (what made a grade), :mod:`~.publish.student_view` (what ``make check``
   shows a student), :mod:`~.publish.grades` (the grade record from the measurements: the rubric applied,
   by a run and by a rescore alike; the rescore), :mod:`~.publish.teacher` (the teacher's notes of a

@@ -22,7 +22,7 @@ import random
 import re
 import sys
 
-from exam_lab.grader.boxed import archives, bounds, derive, documents, launch, package, source
+from exam_lab.grader.boxed import archives, bounds, code_quality, derive, documents, launch, package, source
 from exam_lab.grader.score import boxenv, records
 from exam_lab.grader.score.sheets import PACKAGE, SHEETS, threshold_run_value
 
@@ -111,7 +111,9 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     code = bounds.kept(source.student_code(pkg), 'Python files', capped, verb='read for comments', text=None)
     if code:
         comments, lines = source.comment_ratio(code)
-        record['comments'] = {'comments': comments, 'code': lines, 'files': [os.path.relpath(p, pkg) for p in code]}
+        record['comments'] = {'comments': comments, 'code': lines, 'files': [os.path.relpath(p, pkg) for p in code],
+                              'units': code_quality.comment_units(code, pkg),
+                              'quality': code_quality.quality_signals(code, pkg)}
     if chosen is not None:
         exam = chosen.exam_nodes[0]
         static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),

@@ -459,3 +459,4 @@ def student_code(package_dir):
     """The Python files a teacher reads for comments and quality: not setup.py, not tests."""
     return [p for p in python_files(package_dir) if os.path.basename(p) != 'setup.py'
             and not any(part in ('test', 'tests') for part in os.path.relpath(p, package_dir).split(os.sep))]
+

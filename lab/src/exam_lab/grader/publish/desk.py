@@ -1,7 +1,8 @@
 """The teacher's desk: what a class run leaves besides the grades. No rospy here.
 
 After grading, :func:`finish` writes, in ``OUT``: each student's Gradescope ``results.json`` and
-flight plot, the similarity check across the class, the Moodle worksheet filled (when one is given),
+flight plot, the hand points proposed (``proposals.csv``, :mod:`exam_lab.grader.publish.proposals`),
+the similarity check across the class, the Moodle worksheet filled (when one is given),
 each released student's feedback page in ``moodle-feedback.zip`` (:mod:`exam_lab.grader.publish.feedback`)
 and ``index.html`` (:mod:`exam_lab.grader.publish.page`).
 
@@ -14,7 +15,7 @@ import html
 import json
 import os
 
-from exam_lab.grader.publish import feedback, flightplot, gradescope, hand, moodle, page, report
+from exam_lab.grader.publish import feedback, flightplot, gradescope, hand, moodle, page, proposals, report
 from exam_lab.grader.score import kept, safe_text
 from exam_lab.grader.score.records import RecordError, SimilarityRecord
 
@@ -141,6 +142,10 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
                          os.path.join(out, hand.FILE), added, hand.HAND_MAX, out))
     except (hand.HandError, OSError) as err:  # the teacher's file as it is: never overwritten blindly
         lines.append('hand.csv NOT written: %s' % err)
+    try:
+        lines += proposals.write(out, records, single)
+    except OSError as err:
+        lines.append('proposals.csv NOT written: %s' % err)
     if worksheet:
         base = os.path.splitext(os.path.basename(worksheet))[0]
         target = os.path.join(out, '%s-filled.csv' % base)

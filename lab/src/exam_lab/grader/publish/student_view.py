@@ -18,6 +18,7 @@ import configparser
 import re
 
 from exam_lab.grader.publish.report import NOT_SCORED, _points
+from exam_lab.grader.score import answers
 
 #: The values of the setting.
 SHOW = ('points', 'evidence')
@@ -139,4 +140,36 @@ def lines(record, show, threshold_run=None):
     if reason:
         status += ' - %s' % reason
     out += ['', status, 'not scored by the machine (the teacher grades them): %s' % NOT_SCORED]
+    return out
+
+
+def report_lines(report, show):
+    """What the check says of the student's report (a ReportRecord's value, or None: none was read):
+    which of questions 4-9 have an answer the grader found by its heading, which have none ("no
+    answer found": the teacher looks for it by hand), or that the report was not read and why. Never
+    the points proposed (the teacher's to confirm). With ``evidence``, also the page each answer was
+    found on and the words the OCR was unsure of."""
+    if show not in SHOW:
+        raise ValueError('show = %r; expected one of %s' % (show, ', '.join(SHOW)))
+    if report is None or report.get('state') != 'read':
+        why = (report or {}).get('why') or 'no report was read'
+        return ['your report: not read (%s): the teacher reads it by hand; a PDF with its text (exported from '
+                'LibreOffice or Word) is read by the grader' % why]
+    files = report.get('files') or []
+    found = answers.find_answers(report.get('pages') or [], files)
+    names = ', '.join(f.get('name', '?') for f in files if f.get('state', 'read') == 'read') or 'report'
+    out = ['your report (%s, %d page(s) read): the grader looks for each answer by its question\'s number'
+           % (names, len(report.get('pages') or []))]
+    for item in answers.QUESTIONS:
+        passage = found[item]
+        if passage is None:
+            out.append('  %s: no answer found (start it with "%s." or "Question %s" on a line of its own)'
+                       % (item, item[1:], item[1:]))
+            continue
+        line = '  %s: found' % item
+        if show == 'evidence':
+            line += ' (%s%s)' % (passage['label'], ', in a table' if passage['how'] == 'table' else '')
+            if passage['unsure']:
+                line += '; read by OCR with low confidence: %s' % ', '.join(passage['unsure'][:8])
+        out.append(line)
     return out

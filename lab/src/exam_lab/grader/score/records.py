@@ -38,6 +38,13 @@ STATIC = {
 }
 
 
+#: A function or block of the student's code, commented or not (:func:`~exam_lab.grader.boxed.source.comment_units`).
+COMMENT_UNIT = {'file': Text(500), 'line': Number(0, 1e7, integer=True), 'kind': Text(20), 'name': Text(200),
+                'commented': bool}
+#: A sign of bad practice in the code (:func:`~exam_lab.grader.boxed.source.quality_signals`).
+QUALITY_SIGNAL = {'file': Text(500), 'line': Number(0, 1e7, integer=True), 'kind': Text(50), 'detail': Text(500)}
+
+
 class InspectRecord(Record):
     """What :mod:`exam_lab.grader.boxed.inspect` read in one submission (``inspect.json``).
 
@@ -65,7 +72,8 @@ class InspectRecord(Record):
         'threshold_run_value': Optional(Maybe(float)),
         'handed_in_launch': Optional(Maybe(str)),
         'comments': Maybe({'comments': Number(0, 1e9, integer=True), 'code': Number(0, 1e9, integer=True),
-                           'files': [str]}),
+                           'files': [str], 'units': Optional(Items(COMMENT_UNIT, 300)),
+                           'quality': Optional(Items(QUALITY_SIGNAL, 100))}),
         'facts': {'participant': Maybe(Number(0, 1e15, integer=True)), 'folder': Text(255),
                   'documents': [{'name': str, 'pages': Maybe(Number(0, 1e6, integer=True))}]},
     }

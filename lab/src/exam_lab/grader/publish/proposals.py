@@ -1,0 +1,122 @@
+"""The hand points proposed: ``OUT/proposals.csv`` and each student's ``OUT/<student>/proposals.json``.
+No rospy here.
+
+The 13 points the machine does not score by running (the report's questions 4-9, the comments, the
+code quality: :data:`~exam_lab.grader.score.sheets.HAND_ITEMS`) are proposed from what a run kept:
+each student's ``report.json`` (the report as its box read it), the ``comments`` of its
+``measurements.json`` (what the inspection's box measured of the code) and the class's
+``reference-<sheet>.json`` (what the sheet's drone printed, :mod:`exam_lab.grader.host.reference`).
+:mod:`exam_lab.grader.score.answers` decides; here they are read and written, by ``make grade`` and
+again by ``make rescore`` (from the kept files only). A proposal is never a point: the review page
+(review.json, hand.csv) writes a point only once the teacher confirmed it.
+
+proposals.csv has exactly the columns :data:`COLUMNS`, 8 rows a student (:data:`ITEMS` order), each
+cell safe in a spreadsheet (:mod:`~exam_lab.grader.publish.cells`), the evidence on one line.
+"""
+import csv
+import json
+import os
+
+from exam_lab.grader.publish import cells
+from exam_lab.grader.score import answers, code_items, kept, records, safe_text
+from exam_lab.grader.score.reference import ReferenceRecord, facts, reference_file
+from exam_lab.grader.score.sheets import HAND_ITEMS
+
+FILE = 'proposals.csv'
+STUDENT_FILE = 'proposals.json'
+COLUMNS = ('participant', 'student', 'item', 'points', 'max', 'state', 'evidence')
+ITEMS = tuple(HAND_ITEMS)
+#: Longest evidence in the CSV (the whole is in proposals.json's checks).
+MAX_EVIDENCE = 1500
+
+
+def read_reference(out, sheet):
+    """``(facts, why)``: the class's reference outputs for ``sheet`` (kept in OUT) as
+    :func:`~exam_lab.grader.score.reference.facts`, or ``(None, why not)``."""
+    path = os.path.join(out, reference_file(sheet))
+    if not os.path.isfile(path):
+        return None, 'no %s in OUT (the drone was not run for the reference)' % reference_file(sheet)
+    try:
+        return facts(ReferenceRecord.read(path)), None
+    except records.RecordError as err:
+        return None, '%s is not a reference record: %s' % (reference_file(sheet), err)
+
+
+def read_report(folder):
+    """The report the run kept for one student (its ReportRecord's value; one "not read" saying why
+    when it is missing, refused, or the grader has no report reader)."""
+    record_type = getattr(records, 'ReportRecord', None)
+    if record_type is None:
+        return {'state': 'not read', 'why': 'this grader has no report reader'}
+    return record_type.kept(folder).value
+
+
+def read_comments(folder):
+    """The code's ``comments`` as the inspection measured them (measurements.json's), or None."""
+    path = os.path.join(folder, kept.MeasurementsRecord.FILE)
+    if not os.path.isfile(path):
+        return None
+    try:
+        return kept.MeasurementsRecord.read(path).comments
+    except records.RecordError:
+        return None
+
+
+def student_proposals(folder, sheet, reference):
+    """The 8 proposals of the student graded in ``folder`` (``reference``: :func:`read_reference`'s pair)."""
+    ref, why = reference
+    made = code_items.student_proposals(read_report(folder), ref, read_comments(folder))
+    if ref is None:
+        made = [dict(p, evidence='%s (%s)' % (p['evidence'], why)) if p['item'] in answers.QUESTIONS
+                and p['state'] == answers.TO_CHECK else p for p in made]
+    return safe_text.cleaned([dict(p, evidence=safe_text.one_line(p['evidence'])) for p in made])
+
+
+def write(out, grade_records, single=False):
+    """Write proposals.csv and each student's proposals.json for ``grade_records`` graded into ``out``;
+    return lines for the terminal. One student's failure (a bug) is a line, and its rows say so."""
+    rows, lines, references = [], [], {}
+    states = {}
+    for record in grade_records:
+        folder = out if single else os.path.join(out, record['student'])
+        sheet = record.get('sheet') or 'altitude'
+        if sheet not in references:
+            references[sheet] = read_reference(out, sheet)
+        try:
+            made = student_proposals(folder, sheet, references[sheet])
+            partial = os.path.join(folder, STUDENT_FILE + '.part')
+            with open(partial, 'w') as f:
+                json.dump(made, f, indent=1, sort_keys=True, ensure_ascii=False)
+            os.rename(partial, os.path.join(folder, STUDENT_FILE))
+        except Exception as err:  # one student's bug: its rows say so, the class goes on
+            why = safe_text.one_line('%s: %s' % (type(err).__name__, err))[:300]
+            lines.append('%s: proposals not made (a grader bug, please report): %s' % (record['student'], why))
+            made = [answers.proposal(item, answers.TO_CHECK, None, 'no proposal: %s' % why) for item in ITEMS]
+        for p in made:
+            states[p['state']] = states.get(p['state'], 0) + 1
+            rows.append([record.get('participant'), record['student'], p['item'],
+                         '' if p['points'] is None else _num(p['points']), _num(p['max']), p['state'],
+                         p['evidence'][:MAX_EVIDENCE]])
+    partial = os.path.join(out, FILE + '.part')
+    with open(partial, 'w', newline='') as f:
+        writer = csv.writer(f)
+        writer.writerow(COLUMNS)
+        for row in rows:
+            writer.writerow(cells.row(row))
+    os.rename(partial, os.path.join(out, FILE))
+    for sheet, (ref, why) in sorted(references.items()):
+        if ref is None:
+            lines.append('proposals of sheet %s: the answers were not compared with the drone: %s' % (sheet, why))
+    lines.append('proposals: %s (%s): the teacher confirms them on make review OUT=%s' % (
+        os.path.join(out, FILE), ', '.join('%d %s' % (n, s) for s, n in sorted(states.items())) or 'none', out))
+    return lines
+
+
+def _num(value):
+    return ('%.2f' % value).rstrip('0').rstrip('.')
+
+
+def read(path):
+    """proposals.csv's rows as dicts (each cell read back as written): what make check and a test read."""
+    with open(path, newline='') as f:
+        return [{key: cells.read_cell(value) for key, value in row.items()} for row in csv.DictReader(f)]

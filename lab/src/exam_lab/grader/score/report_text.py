@@ -1,0 +1,98 @@
+"""What in a passage of a report is the student's own: the commands pasted, the tools' output, the
+sentences of the student's (French or English), the sheet's question copied. Pure, no rospy.
+
+The one rule behind every "comment" and "explained" check of :mod:`exam_lab.grader.score.answers`
+(:func:`own_sentences`).
+"""
+import re
+
+#: A sentence of the student's own has at least this many words.
+SENTENCE_WORDS = 4
+
+#: Lines of the tools' own output: never a sentence of the student's.
+_OUTPUT = re.compile(
+    r'^\s*(?:/[\w/]+\s*(?:\[[\w/]+\])?\s*$|\*\s|data\s*:|-{3,}|average rate|min\s*:|subscribed to|no new messages'
+    r'|Node \[|Publications\s*:|Subscriptions\s*:|Services\s*:|contacting node|Pid\s*:|Connections\s*:'
+    r'|direction\s*:|transport\s*:|to\s*:\s*/|topic\s*:\s*/|float32 data\s*$|std_msgs/\w+\s*$|Created (?:file|folder)'
+    r'|Successfully created|Type\s*:|Publishers\s*:|Subscribers\s*:|\[?(?:INFO|WARN|ERROR)\]?\s*\[)', re.I)
+#: The report reader's lines around the OCR of a picture on a text page (ReportRecord's ``text``).
+_PICTURE = re.compile(r'^\s*\[(?:picture \d+, OCR|end of picture \d+)\]\s*$')
+#: A command line as pasted: a prompt, or a line that starts with one of the course's tools.
+_PROMPT = re.compile(r'^\s*(?:[\w.-]+@[\w.-]+:[^$#]*[$#]|[$#>%])\s*')
+_TOOLS = ('rosnode', 'rostopic', 'rosmsg', 'rossrv', 'rosservice', 'rosrun', 'roslaunch', 'roscore',
+          'catkin_create_pkg', 'catkin_make', 'timeout', 'source', 'cd', 'ls')
+
+
+def _first_word(line):
+    words = line.split()
+    return words[0] if words else ''
+
+
+def is_command(line):
+    """Whether a line is a command as pasted (a prompt, or a line starting with a course's tool)."""
+    return bool(_PROMPT.match(line)) or _first_word(line) in _TOOLS
+
+
+def commands_of(text):
+    """The command lines of a passage, their prompt left out (``rosnode list``)."""
+    found = []
+    for line in text.splitlines():
+        stripped = _PROMPT.sub('', line, count=1).strip()
+        for tool in ('rosnode', 'rostopic', 'rosmsg', 'catkin_create_pkg'):
+            at = re.search(r'(?<![\w/])%s\b' % tool, stripped)
+            if at:
+                found.append(stripped[at.start():])
+                break
+    return found
+
+
+#: Each question's statement as the sheets put it, word for word where both sheets agree (the copy
+#: of a question in a report is not a sentence of the student's).
+STATEMENTS = {
+    'Q4': 'run the node from the package then list all the running nodes',
+    'Q5': 'list the information about the node explain each line of the output you get',
+    'Q6': 'list all the available topics explain the role of the rosout topic',
+    'Q7': 'what kind of message is available on the topic',
+    'Q8': 'display a few messages available on the topic at which rate are they published',
+    'Q9': 'create a package exam in your catkin workspace with dependencies to rospy std_msgs and',
+}
+
+
+#: The names the sheets' statements use (``the node mydrone_node from the package mydrone``).
+_SHEET_NAMES = ' mydrone submarinedrone submarine drone node temperature pressure robot remote'
+
+
+def _words(text):
+    return re.findall(r"[^\W\d_]+(?:'[^\W\d_]+)?", text.lower())
+
+
+def _paragraphs(text):
+    """The passage's runs of lines that are neither a command nor a line of output, each joined as
+    one paragraph (a word processor wraps a sentence over lines)."""
+    paragraphs, current = [], []
+    for line in text.splitlines() + ['']:
+        if not line.strip() or is_command(line) or _OUTPUT.match(line) or _PICTURE.match(line):
+            if current:
+                paragraphs.append(' '.join(current))
+            current = []
+        else:
+            current.append(line.strip())
+    return paragraphs
+
+
+def own_sentences(text, item, least=SENTENCE_WORDS):
+    """The sentences of a passage that are the student's own: not a command, not a line of output, at
+    least ``least`` words, not the sheet's statement of ``item`` copied (most of its words are the
+    statement's or the sheet's names, and it holds no number). The rule behind every "comment" and
+    "explained" check (``least`` 1: every word of the student's, for naming each line of an output)."""
+    statement = set(_words(STATEMENTS.get(item, '') + _SHEET_NAMES)) if item in STATEMENTS else set()
+    kept = []
+    for paragraph in _paragraphs(text):
+        for sentence in re.split(r'(?<=[.!?])\s+', paragraph):
+            words = _words(sentence)
+            if len(words) < least:
+                continue
+            if statement and not re.search(r'\d', sentence) and sum(w in statement for w in words) >= 0.7 * len(words):
+                continue
+            kept.append(sentence.strip())
+    return kept
