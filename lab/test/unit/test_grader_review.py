@@ -293,3 +293,36 @@ def test_a_post_from_another_site_is_refused(running, out):
     assert hand_rows(out)['ann']['Q4'] == '1'
     status, _, body = running.request('GET', headers['Location'].split('#')[0])
     assert 'ann Q4: 1 written to hand.csv' in body
+
+
+def test_a_decision_leaves_the_machines_column_as_a_rescore_wrote_it(out):
+    """The page's records are read when it starts: a make rescore meanwhile moved the machine's points,
+    and a decision after it must not write the old ones back."""
+    path = str(out / hand.FILE)
+    records = grades.records_in(str(out))
+    rows = hand_rows(out)
+    rows['ann']['machine'] = '15.5'
+    with open(path, 'w', newline='') as f:
+        writer = csv.DictWriter(f, list(rows['ann']))
+        writer.writeheader()
+        writer.writerows(rows.values())
+    hand.give(path, records, [(hand.key(records[0]), 'Q6', 1.0, '')])
+    assert hand_rows(out)['ann']['machine'] == '15.5' and hand_rows(out)['ann']['Q6'] == '1'
+
+
+def test_a_group_decided_shows_its_points_to_change_them_once_more(out):
+    students, _ = folder.load(str(out))
+    found = groups.groups('Q4', [(s.sheet, s.proposals.get('Q4')) for s in students])
+    pair = found[0]
+    members = [students[i] for i in pair.members]
+    state = decisions.empty()
+    cells = decisions.cells_now(str(out / hand.FILE))
+    targets = {g.id: decisions.group_targets(g.id, 'Q4', [students[i] for i in g.members], cells, state) for g in found}
+    assert 'id="give-%s">Confirm<' % pair.id in page.item_page('t', '/T', 'Q4', found, students, cells, targets)
+    decisions.give(str(out), [s.record for s in students], state,
+                   [(s, 'Q4', 0.5, was) for s, was in targets[pair.id][0]], 'group', pair.id)
+    cells = decisions.cells_now(str(out / hand.FILE))
+    targets = {g.id: decisions.group_targets(g.id, 'Q4', [students[i] for i in g.members], cells, state) for g in found}
+    shown = page.item_page('t', '/T', 'Q4', found, students, cells, targets)
+    assert 'id="give-%s">Change<' % pair.id in shown and 'id="points-%s" value="0.5"' % pair.id in shown
+    assert shown.count('<strong>0.5 in hand.csv</strong>') == len(members) == 2

@@ -197,7 +197,8 @@ def give(path, records, given):
             raise HandError('%s: %s is not a number from 0 to %s' % (item, value, _points(HAND_ITEMS[item][0])))
         if found not in keys:
             raise HandError('%s is no graded student of this run' % _who(found))
-    write(path, records)  # every student's row there, the teacher's cells kept
+    if not os.path.isfile(path) or any(found not in _kept_rows(path) for found, _, _, _ in given):
+        write(path, records)  # the student's row added, every cell kept (else the machine's column is left as it is)
     rows = collections.OrderedDict((found, row) for found, (_, row) in _kept_rows(path).items())
     written, kept = [], []
     for found, item, value, was in given:

@@ -176,13 +176,17 @@ def item_page(title, base, item, found, students, cells, targets, messages=()):
         if kept:
             parts.append('<p>Kept as they are (decided alone, or typed in hand.csv): %s</p>' % ', '.join(
                 '%s (%s)' % (_e(s.name), _e(cell)) for s, cell in kept))
+        given = [cell for _, cell in write if cell]
         if write:
+            # a group decided already: its points are shown, to change them once more
+            value = given[0] if given and len(set(given)) == 1 else ('' if proposed is None else _points(proposed))
+            label = ('points for the %d student(s) (%d given by this group)' % (len(write), len(given)) if given
+                     else 'points for the %d student(s) without one' % len(write))
             parts.append('<form method="post" action="%s/item/%s/%s">' % (base, item, group.id) +
-                         '<label>points for the %d student(s) without one: <input class="points" name="points" '
-                         'id="points-%s" value="%s" inputmode="decimal"></label> ' % (
-                             len(write), group.id, '' if proposed is None else _points(proposed)) +
+                         '<label>%s: <input class="points" name="points" id="points-%s" value="%s" '
+                         'inputmode="decimal"></label> ' % (label, group.id, _e(value)) +
                          '<button type="submit" id="give-%s">%s</button></form>' % (
-                             group.id, 'Confirm' if proposed is not None else 'Give'))
+                             group.id, 'Change' if given else ('Confirm' if proposed is not None else 'Give')))
         parts.append('</div>')
     parts.append('</body></html>')
     return '\n'.join(parts)

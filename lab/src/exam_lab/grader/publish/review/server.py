@@ -42,7 +42,7 @@ class Review(object):
         self.title = 'Hand points: %s' % os.path.basename(self.out)
         self.students, self.notes = folder.load(self.out)
         self.records = [s.record for s in self.students]
-        self.lock = threading.Lock()
+        self.lock, self.said_lock = threading.Lock(), threading.Lock()
         self.messages = {}
 
     def _state(self):
@@ -53,9 +53,10 @@ class Review(object):
 
     def say(self, messages):
         key = secrets.token_urlsafe(8)
-        self.messages[key] = messages
-        while len(self.messages) > MESSAGES:
-            self.messages.pop(next(iter(self.messages)))
+        with self.said_lock:
+            self.messages[key] = messages
+            while len(self.messages) > MESSAGES:
+                self.messages.pop(next(iter(self.messages)))
         return key
 
     def groups(self, item):
