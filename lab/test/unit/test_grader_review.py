@@ -326,3 +326,24 @@ def test_a_group_decided_shows_its_points_to_change_them_once_more(out):
     shown = page.item_page('t', '/T', 'Q4', found, students, cells, targets)
     assert 'id="give-%s">Change<' % pair.id in shown and 'id="points-%s" value="0.5"' % pair.id in shown
     assert shown.count('<strong>0.5 in hand.csv</strong>') == len(members) == 2
+
+
+def review_script():
+    import importlib.util
+    spec = importlib.util.spec_from_file_location('review_script', os.path.join(
+        os.path.dirname(os.path.dirname(HERE)), 'scripts', 'review.py'))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_command_says_why_it_cannot_serve_and_prints_the_agreement(out, tmp_path, capsys):
+    script = review_script()
+    assert script.main(['--out', str(tmp_path / 'nothing')]) == 1
+    assert 'no grade.json' in capsys.readouterr().err
+    (out / 'review.json').write_text('[]')
+    assert script.main(['--out', str(out), '--agreement']) == 1
+    assert 'not a review of version 1' in capsys.readouterr().err
+    (out / 'review.json').unlink()
+    assert script.main(['--out', str(out), '--agreement']) == 0
+    assert capsys.readouterr().out.splitlines()[1].startswith('Q4       0 decided')
