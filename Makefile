@@ -12,7 +12,7 @@ TESTS ?= run_tests
 UNIT_TESTS := run_tests_exam_lab_pytest_unit run_tests_exam_lab_pytest_docs \
 	$(patsubst %/test/unit,run_tests_%_pytest_unit,$(filter-out lab/test/unit,$(wildcard */test/unit)))
 
-.PHONY: help deps build run run-submarine run-simple test test-unit test-grader report bench soak mutation fairness grade rescore worksheet check clean
+.PHONY: help deps build run run-submarine run-simple test test-unit test-grader report bench soak mutation fairness grade rescore review worksheet check clean
 
 help:
 	@echo "make run            install, build, and run the aerial drone with the exam node (Ctrl-C stops)"
@@ -31,6 +31,8 @@ help:
 	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv> [WORKSHEET_SCALE=1]] [ENGINE=local|slurm] [SLURM_ARGS='...']"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
 	@echo "make rescore OUT=<dir> [WORKSHEET=...]  today's rubric on a run's kept measurements (seconds, no ROS)"
+	@echo "make review OUT=<dir> [AGREEMENT=1]  the hand points of a class in one pass, on a page served to this"
+	@echo "                    machine only (the URL it prints; Ctrl-C stops); AGREEMENT=1: the teacher against the proposals"
 	@echo "make worksheet OUT=<dir> WORKSHEET=<Moodle grading worksheet.csv>"
 	@echo "                    the whole grade (machine + OUT/hand.csv) into the worksheet, on its scale"
 	@echo "make check PACKAGE=<dir|zip> [SHEET=altitude|depth] [REPORT=<your report.pdf>]"
@@ -94,6 +96,11 @@ grade: build
 rescore: build
 	@$(ENV) && exec python3 lab/scripts/rescore.py --out "$(OUT)" $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") \
 	  $(if $(WORKSHEET_SCALE),--worksheet-scale)
+
+# make review OUT=<make grade's OUT> [AGREEMENT=1]: the review page (127.0.0.1, a token in the URL it prints)
+review: build
+	@$(if $(OUT),,$(error make review needs OUT=<the folder make grade wrote>))
+	@$(ENV) && exec python3 lab/scripts/review.py --out "$(OUT)" $(if $(AGREEMENT),--agreement)
 
 # make worksheet OUT=<make grade's OUT> WORKSHEET=<Moodle's worksheet>: the machine's and the hand points
 # (OUT/hand.csv, filled by the teacher) as one grade on the worksheet's scale

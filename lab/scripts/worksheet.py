@@ -18,24 +18,9 @@ import glob
 import os
 import sys
 
-from exam_lab.grader.publish import feedback, hand, moodle
-from exam_lab.grader.score import kept, safe_text
+from exam_lab.grader.publish import feedback, grades, hand, moodle
+from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.schema import RecordError
-
-
-def records_in(out):
-    """The grade records of a run's OUT: one per student folder, or the single submission's, each read
-    as a :class:`~exam_lab.grader.score.kept.GradeRecord` (capped, checked, one of an older grader
-    brought to today's shape); raises RecordError naming the file of one that is not a grade."""
-    paths = sorted(glob.glob(os.path.join(out, '*', 'grade.json'))) or \
-        [p for p in [os.path.join(out, 'grade.json')] if os.path.isfile(p)]
-    records = []
-    for path in paths:
-        try:
-            records.append(kept.GradeRecord.read(path).value)
-        except RecordError as err:
-            raise RecordError('%s: %s' % (os.path.relpath(path, out), err))
-    return records
 
 
 def main(argv=None):
@@ -44,7 +29,7 @@ def main(argv=None):
     parser.add_argument('--worksheet', required=True, help="Moodle's offline grading worksheet (CSV)")
     args = parser.parse_args(argv)
     try:
-        records = records_in(args.out)
+        records = grades.records_in(args.out)
     except RecordError as err:
         # Filled from a grade that is not one, a row could be wrong: nothing is written until it is
         # graded or rescored again.

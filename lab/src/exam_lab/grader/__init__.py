@@ -60,7 +60,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.publish.provenance` (what made a grade), :mod:`~.publish.student_view` (what ``make check``
   shows a student), :mod:`~.publish.grades` (the grade record from the measurements: the rubric applied,
   by a run and by a rescore alike; the rescore), :mod:`~.publish.teacher` (the teacher's notes of a
-  grade: what the machine saw but does not score, how the code was read and run).
+  grade: what the machine saw but does not score, how the code was read and run), :mod:`~.publish.review`
+  (``make review``: the hand points confirmed on a page served to 127.0.0.1, into hand.csv).
 - :mod:`~exam_lab.grader.runner` -- one submission, top to bottom: stage, inspect (boxed), plan, build
   and run (box and judge), score (:func:`~exam_lab.grader.publish.grades.score`, also for a rescore),
   publish.

@@ -3,6 +3,7 @@
 record of a grading whose session did not run (:func:`no_session`); the record of a submission that
 could not be graded; and the rescore of a run's OUT with today's rubric.
 """
+import glob
 import os
 import traceback
 
@@ -123,3 +124,19 @@ def bug_note():
     """The teacher's note of a grader bug being handled: its traceback on one line, its last
     MAX_LOG_TEXT characters (a deep recursion's would outgrow any record)."""
     return 'grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')[-records.MAX_LOG_TEXT:]
+
+
+def records_in(out, with_folders=False):
+    """The grade records of a run's OUT: one per student folder, or the single submission's, each read
+    as a :class:`~exam_lab.grader.score.kept.GradeRecord` (capped, checked, one of an older grader
+    brought to today's shape); raises RecordError naming the file of one that is not a grade.
+    ``with_folders``: ``(its folder, record)`` each (the student's files beside its grade)."""
+    paths = sorted(glob.glob(os.path.join(out, '*', 'grade.json'))) or \
+        [p for p in [os.path.join(out, 'grade.json')] if os.path.isfile(p)]
+    found = []
+    for path in paths:
+        try:
+            found.append((os.path.dirname(path), kept.GradeRecord.read(path).value))
+        except records.RecordError as err:
+            raise records.RecordError('%s: %s' % (os.path.relpath(path, out), err))
+    return found if with_folders else [record for _, record in found]

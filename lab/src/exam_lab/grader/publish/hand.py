@@ -60,6 +60,11 @@ def _points(x):
     return ('%.2f' % x).rstrip('0').rstrip('.')
 
 
+def points_cell(x):
+    """Points as hand.csv holds them (``1.5``, ``0.25``, ``2``); empty for None (not given)."""
+    return '' if x is None else _points(x)
+
+
 def _max_row():
     row = {c: '' for c in COLUMNS}
     row.update({'student': MAX_ROW, 'machine': _points(MACHINE_MAX)})
@@ -153,6 +158,13 @@ def write(path, records):
         row['participant'] = '' if not isinstance(found, int) else str(found)
         row['sheet'] = record.get('sheet', '')
         row['machine'] = _points(record['total'])
+    _save(path, rows)
+    return added
+
+
+def _save(path, rows):
+    """``rows`` (``{key: row}``) into ``path`` at once: the columns make grade wrote, then any the
+    teacher added, each cell one no spreadsheet runs."""
     columns = COLUMNS + sorted({c for row in rows.values() for c in row if c and c not in COLUMNS})
     temporary = path + '.new'
     with open(temporary, 'w', newline='', encoding='utf-8') as f:
@@ -162,7 +174,49 @@ def write(path, records):
         for row in rows.values():
             writer.writerow({c: cells.cell(row.get(c) or '') for c in columns})
     os.replace(temporary, path)
-    return added
+
+
+def give(path, records, given):
+    """Write points the teacher gave elsewhere than in the spreadsheet (the review page,
+    :mod:`~exam_lab.grader.publish.review`) into ``hand.csv``, each only over the cell it was decided on.
+
+    :param given: ``[(key, item, value, was)]``: the student's :func:`key`, a hand item, the points (a
+        float, or None to empty the cell: a point not given) and the cell's text when the teacher
+        decided (``''`` for empty): a cell that holds anything else now (typed in the spreadsheet
+        meanwhile, or by another decision) is left as it is.
+    :returns: ``(written, kept)``: the ``(key, item)`` written, and ``(key, item, cell now)`` of those
+        left as they were.
+    :raises HandError: as :func:`write` (nothing is written then); also an item that is no hand item,
+        a value outside its item's range, a key no record has.
+    """
+    keys = {key(record) for record in records}
+    for found, item, value, _ in given:
+        if item not in HAND_ITEMS:
+            raise HandError('%s is no hand item (%s)' % (item, ', '.join(HAND_ITEMS)))
+        if value is not None and not 0.0 <= value <= HAND_ITEMS[item][0]:
+            raise HandError('%s: %s is not a number from 0 to %s' % (item, value, _points(HAND_ITEMS[item][0])))
+        if found not in keys:
+            raise HandError('%s is no graded student of this run' % _who(found))
+    if not os.path.isfile(path) or any(found not in _kept_rows(path) for found, _, _, _ in given):
+        write(path, records)  # the student's row added, every cell kept (else the machine's column is left as it is)
+    rows = collections.OrderedDict((found, row) for found, (_, row) in _kept_rows(path).items())
+    written, kept = [], []
+    for found, item, value, was in given:
+        now = (rows[found].get(item) or '').strip()
+        if not _same(now, (was or '').strip()):
+            kept.append((found, item, now))
+            continue
+        rows[found][item] = '' if value is None else _points(value)
+        written.append((found, item))
+    if written:
+        _save(path, rows)
+    return written, kept
+
+
+def _same(cell, other):
+    """Whether two cells hold one value (``1,5`` is ``1.5``; empty is only empty)."""
+    return cell == other or (bool(cell) and bool(other) and _number(cell) is not None
+                             and _number(cell) == _number(other))
 
 
 def _number(text):
