@@ -14,27 +14,38 @@ file was written, 1 when it could not be (hand.csv, its rows or the worksheet un
 is printed). No ROS, no sandbox, no root: it reads records only.
 """
 import argparse
-import glob
 import os
 import sys
 
-from exam_lab.grader.publish import feedback, hand, moodle
+from exam_lab.grader import contract
+from exam_lab.grader.publish import feedback, grades, hand, moodle
 from exam_lab.grader.score import kept, safe_text
 from exam_lab.grader.score.schema import RecordError
 
 
+def graded_in(out):
+    """The folders of a run's OUT holding a grade.json: one per student folder (a folder listed, never a
+    link: :func:`~exam_lab.grader.contract.folders`), or OUT itself for the single submission."""
+    folders = [os.path.join(out, name) for name in contract.folders(out)
+               if contract.exists(os.path.join(out, name, kept.GradeRecord.FILE))]
+    if folders:
+        return folders
+    return [out] if contract.exists(os.path.join(out, kept.GradeRecord.FILE)) else []
+
+
 def records_in(out):
     """The grade records of a run's OUT: one per student folder, or the single submission's, each read
-    as a :class:`~exam_lab.grader.score.kept.GradeRecord` (capped, checked, one of an older grader
-    brought to today's shape); raises RecordError naming the file of one that is not a grade."""
-    paths = sorted(glob.glob(os.path.join(out, '*', 'grade.json'))) or \
-        [p for p in [os.path.join(out, 'grade.json')] if os.path.isfile(p)]
+    through the contract as a :class:`~exam_lab.grader.score.kept.GradeRecord` (no link, a regular
+    file, capped, checked: its total the sum of its items, its status the rubric's, the student of
+    its folder: :func:`~exam_lab.grader.publish.grades.read_grade`); raises RecordError naming the
+    file of one that is not a grade."""
     records = []
-    for path in paths:
+    for folder in graded_in(out):
         try:
-            records.append(kept.GradeRecord.read(path).value)
+            records.append(grades.read_grade(out, folder))
         except RecordError as err:
-            raise RecordError('%s: %s' % (os.path.relpath(path, out), err))
+            where = os.path.relpath(os.path.join(folder, kept.GradeRecord.FILE), out)
+            raise RecordError(str(err) if str(err).startswith(where) else '%s: %s' % (where, err))
     return records
 
 
@@ -43,6 +54,7 @@ def main(argv=None):
     parser.add_argument('--out', required=True, help='the folder make grade wrote (grade.json files, hand.csv)')
     parser.add_argument('--worksheet', required=True, help="Moodle's offline grading worksheet (CSV)")
     args = parser.parse_args(argv)
+    args.out = os.path.realpath(args.out)  # the teacher's path, followed once; nothing below it is
     try:
         records = records_in(args.out)
     except RecordError as err:
@@ -56,11 +68,11 @@ def main(argv=None):
         return 1
     path = os.path.join(args.out, hand.FILE)
     try:
-        hands = hand.read(path) if os.path.isfile(path) else {}
+        hands = hand.read(path) if contract.exists(path) else {}
     except hand.HandError as err:
         print('worksheet: %s' % safe_text.clean(str(err)), file=sys.stderr)
         return 1
-    if not os.path.isfile(path):
+    if not contract.exists(path):
         print('worksheet: no %s: every student\'s hand points are missing (make grade writes it)' % path)
     try:
         rows, notes = hand.match(hands, records)
@@ -84,7 +96,7 @@ def main(argv=None):
               % (len(missing), path))
         for record in missing:
             print('  %s: %s' % (safe_text.one_line(record['student']), ', '.join(record['missing'])))
-    for line in feedback.write(args.out, records, single=not glob.glob(os.path.join(args.out, '*', 'grade.json'))):
+    for line in feedback.write(args.out, records, single=graded_in(args.out) == [args.out]):
         print(line)
     return 0
 

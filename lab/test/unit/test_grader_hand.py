@@ -10,9 +10,13 @@ from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 
 def record(student, total, participant=None):
     """A grade record as the grader makes it (:func:`report.grade_record`): the machine's items, the
-    last one short of ``17 - total``."""
+    last ones short of ``17 - total`` (each from 0 to its maximum, as the rubric gives them)."""
     items = [{'id': item, 'points': top, 'max': top, 'evidence': 'ok'} for item, (top, _) in ITEMS.items()]
-    items[-1]['points'] -= 17.0 - total
+    short = 17.0 - total
+    for item in reversed(items):
+        taken = min(short, item['points'])
+        item['points'] -= taken
+        short -= taken
     return report.grade_record(student, 'altitude', items, [], {'participant': participant})
 
 

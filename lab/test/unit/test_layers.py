@@ -124,19 +124,22 @@ def test_the_oracle_is_independent_of_the_answer():
 #: folders named here (and itself, and nothing of the grader beyond them), relative imports included:
 #: what runs as a box's uid on the student's bytes (boxed) leans on pure records only; the judge (a
 #: judge uid, never root) the same; root's side (host) never imports what reads student bytes or runs
-#: the student's nodes; score and publish are pure; the runner is one submission's pipeline; class_run
-#: lists a class's students and grades each by the runner; engine/ is the host as the teacher,
-#: submitting classes elsewhere, each student by class_run.
+#: the student's nodes; root reads what it did not write through the contract (the one reader of
+#: foreign files, the one writer in OUT); score and publish
+#: are pure; the runner is one submission's pipeline; class_run lists a class's students and grades
+#: each by the runner; engine/ is the host as the teacher, submitting classes elsewhere, each student
+#: by class_run.
 GRADER = 'exam_lab.grader'
 MAY_IMPORT = {
     'boxed': ('score',),
     'judge': ('score',),
-    'host': ('score',),
+    'contract': ('score',),
+    'host': ('contract', 'score'),
     'score': (),
-    'publish': ('score',),
-    'runner': ('boxed', 'judge', 'host', 'score', 'publish'),
-    'class_run': ('runner', 'boxed', 'host', 'score', 'publish'),
-    'engine': ('class_run', 'host', 'score', 'publish'),
+    'publish': ('contract', 'score'),
+    'runner': ('boxed', 'contract', 'host', 'score', 'publish'),
+    'class_run': ('runner', 'boxed', 'contract', 'host', 'score', 'publish'),
+    'engine': ('class_run', 'contract', 'host', 'score', 'publish'),
 }
 #: The package itself (``exam_lab.grader``: ``workspace()``) is plain configuration, open to every folder.
 PACKAGE_ITSELF = (GRADER,)
@@ -212,8 +215,9 @@ def test_the_pure_grader_folders_import_no_ros(folder):
 
 
 def test_every_grader_module_lives_in_a_trust_folder():
-    """Only the package itself, the runner (one submission's pipeline) and class_run (a class) sit at the
-    grader's top level; every other module is in a folder of MAY_IMPORT."""
+    """Only the package itself, the runner (one submission's pipeline), class_run (a class) and the
+    contract (the one reader of foreign files, the one writer in OUT) sit at the grader's top level;
+    every other module is in a folder of MAY_IMPORT."""
     top = [name for name in source_modules() if name.startswith(GRADER + '.') and name.count('.') == 2]
     assert sorted(top) == ['%s.%s' % (GRADER, f) for f in sorted(MAY_IMPORT)]
 

@@ -24,9 +24,7 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.host.uids` (a slot's box and judge uids, under a lock; what runs as them ended),
   :mod:`~.host.cgroups` (the box's and the judge's cgroups), :mod:`~.host.limits` (their bounds;
   prlimit), :mod:`~.host.bwrap` (bubblewrap's command line; the session's network namespace),
-  :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder),
-  :mod:`~.host.egress` (the only reader of what a box leaves: its record, capped, never a link, checked
-  against its schema; its logs, capped), :mod:`~.host.boxed_run` (one of the grader's modules run in a
+  :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder), :mod:`~.host.boxed_run` (one of the grader's modules run in a
   box on student bytes, its record read back) and :mod:`~.host.underlay` (the simulators' workspace,
   built once, under every student's package).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima),
@@ -53,6 +51,10 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   shows a student), :mod:`~.publish.grades` (the grade record from the measurements: the rubric applied,
   by a run and by a rescore alike; the rescore), :mod:`~.publish.teacher` (the teacher's notes of a
   grade: what the machine saw but does not score, how the code was read and run).
+- :mod:`~exam_lab.grader.contract` -- root's one reader of a file it did not write in this process (a
+  box's or the judge's record and logs, every file kept in OUT: no link followed, regular files only,
+  never blocking, capped, checked against its type) and its one writer in OUT (a temporary file, then
+  ``os.replace``: never through an existing entry).
 - :mod:`~exam_lab.grader.runner` -- one submission, top to bottom: stage, inspect (boxed), plan, build
   and run (box and judge), score (:func:`~exam_lab.grader.publish.grades.score`, also for a rescore),
   publish.

@@ -8,7 +8,7 @@ import os
 import re
 import shutil
 
-from exam_lab.grader import runner
+from exam_lab.grader import contract, runner
 from exam_lab.grader.boxed import archives, bounds, classlist, similarity
 from exam_lab.grader.host import sandbox, staging
 from exam_lab.grader.host.boxed_run import INTAKE_BOUNDS, SIMILARITY_BOUNDS, Boxed, InspectionFailed
@@ -106,14 +106,12 @@ def kept_folders(out):
     kept = {}
     if not out or not os.path.isdir(out):
         return kept
-    for name in sorted(os.listdir(out)):
+    for name in contract.folders(out):
         for record_type in (kept_records.MeasurementsRecord, kept_records.GradeRecord):
-            path = os.path.join(out, name, record_type.FILE)
-            if not os.path.isfile(path):
-                continue
-            try:
-                with open(path, 'rb') as f:
-                    facts = schema.load(f.read(record_type.MAX_BYTES + 1), record_type.FILE, constants=True)
+            try:  # through the contract: no link, a regular file, capped; its shape unchecked on purpose
+                facts = schema.load(contract.read_bytes(os.path.join(out, name, record_type.FILE),
+                                                        record_type.MAX_BYTES, under=out),
+                                    record_type.FILE, constants=True)
             except (OSError, records.RecordError):
                 continue
             if record_type is kept_records.MeasurementsRecord and isinstance(facts, dict):
@@ -164,9 +162,9 @@ def grade_student(name, folder, out_dir, *, sheet=None, underlay=None, isolate=N
     :param refused: why the class's intake did not unpack this student's files (its own bounds): the
         student is not graded, with that sentence, and its measurements are kept for a rescore.
     """
-    if refused is not None:
-        return _refused_at_intake(name, folder, os.path.join(out_dir, name), sheet, refused)
     try:
+        if refused is not None:
+            return _refused_at_intake(name, folder, os.path.join(out_dir, name), sheet, refused)
         return runner.grade_submission(folder, os.path.join(out_dir, name), sheet=sheet, student=name, underlay=underlay,
                                        isolate=isolate,
                                        on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
@@ -177,7 +175,7 @@ def grade_student(name, folder, out_dir, *, sheet=None, underlay=None, isolate=N
         record = dict(record, participant=identity.participant_number(moodle_name), folder=moodle_name)  # who, even so
         try:
             report.write_grade(os.path.join(out_dir, name), record)
-        except OSError:
+        except (OSError, records.RecordError):  # its folder of OUT a link: nothing written through it
             pass
         return record
 
@@ -190,7 +188,7 @@ def _refused_at_intake(name, folder, out_dir, sheet, why):
                 'session': grades.no_session(records.Outcome.REFUSED, 'submission refused: %s' % why, refused=True).value,
                 'extra': {'participant': identity.participant_number(folder_name), 'folder': folder_name,
                           'documents': [], 'seconds': 0.0}}
-    os.makedirs(out_dir, exist_ok=True)
+    contract.make_folder(out_dir)
     return grades.keep_and_score(out_dir, measured)
 
 
@@ -237,10 +235,7 @@ def class_similarity(klass, out, records_):
     finally:
         for work in work_dirs:
             shutil.rmtree(work, ignore_errors=True)
-    partial = os.path.join(out, records.SimilarityRecord.FILE + '.part')
-    with open(partial, 'w') as f:
-        f.write(result.to_json() + '\n')
-    os.rename(partial, os.path.join(out, records.SimilarityRecord.FILE))
+    contract.write_record(os.path.join(out, records.SimilarityRecord.FILE), result)
     return result
 
 

@@ -32,7 +32,8 @@ import sys
 import time
 
 from exam_lab.grader.boxed import archives
-from exam_lab.grader.host import bwrap, egress, limits, sandbox, staging
+from exam_lab.grader import contract
+from exam_lab.grader.host import bwrap, limits, sandbox, staging
 from exam_lab.grader.host.boxed_run import INSPECT_BOUNDS, Boxed, InspectionFailed, session_tail
 from exam_lab.grader.host.bwrap import can_isolate
 from exam_lab.grader.host.session import budget_sentence
@@ -77,7 +78,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
         raise sandbox.SandboxUnavailable(refusal)
     isolate = can_isolate() if isolate is None else isolate
     underlay = underlay or ensure_underlay(default_underlay())  # raises: the grader cannot run
-    os.makedirs(out_dir, exist_ok=True)
+    contract.make_folder(out_dir)  # a folder of OUT that is a link is refused here, before anything is run
     deadline = time.monotonic() + STUDENT_BUDGET  # the student's own time starts here, the simulators built
     work = staging.new_work('exam-grade-')
     folder = os.path.basename(os.path.abspath(submission).rstrip('/'))
@@ -95,7 +96,8 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                 notes.append(teacher.how_read(box, found.uid, INSPECT_BOUNDS))
                 notes.extend(found.notes)
                 fixes.extend(found.fixes)
-                facts, comments = found.facts, found.comments
+                # Who it is, as root read it from the listed entry's name: never as the box says.
+                facts, comments = dict(found.facts, participant=facts['participant'], folder=facts['folder']), found.comments
                 if found.refused is not None:
                     raise archives.UnpackError(found.refused)
                 chosen_sheet, static = found.sheet, found.static
@@ -205,11 +207,11 @@ def run_session(job, *, work, underlay, isolate, box, on_step=None, left=STUDENT
 def session_outcome(log_dir, status, output, left, survivors):
     """The session's record (a :class:`~exam_lab.grader.score.records.SessionRecord`): the one
     it wrote in ``log_dir`` when it ended well (``status`` 0), read through
-    :func:`~exam_lab.grader.host.egress.read_record` (capped, checked), else why there is none;
+    :func:`~exam_lab.grader.host.contract.read_record` (capped, checked), else why there is none;
     ``survivors`` (processes of the box's uid found after it) added to its count."""
     if status == 0:
         try:
-            result = egress.read_record(os.path.join(log_dir, records.SessionRecord.FILE), records.SessionRecord,
+            result = contract.read_record(os.path.join(log_dir, records.SessionRecord.FILE), records.SessionRecord,
                                         records.SessionRecord.MAX_BYTES)
         except records.RecordError as err:
             return grades.no_session(Outcome.SESSION_FAILED, 'the session\'s record was refused: %s' % err,
@@ -223,12 +225,12 @@ def session_outcome(log_dir, status, output, left, survivors):
 
 
 def keep_logs(work, out_dir):
-    """Copy the session's logs into ``out_dir/logs`` as data (:func:`~exam_lab.grader.host.egress.copy_results`);
+    """Copy the session's logs into ``out_dir/logs`` as data (:func:`~exam_lab.grader.host.contract.copy_results`);
     return the notes on what was not copied."""
     logs = os.path.join(out_dir, 'logs')
     shutil.rmtree(logs, ignore_errors=True)
     if os.path.isdir(os.path.join(work, 'logs')):
-        skipped = egress.copy_results(os.path.join(work, 'logs'), logs)
+        skipped = contract.copy_results(os.path.join(work, 'logs'), logs)
         if skipped:
             return ['not copied to logs/ (not a regular file): %s' % ', '.join(skipped)]
     return []

@@ -23,13 +23,15 @@ spreadsheet runs and read back as it was (:mod:`~exam_lab.grader.publish.cells`)
 import collections
 import csv
 import io
-import os
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import cells
 from exam_lab.grader.score.identity import identity
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 
 FILE = 'hand.csv'
+#: Most bytes of hand.csv read: a class of a thousand students with long remarks fits many times over.
+MAX_BYTES = 8 << 20
 #: The row that shows each column's maximum to the teacher (skipped when read).
 MAX_ROW = '(max)'
 COLUMNS = ['student', 'participant', 'sheet', 'machine'] + list(HAND_ITEMS) + ['remark']
@@ -68,9 +70,12 @@ def _max_row():
 
 
 def _rows(path):
-    """The rows of an existing hand.csv as dicts (a spreadsheet may add a BOM or use ';')."""
-    with open(path, newline='', encoding='utf-8-sig') as f:
-        text = f.read()
+    """The rows of an existing hand.csv as dicts (a spreadsheet may add a BOM or use ';'), read through
+    the contract (no link, a regular file, capped, UTF-8): HandError naming the file otherwise."""
+    try:
+        text = contract.read_text(path, MAX_BYTES)
+    except contract.ContractError as err:
+        raise HandError('%s: %s' % (path, str(err).split(': ', 1)[-1]))
     try:  # only the delimiter: a header without quotes makes the sniffer turn doubled quotes off
         delimiter = csv.Sniffer().sniff(text.split('\n', 1)[0], delimiters=',;\t').delimiter
     except csv.Error:
@@ -140,7 +145,7 @@ def write(path, records):
         two records are one participant (nothing is written then).
     """
     _unique_keys(records)
-    kept = _kept_rows(path) if os.path.isfile(path) else collections.OrderedDict()
+    kept = _kept_rows(path) if contract.exists(path) else collections.OrderedDict()
     rows = collections.OrderedDict((found, row) for found, (_, row) in kept.items())
     added = 0
     for record in records:
@@ -154,14 +159,13 @@ def write(path, records):
         row['sheet'] = record.get('sheet', '')
         row['machine'] = _points(record['total'])
     columns = COLUMNS + sorted({c for row in rows.values() for c in row if c and c not in COLUMNS})
-    temporary = path + '.new'
-    with open(temporary, 'w', newline='', encoding='utf-8') as f:
-        writer = csv.DictWriter(f, columns, extrasaction='ignore')
-        writer.writeheader()
-        writer.writerow(_max_row())
-        for row in rows.values():
-            writer.writerow({c: cells.cell(row.get(c) or '') for c in columns})
-    os.replace(temporary, path)
+    text = io.StringIO(newline='')
+    writer = csv.DictWriter(text, columns, extrasaction='ignore')
+    writer.writeheader()
+    writer.writerow(_max_row())
+    for row in rows.values():
+        writer.writerow({c: cells.cell(row.get(c) or '') for c in columns})
+    contract.write_text(path, text.getvalue())
     return added
 
 

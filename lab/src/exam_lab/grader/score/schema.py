@@ -302,7 +302,7 @@ class Record(object):
     @classmethod
     def read(cls, path):
         """The record in the file ``path``, one the grader wrote itself (kept in OUT; for a box's, root
-        uses :func:`exam_lab.grader.host.egress.read_record`): read up to ``MAX_BYTES``, then as
+        uses :func:`exam_lab.grader.contract.read_record`): read up to ``MAX_BYTES``, then as
         :meth:`from_json`; raises :class:`RecordError` naming the file when it cannot be read."""
         try:
             with open(path, 'rb') as f:
