@@ -66,6 +66,9 @@ def main(argv=None):
     if not records:
         print('worksheet: no grade.json in %s: run make grade first' % args.out, file=sys.stderr)
         return 1
+    records, twice = hand.newest(records)  # one participant graded twice: its newest, said; never the class's
+    for line in twice:
+        print(safe_text.one_line(line))
     path = os.path.join(args.out, hand.FILE)
     try:
         hands = hand.read(path) if contract.exists(path) else {}

@@ -15,7 +15,7 @@ from exam_lab.grader.boxed import archives
 from exam_lab.grader.boxed.archives import (ARCHIVE_ENDINGS, SKIPPED_DIRS, UNREADABLE, Plan, UnpackError, open_archive,
                                             shown_name, tar_entries, unreadable_why, without_ending, write_plan,
                                             zip_entries)
-from exam_lab.grader.score.identity import participant_number, student_name
+from exam_lab.grader.score.identity import moodle_span, participant_number, student_name
 
 #: A class archive ("download all submissions") holds every student's uploads: its bounds as a whole
 #: (entries, bytes of the students it unpacks); each student's files are paid from MAX_FILES / MAX_BYTES.
@@ -25,9 +25,10 @@ CLASS_BYTES = 4 * 1024 * 1024 * 1024
 #: included: a compressed tar is decompressed to find each next entry, so a student's file over its own
 #: bounds (a 5 GB recording) is read, never kept, up to this bound of the class's.
 CLASS_READ_BYTES = 4 * CLASS_BYTES
-#: Characters kept at the end of a student's name too long to be a folder's (:func:`_fitting`): Moodle's
-#: ``_<participant>_assignsubmission_file_`` and more, at most 240 bytes in any script.
-_KEPT_END = 60
+#: Characters kept at the end of the parts of a name too long to be a folder's (:func:`_fitting`): of
+#: the student's name before Moodle's ``_<participant>_assignsubmission_<plugin>_``, and of the
+#: student's own file name after it (an archive's ending).
+_KEPT_END = 16
 
 
 #: Why a student's entry of a class folder that is a link is not graded (:func:`list_students`).
@@ -181,17 +182,36 @@ def unpack_class(archive, target, refused):
 
 def _fitting(key):
     """A student's top entry as a name this file system takes: one of more than NAME_MAX bytes (Moodle
-    allows 100 characters each for a first and a last name: 300 bytes and more in Cyrillic or Chinese)
-    loses characters from its middle, its start and its end (the participant number, the plugin, an
-    archive's ending) kept, so that one long name stops no one else."""
-    def fits(name):
-        return len(name.encode('utf-8', 'surrogateescape')) <= archives.NAME_MAX
-    if fits(key):
+    allows 100 characters each for a first and a last name: 300 bytes and more in Cyrillic or Chinese;
+    a flat download's entry ends with the student's own file name) loses characters from the middle of
+    the student's file name, then from the middle of the student's name, so that one long name stops no
+    one else. Moodle's part, ``_<participant>_assignsubmission_<plugin>_``, is kept whole and first: the
+    participant number read from the name (:func:`~exam_lab.grader.score.identity.participant_number`)
+    is the one Moodle wrote, never one of the student's file name."""
+    if _size(key) <= archives.NAME_MAX:
         return key
-    head, tail = key[:-_KEPT_END], key[-_KEPT_END:]
-    while not fits(head + '-' + tail):
-        head = head[:-1]
-    return head + '-' + tail
+    span = moodle_span(key)
+    if span is None:
+        return _shortened(key, archives.NAME_MAX)
+    head, moodle, tail = key[:span[0]], key[span[0]:span[1]], key[span[1]:]
+    room = archives.NAME_MAX - _size(moodle)
+    tail = _shortened(tail, room - _size(head))  # the student's file name first, then its name
+    return _shortened(head, room - _size(tail)) + moodle + tail
+
+
+def _size(name):
+    return len(name.encode('utf-8', 'surrogateescape'))
+
+
+def _shortened(part, room):
+    """``part`` in at most ``room`` bytes when it can be: its middle cut (``-``), its last _KEPT_END
+    characters kept."""
+    if _size(part) <= room or not part:
+        return part
+    start, end = part[:-_KEPT_END], part[-_KEPT_END:]
+    while start and _size(start + '-' + end) > room:
+        start = start[:-1]
+    return start + '-' + end
 
 
 def _students_of(entries):

@@ -133,6 +133,10 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         entry = entries[record['student']] = _student(out, record, single)
         entry['problems'][:0] = refused.get(id(record), [])
         lines += ['%s: %s' % (record['student'], problem) for problem in entry['problems']]
+    # One participant graded twice (two archives, two folders) is that participant's matter: its newest
+    # grade goes to the worksheet and the feedback zip, said here; everyone else's as always.
+    newest, twice = hand.newest(records)
+    lines += twice
     try:
         added = hand.write(os.path.join(out, hand.FILE), records)
         lines.append('hand points: %s (%d new row(s)): fill in the %d points the machine does not judge, '
@@ -144,7 +148,7 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         base = os.path.splitext(os.path.basename(worksheet))[0]
         target = os.path.join(out, '%s-filled.csv' % base)
         try:
-            summary = moodle.fill_file(worksheet, target, records, scale)
+            summary = moodle.fill_file(worksheet, target, newest, scale)
             lines += moodle.summary_lines(summary, target)
             contract.write_text(os.path.join(out, 'worksheet.json'), json.dumps(summary, indent=1, sort_keys=True))
         except (moodle.WorksheetError, OSError) as err:
@@ -152,7 +156,7 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         except Exception as err:  # a bug on one record's text: the page must still say so
             lines.append('worksheet NOT filled (a grader bug, please report): %s' % _failure(err))
     try:
-        lines += feedback.write(out, records, single, show)
+        lines += feedback.write(out, newest, single, show)
     except Exception as err:  # the grades are written; the page must still say why the zip is not
         lines.append('moodle feedback NOT written (a grader bug, please report): %s' % _failure(err))
     # The desk's lines quote a worksheet's cells, hand.csv's, an error's words: one line each, made

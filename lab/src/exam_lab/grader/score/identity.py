@@ -17,6 +17,8 @@ _FOLDER_NUMBER = re.compile(r'_([0-9]+)_assign(?:submission|feedback)_')
 #: The whole prefix Moodle gives a student's folder (or flat file) in that zip: the folder of Moodle 3.1 to
 #: 4.0 and a flat file's prefix end in '_', a folder of Moodle 4.1 on ends with the plugin's name.
 _MOODLE_FOLDER = re.compile(r'^(.*?_[0-9]+_assign(?:submission|feedback)_[a-z]+(?:_|$))')
+#: Moodle's own part of a "download all submissions" name, from the number to the plugin's name.
+_MOODLE_PART = re.compile(r'_[0-9]+_assign(?:submission|feedback)_[a-z]+(?:_|$)')
 #: Endings of the files a class's run writes in OUT beside the students' folders (grades.csv, index.html,
 #: hand.csv, similarity.json, the filled worksheet...): a student's folder never has one.
 OUTPUT_ENDINGS = ('.csv', '.html', '.json', '.jsonl', '.md', '.png', '.txt', '.log', '.zip')
@@ -29,6 +31,14 @@ def participant_number(name):
     """The participant's unique id in a Moodle "download all submissions" name, or None."""
     match = _FOLDER_NUMBER.search(name + '_' if not name.endswith('_') else name)
     return int(match.group(1)) if match else None
+
+
+def moodle_span(name):
+    """``(start, end)`` of Moodle's part of a "download all submissions" name (``_1234_assignsubmission_
+    file_``: the participant number, :func:`participant_number`'s), or None: what a name shortened to
+    fit a folder keeps whole."""
+    match = _MOODLE_PART.search(name)
+    return match.span() if match else None
 
 
 def identity(record):
