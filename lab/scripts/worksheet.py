@@ -45,7 +45,9 @@ def records_in(out):
             records.append(grades.read_grade(out, folder))
         except RecordError as err:
             where = os.path.relpath(os.path.join(folder, kept.GradeRecord.FILE), out)
-            raise RecordError(str(err) if str(err).startswith(where) else '%s: %s' % (where, err))
+            why = str(err)  # named by its place in OUT, once
+            raise RecordError(why if why.startswith(where) else where + why[len(kept.GradeRecord.FILE):]
+                              if why.startswith(kept.GradeRecord.FILE) else '%s: %s' % (where, why))
     return records
 
 

@@ -123,9 +123,9 @@ def test_the_oracle_is_independent_of_the_answer():
 #: The grader's folders by trust level (exam_lab.grader's docstring). Each folder may import only the
 #: folders named here (and itself, and nothing of the grader beyond them), relative imports included:
 #: what runs as a box's uid on the student's bytes (boxed) leans on pure records only; the judge (a
-#: judge uid, never root) the same; root's side (host) never imports what reads student bytes or runs
-#: the student's nodes; root reads what it did not write through the contract (the one reader of
-#: foreign files, the one writer in OUT); score and publish
+#: judge uid, never root) the same; root's side (host, the runner, class_run, engine) never imports
+#: boxed/ nor judge/: root never runs box code, it runs a box (``python -m`` in it) and reads its record
+#: through the contract (the one reader of foreign files, the one writer in OUT); score and publish
 #: are pure; the runner is one submission's pipeline; class_run lists a class's students and grades
 #: each by the runner; engine/ is the host as the teacher, submitting classes elsewhere, each student
 #: by class_run.
@@ -137,10 +137,12 @@ MAY_IMPORT = {
     'host': ('contract', 'score'),
     'score': (),
     'publish': ('contract', 'score'),
-    'runner': ('boxed', 'contract', 'host', 'score', 'publish'),
-    'class_run': ('runner', 'boxed', 'contract', 'host', 'score', 'publish'),
+    'runner': ('contract', 'host', 'score', 'publish'),
+    'class_run': ('runner', 'contract', 'host', 'score', 'publish'),
     'engine': ('class_run', 'contract', 'host', 'score', 'publish'),
 }
+#: Root's side: none of these may import boxed/ (nor judge/), whatever MAY_IMPORT is changed to.
+ROOT_SIDE = ('host', 'runner', 'class_run', 'engine')
 #: The package itself (``exam_lab.grader``: ``workspace()``) is plain configuration, open to every folder.
 PACKAGE_ITSELF = (GRADER,)
 
@@ -184,6 +186,28 @@ def test_the_grader_folders_keep_to_their_trust_level(folder):
     modules = {name: source_modules()[name] for name in grader_modules(folder)}
     assert modules, 'no modules under %s.%s' % (GRADER, folder)
     assert trust_violations(folder, modules) == []
+
+
+def test_root_side_may_not_import_box_code():
+    assert [f for f in ROOT_SIDE if {'boxed', 'judge'} & set(MAY_IMPORT[f])] == []
+
+
+@pytest.mark.parametrize('folder', ROOT_SIDE)
+def test_the_trust_check_sees_root_importing_box_code(tmp_path, folder):
+    # A planted module of root's side that imports box code, absolutely and relatively: the check
+    # must fail on each.
+    planted = tmp_path / 'planted.py'
+    planted.write_text('from exam_lab.grader.boxed import similarity\nimport exam_lab.grader.boxed.classlist\n'
+                       'from exam_lab.grader.judge import probe\n')
+    name = '%s.%s' % (GRADER, folder) if folder in ('runner', 'class_run') else '%s.%s.planted' % (GRADER, folder)
+    offending = trust_violations(folder, {name: str(planted)})
+    assert '%s imports %s.boxed.similarity' % (name, GRADER) in offending
+    assert '%s imports %s.boxed.classlist' % (name, GRADER) in offending
+    assert '%s imports %s.judge.probe' % (name, GRADER) in offending
+    relative = tmp_path / 'relative.py'
+    relative.write_text('from ..boxed import archives\n' if folder not in ('runner', 'class_run') else
+                        'from .boxed import archives\n')
+    assert '%s imports %s.boxed.archives' % (name, GRADER) in trust_violations(folder, {name: str(relative)})
 
 
 def test_the_trust_check_sees_a_forbidden_import_absolute_or_relative(tmp_path):

@@ -24,7 +24,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.host.uids` (a slot's box and judge uids, under a lock; what runs as them ended),
   :mod:`~.host.cgroups` (the box's and the judge's cgroups), :mod:`~.host.limits` (their bounds;
   prlimit), :mod:`~.host.bwrap` (bubblewrap's command line; the session's network namespace),
-  :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder), :mod:`~.host.boxed_run` (one of the grader's modules run in a
+  :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder), :mod:`~.host.classfolder`
+  (a class folder's students, by its entries' names), :mod:`~.host.similarity_setup` (the similarity
+  check's venv and boilerplate, made by root before its box), :mod:`~.host.boxed_run` (one of the grader's modules run in a
   box on student bytes, its record read back) and :mod:`~.host.underlay` (the simulators' workspace,
   built once, under every student's package).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima),
@@ -38,7 +40,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   (the typed records that cross the boundary, with their schemas), :mod:`~.score.kept` (what a grading
   keeps, as records: its measurements and its grade, versioned), :mod:`~.score.schema` (a schema, its
   check, the base of every record), :mod:`~.score.identity` (who a
-  submission is: Moodle's participant number and folder, the student's name) and :mod:`~.score.boxenv`
+  submission is: Moodle's participant number and folder, the student's name; a class listed from its
+  entries' names), :mod:`~.score.names` (archive endings, folders never taken, both sides' alike) and :mod:`~.score.boxenv`
   (the paths and the environment a box's processes see).
 - ``publish/`` -- what the teacher reads, from records only: :mod:`~.publish.report` (grade.json,
   grade.md, grades.csv, the terminal table), :mod:`~.publish.desk` (writes the rest into OUT),

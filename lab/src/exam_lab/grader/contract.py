@@ -43,7 +43,7 @@ _CLOEXEC = getattr(os, 'O_CLOEXEC', 0)
 _READ_FLAGS = os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | _CLOEXEC
 #: How a folder on the way is opened: a folder, never through a link.
 _DIR_FLAGS = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | _CLOEXEC
-_WHY = {errno.ELOOP: 'a link, not followed', errno.ENOENT: 'missing', errno.ENOTDIR: 'a folder on its way is not one',
+_WHY = {errno.ELOOP: 'a link, not followed', errno.ENOENT: 'missing', errno.ENOTDIR: 'a link or no folder on its way, not followed',
         errno.ENXIO: 'not a regular file', errno.EACCES: 'not readable'}
 
 

@@ -31,7 +31,6 @@ import shutil
 import sys
 import time
 
-from exam_lab.grader.boxed import archives
 from exam_lab.grader import contract
 from exam_lab.grader.host import bwrap, limits, sandbox, staging
 from exam_lab.grader.host.boxed_run import INSPECT_BOUNDS, Boxed, InspectionFailed, session_tail
@@ -99,7 +98,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                 # Who it is, as root read it from the listed entry's name: never as the box says.
                 facts, comments = dict(found.facts, participant=facts['participant'], folder=facts['folder']), found.comments
                 if found.refused is not None:
-                    raise archives.UnpackError(found.refused)
+                    raise records.UnpackError(found.refused)
                 chosen_sheet, static = found.sheet, found.static
                 job = plan_job(found)
                 if job is None:
@@ -112,7 +111,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                     how_run = teacher.how_run(box)
                     session = run_session(job, work=work, underlay=underlay, isolate=isolate, box=box, on_step=on_step,
                                           left=deadline - time.monotonic())
-        except (archives.UnpackError, staging.UploadRefused) as err:
+        except (records.UnpackError, staging.UploadRefused) as err:
             session = grades.no_session(Outcome.REFUSED, 'submission refused: %s' % err, refused=True)
         except InspectionFailed as err:
             session = grades.no_session(Outcome.INSPECTION_FAILED, 'the inspection of the upload failed: %s' % err)

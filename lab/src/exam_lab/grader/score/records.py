@@ -22,6 +22,12 @@ from exam_lab.grader.score.sheets import SHEETS
 MEASUREMENTS = 'measurements.json'
 
 
+class UnpackError(Exception):
+    """A submission (or a class archive) that cannot be opened safely; the message says why, for the
+    teacher. Raised in the box (boxed/archives.py) and by root of what a box said (the class's intake):
+    one type for both sides."""
+
+
 #: What the inspection read of the package for the rubric (``static`` of :func:`~exam_lab.grader.score.rubric.score`).
 STATIC = {
     'launch_files': [str], 'package': Text(255), 'python2': [str], 'params_in_code': [str],
