@@ -1,29 +1,41 @@
-"""Grading one submission, stage by stage (:func:`grade_submission`); each stage a call, a record in and a
-record out:
+"""Grading one submission (:func:`grade_submission`).
 
-1. **stage** (:func:`~exam_lab.grader.host.staging.stage_work`): root copies the upload byte for byte
-   into the box's work folder (regular files, folders, links as links:
-   :func:`~exam_lab.grader.host.staging.stage_upload`), never parsing a student's bytes;
-2. **inspect** (:func:`inspect`): :mod:`~exam_lab.grader.boxed.inspect` runs in the submission's
-   :class:`~exam_lab.grader.host.sandbox.Box`, as the box's uid, without network, within
-   :data:`~exam_lab.grader.host.boxed_run.INSPECT_BOUNDS` (unpacking, the package copied into the
-   workspace, the teacher's fixes, launch and YAML analysis, the derived launch files, the source scan,
-   PDF facts, comment statistics); root reads back one capped, checked
-   :class:`~exam_lab.grader.score.records.InspectRecord` (:class:`~exam_lab.grader.host.boxed_run.Boxed`);
-3. **plan** (:func:`plan_job`): the session's job, a :class:`~exam_lab.grader.score.records.JobRecord`
-   computed once from that record (each run's :class:`~exam_lab.grader.score.records.PlanRecord` the judge reads);
-4. **session** (:func:`run_session`): :mod:`exam_lab.grader.host.session` builds and runs the package in a
-   network namespace with only loopback (:func:`~exam_lab.grader.host.bwrap.network_namespace`) under a
-   :class:`~exam_lab.harness.supervisor.Supervisor` with the student's time limit; root reads back its
-   :class:`~exam_lab.grader.score.records.SessionRecord` (:func:`session_outcome`);
-5. **score** and **publish** (:func:`publish`): the measurements kept, the grade made from them by
-   :func:`~exam_lab.grader.publish.grades.score` (the rubric; a rescore does the same), grade.json and
-   grade.md written; the session's logs copied as data (regular files only, each capped:
-   :func:`keep_logs`).
+Theory of operation
 
-A class is graded by :mod:`~exam_lab.grader.class_run`, each student by :func:`grade_submission`. The
-simulators are an underlay built once (:mod:`~exam_lab.grader.host.underlay`); each student's package
-is built alone in an overlay of its own on top of it.
+We want to run a student's package and measure it from the outside, as root never runs, reads or
+parses the student's bytes. So one grading runs as three kinds of processes:
+
+  - root (this module, :mod:`~exam_lab.grader.class_run`, ``host/``): copies the upload into the box's
+    work folder byte for byte, never opening an archive (:mod:`~exam_lab.grader.host.staging`); opens
+    the box (:class:`~exam_lab.grader.host.sandbox.Box`: a uid of its own, bubblewrap, cgroups,
+    limits); starts what runs in it; and reads back only what the contract lets it read
+    (:mod:`~exam_lab.grader.contract`). It never imports the box's code (``boxed/``, ``judge/``): it
+    runs it, as ``python -m`` in the box, and reads its record.
+  - the box's uid (``boxed/``, on the student's bytes, without network): the inspection unpacks the
+    upload, finds the package, reads its launch files and sources, writes the derived launch files,
+    and hands back one record (:class:`~exam_lab.grader.score.records.InspectRecord`); then the
+    student's build and nodes run as the same uid in the session's network namespace of loopback only.
+  - the judge's uid (``judge/``, never root, never reading the student's files): the master and the
+    probe, which plays the drone, flies the plan and measures the node from the ROS graph.
+
+What crosses, and how:
+
+  - down, into the box: the upload (bytes), and a job root computed from the inspection's record, once
+    (:func:`plan_job`: a :class:`~exam_lab.grader.score.records.JobRecord`, each run's plan in it);
+  - up, out of the box: one record per step (the inspection's, the session's
+    :class:`~exam_lab.grader.score.records.SessionRecord`), each read through the contract (no link,
+    a regular file, capped, checked by its type, its text cleaned once) and the logs, copied as capped
+    text (:func:`keep_logs`); nothing else of the box is read;
+  - into OUT: the measurements kept (what ``make rescore`` scores again), then the grade made from them
+    by the rubric (pure: :func:`~exam_lab.grader.publish.grades.score`), each written by the contract's
+    writer (a temporary file, then ``os.replace``).
+
+Who a submission is (Moodle's participant number and folder) is read by root from the listed entry's
+name, once, and carried in the records from there: never as a box says it. A fault of the grader (a
+bug, a box that cannot open) is "the grader failed" with its traceback for the teacher; a fault of the
+student's bytes (refused, no node, a build that fails) is what the record says: one student's row
+either way, never the class's. The simulators are an underlay built once
+(:mod:`~exam_lab.grader.host.underlay`); each student's package is built alone in an overlay on top.
 """
 import os
 import random
