@@ -60,3 +60,21 @@ def test_moodles_part_is_found_where_moodle_wrote_it():
     assert identity.moodle_span('Jane Doe_1234_assignsubmission_file_') == (8, 36)
     assert identity.moodle_span('Jane Doe_1234_assignsubmission_onlinetext_onlinetext.html') == (8, 42)
     assert identity.moodle_span('Jane Doe') is None
+
+
+def test_root_lists_a_class_folder_by_names_and_kinds_as_the_box_lists_an_unpacked_one(tmp_path):
+    """host.classfolder (root) and boxed.classlist (the intake's box) give one listing: the pure
+    score.identity.class_listing over the entries' names and kinds (lstat), nothing opened."""
+    from exam_lab.grader.host import classfolder
+    klass = tmp_path / 'class'
+    (klass / 'Ann_1_assignsubmission_file_').mkdir(parents=True)
+    (klass / 'Bob_2_assignsubmission_file_exam.zip').write_bytes(exam_zip())
+    (klass / 'Cy_3_assignsubmission_file_report.pdf').write_bytes(b'%PDF-1.4')
+    os.symlink(str(tmp_path), str(klass / 'Dee_4_assignsubmission_file_'))
+    os.mkfifo(str(klass / 'Eve_5_assignsubmission_file_notes.txt'))
+    (klass / '__MACOSX').mkdir()
+    root_refused, box_refused = {}, {}
+    listed = classfolder.list_students(str(klass), root_refused)
+    assert listed == classlist.list_students(str(klass), None, box_refused) and root_refused == box_refused
+    assert [name for name, _ in listed] == ['Ann', 'Bob', 'Dee', 'Cy']
+    assert root_refused == {str(klass / 'Dee_4_assignsubmission_file_'): identity.LINKED}
