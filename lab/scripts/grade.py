@@ -22,12 +22,11 @@ import sys
 
 from exam_lab.grader import class_run, runner, workspace
 
-from exam_lab.grader.boxed import archives
 from exam_lab.grader.engine import slurm
 from exam_lab.grader.host import reference
 
 from exam_lab.grader.publish import desk, moodle, progress, report
-from exam_lab.grader.score import safe_text
+from exam_lab.grader.score import records, safe_text
 from exam_lab.grader.score.sheets import SHEETS
 
 
@@ -115,7 +114,7 @@ def main(argv=None):
     except RuntimeError as err:
         say('grade: %s' % err, sys.stderr)
         return 1
-    except archives.UnpackError as err:  # the class archive itself (one student's upload never gets here)
+    except records.UnpackError as err:  # the class archive itself (one student's upload never gets here)
         say('grade: the class archive cannot be opened safely: %s' % err, sys.stderr)
         return 1
     return 0

@@ -26,7 +26,7 @@ def main(argv=None):
     parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV) to fill again")
     parser.add_argument('--worksheet-scale', action='store_true', help="scale to the worksheet's maximum grade")
     args = parser.parse_args(argv)
-    out = os.path.abspath(args.out)
+    out = os.path.realpath(args.out)  # the teacher's path, followed once; nothing below it is
     if not os.path.isdir(out) or not grades.graded_folders(out):
         print('rescore: no measurements.json in %s (graded before measurements were kept? run make grade '
               'again)' % out, file=sys.stderr)

@@ -43,6 +43,9 @@ def main(argv=None):
         for line in decisions.agreement_lines(state):
             print(line)
         return 0
+    if not os.path.isdir(out):
+        print('review: no grade.json in %s (no such folder): run make grade first' % out, file=sys.stderr)
+        return 1
     try:
         review = server.Review(out)
     except (RecordError, hand.HandError, OSError) as err:

@@ -14,10 +14,10 @@ file was written, 1 when it could not be (hand.csv, its rows or the worksheet un
 is printed). No ROS, no sandbox, no root: it reads records only.
 """
 import argparse
-import glob
 import os
 import sys
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import feedback, grades, hand, moodle
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.schema import RecordError
@@ -28,6 +28,7 @@ def main(argv=None):
     parser.add_argument('--out', required=True, help='the folder make grade wrote (grade.json files, hand.csv)')
     parser.add_argument('--worksheet', required=True, help="Moodle's offline grading worksheet (CSV)")
     args = parser.parse_args(argv)
+    args.out = os.path.realpath(args.out)  # the teacher's path, followed once; nothing below it is
     try:
         records = grades.records_in(args.out)
     except RecordError as err:
@@ -39,13 +40,16 @@ def main(argv=None):
     if not records:
         print('worksheet: no grade.json in %s: run make grade first' % args.out, file=sys.stderr)
         return 1
+    records, twice = hand.newest(records)  # one participant graded twice: its newest, said; never the class's
+    for line in twice:
+        print(safe_text.one_line(line))
     path = os.path.join(args.out, hand.FILE)
     try:
-        hands = hand.read(path) if os.path.isfile(path) else {}
+        hands = hand.read(path) if contract.exists(path) else {}
     except hand.HandError as err:
         print('worksheet: %s' % safe_text.clean(str(err)), file=sys.stderr)
         return 1
-    if not os.path.isfile(path):
+    if not contract.exists(path):
         print('worksheet: no %s: every student\'s hand points are missing (make grade writes it)' % path)
     try:
         rows, notes = hand.match(hands, records)
@@ -69,7 +73,7 @@ def main(argv=None):
               % (len(missing), path))
         for record in missing:
             print('  %s: %s' % (safe_text.one_line(record['student']), ', '.join(record['missing'])))
-    for line in feedback.write(args.out, records, single=not glob.glob(os.path.join(args.out, '*', 'grade.json'))):
+    for line in feedback.write(args.out, records, single=grades.graded_in(args.out) == [args.out]):
         print(line)
     return 0
 

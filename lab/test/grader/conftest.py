@@ -57,8 +57,8 @@ class Runs(object):
         self.factory.getbasetemp()  # made here, once: threads making it at once would make one each
         if any(name == 'main_class' for name, _ in self.order):
             # Before any run: the similarity check's venv, made by one process (nothing locks its making).
-            from exam_lab.grader.boxed import similarity
-            similarity.ensure_venv()
+            from exam_lab.grader.host import similarity_setup
+            similarity_setup.ensure_venv()
         for thread in self.threads:
             thread.start()
 

@@ -24,7 +24,8 @@ import pytest
 from exam_lab.grader import class_run, runner
 from exam_lab.grader.host import boxed_run
 
-from exam_lab.grader.host import egress, limits, sandbox, staging, uids
+from exam_lab.grader import contract
+from exam_lab.grader.host import limits, sandbox, staging, uids
 from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
 from hostile_run import GOOD as VICTIM, HOSTILE, NAMES, SECRET_DIR, VICTIM_NAME, files_under, write_secrets
@@ -255,14 +256,14 @@ def test_the_results_take_only_regular_files_capped(tmp_path):
     os.symlink(str(secret), str(source / 'leak.log'))
     os.symlink('/nonexistent', str(source / 'dangling.log'))
     os.mkfifo(str(source / 'fifo.log'))
-    (source / 'long.log').write_text('first\n' + 'x' * (3 * egress.LOG_PART) + '\nlast\n')
+    (source / 'long.log').write_text('first\n' + 'x' * (3 * contract.LOG_PART) + '\nlast\n')
     (source / 'probe-main.json').write_text(json.dumps({'ok': True}))
-    skipped = egress.copy_results(str(source), str(target))
+    skipped = contract.copy_results(str(source), str(target))
     assert sorted(skipped) == ['dangling.log', 'fifo.log', 'leak.log']
     assert sorted(os.listdir(str(target))) == ['long.log', 'probe-main.json']
     text = (target / 'long.log').read_text()
     assert text.startswith('first\n') and text.endswith('\nlast\n')
-    assert 'bytes cut by the grader' in text and len(text) < 2 * egress.LOG_PART + 200
+    assert 'bytes cut by the grader' in text and len(text) < 2 * contract.LOG_PART + 200
 
 
 def test_no_sandbox_no_grading_unless_the_risk_is_named(monkeypatch, tmp_path):

@@ -36,7 +36,7 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader.boxed import similarity
+from exam_lab.grader.host import similarity_setup
 from exam_lab.grader.host import uids
 from exam_lab.harness.wait import wait_until
 from test_grade import EXPECTED, FULL, STATUS
@@ -327,7 +327,7 @@ def graded(teacher, klass, local, cluster):
     state, conf, ctl, _ = cluster
     # The similarity check runs on the login node, which has no network to install its venv: the
     # teacher's copy of root's (made by the local run; its python a link to the system's).
-    venv, copy = similarity.venv_dir(), os.path.join(teacher.ws, os.path.basename(similarity.venv_dir()))
+    venv, copy = similarity_setup.venv_dir(), os.path.join(teacher.ws, os.path.basename(similarity_setup.venv_dir()))
     if os.path.isdir(venv) and not os.path.isdir(copy):
         shutil.copytree(venv, copy, symlinks=True)
         _chown_tree(copy, teacher.uid)

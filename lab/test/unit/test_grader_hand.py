@@ -10,9 +10,13 @@ from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 
 def record(student, total, participant=None):
     """A grade record as the grader makes it (:func:`report.grade_record`): the machine's items, the
-    last one short of ``17 - total``."""
+    last ones short of ``17 - total`` (each from 0 to its maximum, as the rubric gives them)."""
     items = [{'id': item, 'points': top, 'max': top, 'evidence': 'ok'} for item, (top, _) in ITEMS.items()]
-    items[-1]['points'] -= 17.0 - total
+    short = 17.0 - total
+    for item in reversed(items):
+        taken = min(short, item['points'])
+        item['points'] -= taken
+        short -= taken
     return report.grade_record(student, 'altitude', items, [], {'participant': participant})
 
 
@@ -281,12 +285,29 @@ def test_a_row_without_a_number_is_not_given_to_a_student_who_has_one(tmp_path, 
         hand.match(hand.read(str(out / hand.FILE)), [jane])
 
 
-def test_one_participant_in_two_folders_is_refused_by_name(tmp_path):
+def graded_on(grade, date):
+    return dict(grade, provenance=dict(grade.get('provenance') or {}, date=date))
+
+
+def test_one_participant_in_two_folders_has_the_row_of_its_newest_grade_and_the_class_its_own(tmp_path):
+    """A student renamed in Moodle between two runs (two folders of OUT, one number), or a flat download
+    with exam.zip and exam_v2.zip: that participant's matter. hand.csv is written for everyone, the
+    participant's row is its newest grade's, and the notes say which grade is used and which not
+    (it used to refuse the whole class's hand.csv)."""
     path = str(tmp_path / hand.FILE)
-    twice = [dict(record('Jane Doe', 15.0, 1002)), dict(record('Jane Doe_2', 12.0, 1002))]
-    with pytest.raises(hand.HandError, match='Jane Doe and Jane Doe_2 are both participant 1002'):
-        hand.write(path, twice)
-    assert not (tmp_path / hand.FILE).exists()
+    twice = [graded_on(record('Jane Doe', 15.0, 1002), '2026-12-01T10:00:00Z'),
+             graded_on(record('Jane Doe_2', 12.0, 1002), '2026-12-01T11:00:00Z'), record('Paul Martin', 10.0, 7)]
+    assert hand.write(path, twice) == 2
+    hands = hand.read(path)
+    assert sorted(hands) == [7, 1002] and hands[1002].student == 'Jane Doe_2'
+    chosen, notes = hand.newest(twice)
+    assert [r['student'] for r in chosen] == ['Jane Doe_2', 'Paul Martin']
+    assert notes == ["participant 1002 has 2 grades (Jane Doe, Jane Doe_2): the newest, Jane Doe_2's, is used; "
+                     "Jane Doe not (two archives or two folders of one participant: remove the stale one and "
+                     "run make rescore)"]
+    fill(path, {('Jane Doe_2', 'Q4'): '1'})
+    rows, _ = hand.match(hand.read(path), twice)
+    assert [r.points['Q4'] if r else None for r in rows] == [None, 1.0, None]
 
 
 def test_two_students_sharing_a_name_keep_their_own_rows(tmp_path):

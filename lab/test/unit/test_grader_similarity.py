@@ -13,6 +13,14 @@ import subprocess
 import pytest
 
 from exam_lab.grader.boxed import similarity
+from exam_lab.grader.host import similarity_setup
+
+
+def root_check(subs, out, scratch):
+    """The check as the class run makes it: root's venv and boilerplate (host.similarity_setup), then
+    the box's comparison."""
+    return similarity.check(subs, out, similarity_setup.ensure_venv(),
+                            similarity_setup.boilerplate(os.path.join(str(scratch), 'boilerplate')))
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 ORIGINAL = os.path.join(HERE, '..', 'grader', 'submissions', 'good_student', 'exam')
@@ -109,7 +117,7 @@ def result(tmp_path_factory):
         subs.append((name, str(root / name)))
     out = root / 'out'
     out.mkdir()
-    got = similarity.check(subs, str(out))
+    got = root_check(subs, str(out), root)
     assert 'error' not in got, got.get('error')
     with open(str(out / 'similarity.json')) as f:
         assert json.load(f)['pairs'] == got['pairs']
@@ -146,7 +154,7 @@ def test_the_shared_boilerplate_counts_for_nothing(tmp_path):
             '  <node pkg="exam" name="exam" type="exam_node.py" output="screen">\n'
             '    <param name="threshold" value="1300" />\n  </node>\n</launch>\n')
         subs.append((name, str(where)))
-    got = similarity.check(subs, str(tmp_path))
+    got = root_check(subs, str(tmp_path), tmp_path)
     assert got.get('pairs') == [], got
 
 

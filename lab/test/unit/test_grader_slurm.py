@@ -62,9 +62,11 @@ def test_the_state_line_counts_pending_running_and_done():
 ENDS = ('record', 'queued') + slurm.ENDED
 
 
-def graded(name):
-    """A grade record as a task leaves it (report.grade_record's: a record of the grader)."""
-    return report.grade_record(name, 'altitude', [], [], {'seconds': 1.0})
+def graded(name, participant=None, folder=None):
+    """A grade record as a task leaves it (report.grade_record's: a record of the grader), of the
+    participant and Moodle's folder its manifest line names (the array's students: ``/class/<name>``)."""
+    return report.grade_record(name, 'altitude', [], [], {'seconds': 1.0, 'participant': participant,
+                                                          'folder': folder or name})
 
 
 class ScriptedSlurm(object):
@@ -224,7 +226,8 @@ def test_a_moodle_class_zip_is_graded_as_a_folder_is(tmp_path, monkeypatch):
                         seen[entry['student']] = entry['submission']
                         assert os.path.isfile(os.path.join(entry['submission'], 'exam', 'package.xml'))
                         with open(os.path.join(self.base, 'results', '%d.json' % index), 'w') as r:
-                            json.dump(grades.could_not_grade(entry['student'], None, 'scripted'), r)
+                            json.dump(dict(grades.could_not_grade(entry['student'], None, 'scripted'),
+                                           participant=entry['participant'], folder=entry['folder']), r)
                 return 0, '', ''
             return ScriptedSlurm.__call__(self, argv)
 
@@ -244,6 +247,11 @@ def test_a_moodle_class_zip_is_graded_as_a_folder_is(tmp_path, monkeypatch):
     ('{"student": "s1", "tot', 'grade.json: not JSON'),                          # cut short
     (json.dumps(graded('s0')), "grade.json: the grade of 's0', not of 's1'"),    # another student's
     (json.dumps(dict(graded('s1'), total='17')), 'grade.json.total: a number expected, got str'),
+    # the same name, another participant or another folder of Moodle's: not this line's student
+    (json.dumps(graded('s1', participant=7)), "the grade of participant 7 (folder 's1'), not of participant None "
+                                              "(folder 's1')"),
+    (json.dumps(graded('s1', folder='s1_7_assignsubmission_file_')), 'not of participant None'),
+    (json.dumps(dict(graded('s1'), total=17.0)), 'grade.json.total: 17.0, but its 0 item(s) come to 0'),
 ])
 def test_a_result_that_is_not_the_students_grade_stops_that_student_only(array, left, why):
     """Issue 37 point 1: the host reads each task's result as a grade record (capped, checked); one

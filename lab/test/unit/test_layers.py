@@ -123,21 +123,26 @@ def test_the_oracle_is_independent_of_the_answer():
 #: The grader's folders by trust level (exam_lab.grader's docstring). Each folder may import only the
 #: folders named here (and itself, and nothing of the grader beyond them), relative imports included:
 #: what runs as a box's uid on the student's bytes (boxed) leans on pure records only; the judge (a
-#: judge uid, never root) the same; root's side (host) never imports what reads student bytes or runs
-#: the student's nodes; score and publish are pure; the runner is one submission's pipeline; class_run
-#: lists a class's students and grades each by the runner; engine/ is the host as the teacher,
-#: submitting classes elsewhere, each student by class_run.
+#: judge uid, never root) the same; root's side (host, the runner, class_run, engine) never imports
+#: boxed/ nor judge/: root never runs box code, it runs a box (``python -m`` in it) and reads its record
+#: through the contract (the one reader of foreign files, the one writer in OUT); score and publish
+#: are pure; the runner is one submission's pipeline; class_run lists a class's students and grades
+#: each by the runner; engine/ is the host as the teacher, submitting classes elsewhere, each student
+#: by class_run.
 GRADER = 'exam_lab.grader'
 MAY_IMPORT = {
     'boxed': ('score',),
     'judge': ('score',),
-    'host': ('score',),
+    'contract': ('score',),
+    'host': ('contract', 'score'),
     'score': (),
-    'publish': ('score',),
-    'runner': ('boxed', 'judge', 'host', 'score', 'publish'),
-    'class_run': ('runner', 'boxed', 'host', 'score', 'publish'),
-    'engine': ('class_run', 'host', 'score', 'publish'),
+    'publish': ('contract', 'score'),
+    'runner': ('contract', 'host', 'score', 'publish'),
+    'class_run': ('runner', 'contract', 'host', 'score', 'publish'),
+    'engine': ('class_run', 'contract', 'host', 'score', 'publish'),
 }
+#: Root's side: none of these may import boxed/ (nor judge/), whatever MAY_IMPORT is changed to.
+ROOT_SIDE = ('host', 'runner', 'class_run', 'engine')
 #: The package itself (``exam_lab.grader``: ``workspace()``) is plain configuration, open to every folder.
 PACKAGE_ITSELF = (GRADER,)
 
@@ -183,6 +188,28 @@ def test_the_grader_folders_keep_to_their_trust_level(folder):
     assert trust_violations(folder, modules) == []
 
 
+def test_root_side_may_not_import_box_code():
+    assert [f for f in ROOT_SIDE if {'boxed', 'judge'} & set(MAY_IMPORT[f])] == []
+
+
+@pytest.mark.parametrize('folder', ROOT_SIDE)
+def test_the_trust_check_sees_root_importing_box_code(tmp_path, folder):
+    # A planted module of root's side that imports box code, absolutely and relatively: the check
+    # must fail on each.
+    planted = tmp_path / 'planted.py'
+    planted.write_text('from exam_lab.grader.boxed import similarity\nimport exam_lab.grader.boxed.classlist\n'
+                       'from exam_lab.grader.judge import probe\n')
+    name = '%s.%s' % (GRADER, folder) if folder in ('runner', 'class_run') else '%s.%s.planted' % (GRADER, folder)
+    offending = trust_violations(folder, {name: str(planted)})
+    assert '%s imports %s.boxed.similarity' % (name, GRADER) in offending
+    assert '%s imports %s.boxed.classlist' % (name, GRADER) in offending
+    assert '%s imports %s.judge.probe' % (name, GRADER) in offending
+    relative = tmp_path / 'relative.py'
+    relative.write_text('from ..boxed import archives\n' if folder not in ('runner', 'class_run') else
+                        'from .boxed import archives\n')
+    assert '%s imports %s.boxed.archives' % (name, GRADER) in trust_violations(folder, {name: str(relative)})
+
+
 def test_the_trust_check_sees_a_forbidden_import_absolute_or_relative(tmp_path):
     # A planted module of boxed/ that imports root's side, both ways: the check must fail on each.
     planted = tmp_path / 'planted.py'
@@ -212,8 +239,9 @@ def test_the_pure_grader_folders_import_no_ros(folder):
 
 
 def test_every_grader_module_lives_in_a_trust_folder():
-    """Only the package itself, the runner (one submission's pipeline) and class_run (a class) sit at the
-    grader's top level; every other module is in a folder of MAY_IMPORT."""
+    """Only the package itself, the runner (one submission's pipeline), class_run (a class) and the
+    contract (the one reader of foreign files, the one writer in OUT) sit at the grader's top level;
+    every other module is in a folder of MAY_IMPORT."""
     top = [name for name in source_modules() if name.startswith(GRADER + '.') and name.count('.') == 2]
     assert sorted(top) == ['%s.%s' % (GRADER, f) for f in sorted(MAY_IMPORT)]
 

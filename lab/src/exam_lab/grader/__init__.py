@@ -25,12 +25,12 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.host.uids` (a slot's box and judge uids, under a lock; what runs as them ended),
   :mod:`~.host.cgroups` (the box's and the judge's cgroups), :mod:`~.host.limits` (their bounds;
   prlimit), :mod:`~.host.bwrap` (bubblewrap's command line; the session's network namespace),
-  :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder),
-  :mod:`~.host.egress` (the only reader of what a box leaves: its record, capped, never a link, checked
-  against its schema; its logs, capped), :mod:`~.host.boxed_run` (one of the grader's modules run in a
-  box on student bytes, its record read back), :mod:`~.host.underlay` (the simulators' workspace,
-  built once, under every student's package) and :mod:`~.host.reference` (the sheet's drone run alone
-  in a network namespace, the report's commands' outputs captured: the reference of questions 4-9).
+  :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder), :mod:`~.host.classfolder`
+  (a class folder's students, by its entries' names), :mod:`~.host.similarity_setup` (the similarity
+  check's venv and boilerplate, made by root before its box), :mod:`~.host.boxed_run` (one of the grader's
+  modules run in a box on student bytes, its record read back), :mod:`~.host.underlay` (the simulators'
+  workspace, built once, under every student's package) and :mod:`~.host.reference` (the sheet's drone
+  run alone in a network namespace, the report's commands' outputs captured: the reference of questions 4-9).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima),
   :mod:`~.score.rubric` (points, evidence and status from the measurements: :func:`~.score.rubric.score`)
   and its parts: :mod:`~.score.tolerances` (each tolerance, one constant), :mod:`~.score.measured` (the
@@ -42,12 +42,13 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   (the typed records that cross the boundary, with their schemas), :mod:`~.score.kept` (what a grading
   keeps, as records: its measurements and its grade, versioned), :mod:`~.score.schema` (a schema, its
   check, the base of every record), :mod:`~.score.answers` (the report's questions 4-9 found by their
-  headings and judged by named checks), :mod:`~.score.report_tables` (a report's table read from its layout: the questions' rows, their
-  cells), :mod:`~.score.report_text` (what of a passage is the student's own: commands, output,
-  sentences), :mod:`~.score.code_items` (the comments and the code quality
-  proposed from the inspection's measures), :mod:`~.score.reference`
-  (the drone's reference outputs as a record, and what of them every run shares), :mod:`~.score.identity` (who a
-  submission is: Moodle's participant number and folder, the student's name) and :mod:`~.score.boxenv`
+  headings and judged by named checks), :mod:`~.score.report_tables` (a report's table read from its
+  layout: the questions' rows, their cells), :mod:`~.score.report_text` (what of a passage is the
+  student's own: commands, output, sentences), :mod:`~.score.code_items` (the comments and the code
+  quality proposed from the inspection's measures), :mod:`~.score.reference` (the drone's reference
+  outputs as a record, and what of them every run shares), :mod:`~.score.identity` (who a submission is:
+  Moodle's participant number and folder, the student's name; a class listed from its entries' names),
+  :mod:`~.score.names` (archive endings, folders never taken, both sides' alike) and :mod:`~.score.boxenv`
   (the paths and the environment a box's processes see).
 - ``publish/`` -- what the teacher reads, from records only: :mod:`~.publish.report` (grade.json,
   grade.md, grades.csv, the terminal table), :mod:`~.publish.desk` (writes the rest into OUT),
@@ -62,6 +63,10 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   by a run and by a rescore alike; the rescore), :mod:`~.publish.teacher` (the teacher's notes of a
   grade: what the machine saw but does not score, how the code was read and run), :mod:`~.publish.review`
   (``make review``: the hand points confirmed on a page served to 127.0.0.1, into hand.csv).
+- :mod:`~exam_lab.grader.contract` -- root's one reader of a file it did not write in this process (a
+  box's or the judge's record and logs, every file kept in OUT: no link followed, regular files only,
+  never blocking, capped, checked against its type) and its one writer in OUT (a temporary file, then
+  ``os.replace``: never through an existing entry).
 - :mod:`~exam_lab.grader.runner` -- one submission, top to bottom: stage, inspect (boxed), plan, build
   and run (box and judge), score (:func:`~exam_lab.grader.publish.grades.score`, also for a rescore),
   publish.

@@ -8,14 +8,15 @@ import os
 import re
 import shutil
 
-from exam_lab.grader import runner
-from exam_lab.grader.boxed import archives, bounds, classlist, similarity
-from exam_lab.grader.host import sandbox, staging
+from exam_lab.grader import contract, runner
+from exam_lab.grader.host import classfolder, sandbox, similarity_setup, staging
 from exam_lab.grader.host.boxed_run import INTAKE_BOUNDS, SIMILARITY_BOUNDS, Boxed, InspectionFailed
 from exam_lab.grader.host.underlay import default_underlay, ensure_underlay
 from exam_lab.grader.host.bwrap import can_isolate
 from exam_lab.grader.publish import desk, grades, report
 from exam_lab.grader.score import identity, records, schema
+from exam_lab.grader.score.names import CLASS_BYTES
+from exam_lab.grader.score.records import UnpackError
 from exam_lab.grader.score import kept as kept_records
 
 #: Gradings side by side per core when JOBS is not given. A grading mostly waits (its flight is timed),
@@ -53,26 +54,26 @@ def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
     the students both engines grade (:func:`grade_class`, :mod:`exam_lab.grader.engine.slurm`); with
     ``out``, the folder of an earlier run of the class, each student keeps the name (the folder in OUT)
     that run gave its participant number (:func:`kept_folders`). A
-    folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.boxed.classlist.list_students`
+    folder is listed by root, by its entries' names only (:func:`~exam_lab.grader.host.classfolder.list_students`
     opens no file of a folder); an archive is unpacked by :mod:`exam_lab.grader.boxed.intake` in a box of
     its own (INTAKE_BOUNDS), in a work folder made in ``scratch`` (default: the system's temp folder) and
     appended to ``work_dirs`` (the caller removes it once the students are graded). ``refused`` (a
     dict) receives ``{folder: why}`` of the students whose files the intake refused by their own
     bounds, or whose entry of a class folder is a link (:func:`grade_student`'s ``refused``).
 
-    :raises archives.UnpackError: the archive could not be unpacked (why, and the end of the box's log).
+    :raises UnpackError: the archive could not be unpacked (why, and the end of the box's log).
     """
     # The teacher's path, followed (as a submission's is): a link to the class's zip is that zip. Its
-    # entries are not: a link in a class folder is passed over (classlist.list_students).
+    # entries are not: a link in a class folder is passed over (classfolder.list_students).
     class_path = os.path.realpath(class_path)
     if not os.path.isfile(class_path):
-        return _unique(classlist.list_students(class_path, None, refused), kept_folders(out))
+        return _unique(classfolder.list_students(class_path, refused), kept_folders(out))
     if scratch:
         os.makedirs(scratch, mode=0o711, exist_ok=True)
     # One file, bounded as a class (a class of 60 with its PDFs is more than one upload may be).
     work = staging.new_work('exam-intake-', scratch)
     work_dirs.append(work)
-    (staged,) = staging.stage_work(work, [(os.path.basename(class_path), class_path)], (classlist.CLASS_BYTES, 1))
+    (staged,) = staging.stage_work(work, [(os.path.basename(class_path), class_path)], (CLASS_BYTES, 1))
     with sandbox.Box(work, bwrap=sandbox.check() is None) as box:
         boxed = Boxed(box, work)
         try:
@@ -80,12 +81,12 @@ def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
                                                                  boxed.path(boxed.out)], records.IntakeRecord,
                               INTAKE_BOUNDS)
         except InspectionFailed as err:
-            raise archives.UnpackError('unpacking it in its box failed: %s' % err)
+            raise UnpackError('unpacking it in its box failed: %s' % err)
     students = []
     for student in found.students:
         path = os.path.join(boxed.out, student['path'])
         if os.path.realpath(path) != os.path.normpath(path) or not os.path.lexists(path):
-            raise archives.UnpackError('the intake named %s, which is a link or missing' % student['path'])
+            raise UnpackError('the intake named %s, which is a link or missing' % student['path'])
         if student.get('refused') is not None and refused is not None:
             refused[path] = student['refused']
         students.append((student['name'], path))
@@ -106,14 +107,12 @@ def kept_folders(out):
     kept = {}
     if not out or not os.path.isdir(out):
         return kept
-    for name in sorted(os.listdir(out)):
+    for name in contract.folders(out):
         for record_type in (kept_records.MeasurementsRecord, kept_records.GradeRecord):
-            path = os.path.join(out, name, record_type.FILE)
-            if not os.path.isfile(path):
-                continue
-            try:
-                with open(path, 'rb') as f:
-                    facts = schema.load(f.read(record_type.MAX_BYTES + 1), record_type.FILE, constants=True)
+            try:  # through the contract: no link, a regular file, capped; its shape unchecked on purpose
+                facts = schema.load(contract.read_bytes(os.path.join(out, name, record_type.FILE),
+                                                        record_type.MAX_BYTES, under=out),
+                                    record_type.FILE, constants=True)
             except (OSError, records.RecordError):
                 continue
             if record_type is kept_records.MeasurementsRecord and isinstance(facts, dict):
@@ -164,9 +163,9 @@ def grade_student(name, folder, out_dir, *, sheet=None, underlay=None, isolate=N
     :param refused: why the class's intake did not unpack this student's files (its own bounds): the
         student is not graded, with that sentence, and its measurements are kept for a rescore.
     """
-    if refused is not None:
-        return _refused_at_intake(name, folder, os.path.join(out_dir, name), sheet, refused)
     try:
+        if refused is not None:
+            return _refused_at_intake(name, folder, os.path.join(out_dir, name), sheet, refused)
         return runner.grade_submission(folder, os.path.join(out_dir, name), sheet=sheet, student=name, underlay=underlay,
                                        isolate=isolate,
                                        on_step=on_step, unsandboxed=unsandboxed, jobs=jobs)
@@ -177,7 +176,7 @@ def grade_student(name, folder, out_dir, *, sheet=None, underlay=None, isolate=N
         record = dict(record, participant=identity.participant_number(moodle_name), folder=moodle_name)  # who, even so
         try:
             report.write_grade(os.path.join(out_dir, name), record)
-        except OSError:
+        except (OSError, records.RecordError):  # its folder of OUT a link: nothing written through it
             pass
         return record
 
@@ -190,7 +189,7 @@ def _refused_at_intake(name, folder, out_dir, sheet, why):
                 'session': grades.no_session(records.Outcome.REFUSED, 'submission refused: %s' % why, refused=True).value,
                 'extra': {'participant': identity.participant_number(folder_name), 'folder': folder_name,
                           'documents': [], 'seconds': 0.0}}
-    os.makedirs(out_dir, exist_ok=True)
+    contract.make_folder(out_dir)
     return grades.keep_and_score(out_dir, measured)
 
 
@@ -208,14 +207,14 @@ def class_similarity(klass, out, records_):
         listed = [(by_folder.get(os.path.basename(folder), name), folder)
                   for name, folder in class_students(klass, work_dirs, refused=refused)]
         intake = [(name, folder) for name, folder in listed if folder not in refused]
-        python = similarity.ensure_venv()  # as root: an installation, from PyPI, of no student's bytes
+        python = similarity_setup.ensure_venv()  # as root: an installation, from PyPI, of no student's bytes
         # Each student staged by its own bounds: one over them is not compared, the others are.
         work = staging.new_work('exam-similarity-')
         work_dirs.append(work)
         staged = staging.stage_work(work, [(os.path.basename(f), f) for _, f in intake], refused=refused)
         kept = [(student, path) for student, path in zip(intake, staged) if path is not None]
         submissions, staged = [student for student, _ in kept], [path for _, path in kept]
-        similarity.boilerplate(os.path.join(work, 'upload', 'boilerplate'))
+        similarity_setup.boilerplate(os.path.join(work, 'upload', 'boilerplate'))
         venv = os.path.dirname(os.path.dirname(python))
         with sandbox.Box(work, [venv], bwrap=sandbox.check() is None) as box:
             # copydetect imports matplotlib, which wants Debian's /etc/matplotlibrc
@@ -230,17 +229,14 @@ def class_similarity(klass, out, records_):
         # The intake's words of why (a student's file names among them) are made safe with the record.
         refusals = ['%s: not compared (its files were refused: %s)' % (name, refused[folder])
                     for name, folder in listed if folder in refused]
-        result = records.SimilarityRecord.make(dict(result, notes=bounds.closed(refusals + result['notes'])))
+        result = records.SimilarityRecord.make(dict(result, notes=schema.closed(refusals + result['notes'])))
     except Exception as err:  # a bug of the check, or its box failing, must not cost the class its page
-        why = str(err) if isinstance(err, (InspectionFailed, archives.UnpackError)) else repr(err)
+        why = str(err) if isinstance(err, (InspectionFailed, UnpackError)) else repr(err)
         result = desk.similarity_failed(why)
     finally:
         for work in work_dirs:
             shutil.rmtree(work, ignore_errors=True)
-    partial = os.path.join(out, records.SimilarityRecord.FILE + '.part')
-    with open(partial, 'w') as f:
-        f.write(result.to_json() + '\n')
-    os.rename(partial, os.path.join(out, records.SimilarityRecord.FILE))
+    contract.write_record(os.path.join(out, records.SimilarityRecord.FILE), result)
     return result
 
 

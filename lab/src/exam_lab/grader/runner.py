@@ -1,29 +1,41 @@
-"""Grading one submission, stage by stage (:func:`grade_submission`); each stage a call, a record in and a
-record out:
+"""Grading one submission (:func:`grade_submission`).
 
-1. **stage** (:func:`~exam_lab.grader.host.staging.stage_work`): root copies the upload byte for byte
-   into the box's work folder (regular files, folders, links as links:
-   :func:`~exam_lab.grader.host.staging.stage_upload`), never parsing a student's bytes;
-2. **inspect** (:func:`inspect`): :mod:`~exam_lab.grader.boxed.inspect` runs in the submission's
-   :class:`~exam_lab.grader.host.sandbox.Box`, as the box's uid, without network, within
-   :data:`~exam_lab.grader.host.boxed_run.INSPECT_BOUNDS` (unpacking, the package copied into the
-   workspace, the teacher's fixes, launch and YAML analysis, the derived launch files, the source scan,
-   PDF facts, comment statistics); root reads back one capped, checked
-   :class:`~exam_lab.grader.score.records.InspectRecord` (:class:`~exam_lab.grader.host.boxed_run.Boxed`);
-3. **plan** (:func:`plan_job`): the session's job, a :class:`~exam_lab.grader.score.records.JobRecord`
-   computed once from that record (each run's :class:`~exam_lab.grader.score.records.PlanRecord` the judge reads);
-4. **session** (:func:`run_session`): :mod:`exam_lab.grader.host.session` builds and runs the package in a
-   network namespace with only loopback (:func:`~exam_lab.grader.host.bwrap.network_namespace`) under a
-   :class:`~exam_lab.harness.supervisor.Supervisor` with the student's time limit; root reads back its
-   :class:`~exam_lab.grader.score.records.SessionRecord` (:func:`session_outcome`);
-5. **score** and **publish** (:func:`publish`): the measurements kept, the grade made from them by
-   :func:`~exam_lab.grader.publish.grades.score` (the rubric; a rescore does the same), grade.json and
-   grade.md written; the session's logs copied as data (regular files only, each capped:
-   :func:`keep_logs`).
+Theory of operation
 
-A class is graded by :mod:`~exam_lab.grader.class_run`, each student by :func:`grade_submission`. The
-simulators are an underlay built once (:mod:`~exam_lab.grader.host.underlay`); each student's package
-is built alone in an overlay of its own on top of it.
+We want to run a student's package and measure it from the outside, as root never runs, reads or
+parses the student's bytes. So one grading runs as three kinds of processes:
+
+  - root (this module, :mod:`~exam_lab.grader.class_run`, ``host/``): copies the upload into the box's
+    work folder byte for byte, never opening an archive (:mod:`~exam_lab.grader.host.staging`); opens
+    the box (:class:`~exam_lab.grader.host.sandbox.Box`: a uid of its own, bubblewrap, cgroups,
+    limits); starts what runs in it; and reads back only what the contract lets it read
+    (:mod:`~exam_lab.grader.contract`). It never imports the box's code (``boxed/``, ``judge/``): it
+    runs it, as ``python -m`` in the box, and reads its record.
+  - the box's uid (``boxed/``, on the student's bytes, without network): the inspection unpacks the
+    upload, finds the package, reads its launch files and sources, writes the derived launch files,
+    and hands back one record (:class:`~exam_lab.grader.score.records.InspectRecord`); then the
+    student's build and nodes run as the same uid in the session's network namespace of loopback only.
+  - the judge's uid (``judge/``, never root, never reading the student's files): the master and the
+    probe, which plays the drone, flies the plan and measures the node from the ROS graph.
+
+What crosses, and how:
+
+  - down, into the box: the upload (bytes), and a job root computed from the inspection's record, once
+    (:func:`plan_job`: a :class:`~exam_lab.grader.score.records.JobRecord`, each run's plan in it);
+  - up, out of the box: one record per step (the inspection's, the session's
+    :class:`~exam_lab.grader.score.records.SessionRecord`), each read through the contract (no link,
+    a regular file, capped, checked by its type, its text cleaned once) and the logs, copied as capped
+    text (:func:`keep_logs`); nothing else of the box is read;
+  - into OUT: the measurements kept (what ``make rescore`` scores again), then the grade made from them
+    by the rubric (pure: :func:`~exam_lab.grader.publish.grades.score`), each written by the contract's
+    writer (a temporary file, then ``os.replace``).
+
+Who a submission is (Moodle's participant number and folder) is read by root from the listed entry's
+name, once, and carried in the records from there: never as a box says it. A fault of the grader (a
+bug, a box that cannot open) is "the grader failed" with its traceback for the teacher; a fault of the
+student's bytes (refused, no node, a build that fails) is what the record says: one student's row
+either way, never the class's. The simulators are an underlay built once
+(:mod:`~exam_lab.grader.host.underlay`); each student's package is built alone in an overlay on top.
 """
 import os
 import random
@@ -31,8 +43,8 @@ import shutil
 import sys
 import time
 
-from exam_lab.grader.boxed import archives
-from exam_lab.grader.host import bwrap, egress, limits, sandbox, staging
+from exam_lab.grader import contract
+from exam_lab.grader.host import bwrap, limits, sandbox, staging
 from exam_lab.grader.host.boxed_run import INSPECT_BOUNDS, Boxed, InspectionFailed, session_tail
 from exam_lab.grader.host.bwrap import can_isolate
 from exam_lab.grader.host.session import budget_sentence
@@ -77,7 +89,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
         raise sandbox.SandboxUnavailable(refusal)
     isolate = can_isolate() if isolate is None else isolate
     underlay = underlay or ensure_underlay(default_underlay())  # raises: the grader cannot run
-    os.makedirs(out_dir, exist_ok=True)
+    contract.make_folder(out_dir)  # a folder of OUT that is a link is refused here, before anything is run
     deadline = time.monotonic() + STUDENT_BUDGET  # the student's own time starts here, the simulators built
     work = staging.new_work('exam-grade-')
     folder = os.path.basename(os.path.abspath(submission).rstrip('/'))
@@ -95,9 +107,10 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                 notes.append(teacher.how_read(box, found.uid, INSPECT_BOUNDS))
                 notes.extend(found.notes)
                 fixes.extend(found.fixes)
-                facts, comments = found.facts, found.comments
+                # Who it is, as root read it from the listed entry's name: never as the box says.
+                facts, comments = dict(found.facts, participant=facts['participant'], folder=facts['folder']), found.comments
                 if found.refused is not None:
-                    raise archives.UnpackError(found.refused)
+                    raise records.UnpackError(found.refused)
                 chosen_sheet, static = found.sheet, found.static
                 job = plan_job(found)
                 if job is None:
@@ -110,7 +123,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                     how_run = teacher.how_run(box)
                     session = run_session(job, work=work, underlay=underlay, isolate=isolate, box=box, on_step=on_step,
                                           left=deadline - time.monotonic())
-        except (archives.UnpackError, staging.UploadRefused) as err:
+        except (records.UnpackError, staging.UploadRefused) as err:
             session = grades.no_session(Outcome.REFUSED, 'submission refused: %s' % err, refused=True)
         except InspectionFailed as err:
             session = grades.no_session(Outcome.INSPECTION_FAILED, 'the inspection of the upload failed: %s' % err)
@@ -205,11 +218,11 @@ def run_session(job, *, work, underlay, isolate, box, on_step=None, left=STUDENT
 def session_outcome(log_dir, status, output, left, survivors):
     """The session's record (a :class:`~exam_lab.grader.score.records.SessionRecord`): the one
     it wrote in ``log_dir`` when it ended well (``status`` 0), read through
-    :func:`~exam_lab.grader.host.egress.read_record` (capped, checked), else why there is none;
+    :func:`~exam_lab.grader.host.contract.read_record` (capped, checked), else why there is none;
     ``survivors`` (processes of the box's uid found after it) added to its count."""
     if status == 0:
         try:
-            result = egress.read_record(os.path.join(log_dir, records.SessionRecord.FILE), records.SessionRecord,
+            result = contract.read_record(os.path.join(log_dir, records.SessionRecord.FILE), records.SessionRecord,
                                         records.SessionRecord.MAX_BYTES)
         except records.RecordError as err:
             return grades.no_session(Outcome.SESSION_FAILED, 'the session\'s record was refused: %s' % err,
@@ -223,12 +236,12 @@ def session_outcome(log_dir, status, output, left, survivors):
 
 
 def keep_logs(work, out_dir):
-    """Copy the session's logs into ``out_dir/logs`` as data (:func:`~exam_lab.grader.host.egress.copy_results`);
+    """Copy the session's logs into ``out_dir/logs`` as data (:func:`~exam_lab.grader.host.contract.copy_results`);
     return the notes on what was not copied."""
     logs = os.path.join(out_dir, 'logs')
     shutil.rmtree(logs, ignore_errors=True)
     if os.path.isdir(os.path.join(work, 'logs')):
-        skipped = egress.copy_results(os.path.join(work, 'logs'), logs)
+        skipped = contract.copy_results(os.path.join(work, 'logs'), logs)
         if skipped:
             return ['not copied to logs/ (not a regular file): %s' % ', '.join(skipped)]
     return []

@@ -22,6 +22,11 @@ import tarfile
 import zipfile
 import zlib
 
+# The names both sides of the box read alike, and the refusal both raise: the box's modules take them here.
+from exam_lab.grader.score.names import (  # noqa: F401
+    ARCHIVE_ENDINGS, BUILD_PRODUCTS, SKIPPED_DIRS, SKIPPED_ON_UNPACK, without_ending)
+from exam_lab.grader.score.records import UnpackError  # noqa: F401
+
 #: Most files one submission may unpack, all its archives together (a package has tens).
 MAX_FILES = 5000
 #: Most bytes one submission may unpack, all its archives together.
@@ -36,15 +41,7 @@ NAME_MAX = 255
 PATH_MAX = 4096
 #: Most folders one entry's path may hold (a package is a few deep; a workspace's a few more).
 MAX_PARTS = 64
-#: Folders of a catkin workspace that the student's build made: never unpacked, never copied.
-BUILD_PRODUCTS = ('build', 'devel', 'install', 'build_isolated', 'devel_isolated', 'install_isolated',
-                  '.catkin_tools')
-#: Folders never unpacked: build products, version control, caches, macOS's resource forks.
-SKIPPED_ON_UNPACK = BUILD_PRODUCTS + ('.git', '.svn', '__pycache__', '__MACOSX')
-#: Folders never copied into a workspace nor searched: the above and the editors' and loggers' own.
-SKIPPED_DIRS = SKIPPED_ON_UNPACK + ('log', 'logs', '.vscode', '.idea')
-#: File name endings of archives the grader opens, and the magic bytes of those it cannot.
-ARCHIVE_ENDINGS = ('.zip', '.tar', '.tar.gz', '.tgz', '.tar.bz2', '.tbz2', '.tar.xz', '.txz')
+#: The magic bytes of the archives the grader cannot open.
 _UNSUPPORTED = ((b'Rar!\x1a\x07', 'a RAR archive'), (b'7z\xbc\xaf\x27\x1c', 'a 7-Zip archive'),
                 (b'\x1f\x8b', 'a gzip file that holds no tar'), (b'BZh', 'a bzip2 file that holds no tar'),
                 (b'\xfd7zXZ\x00', 'an xz file that holds no tar'), (b'%PDF', 'a PDF document'))
@@ -61,10 +58,6 @@ _ZIP_UTF8 = 0x800
 #: The Info-ZIP Unicode Path Extra Field (APPNOTE.TXT 4.6.9): version 1, the CRC-32 of the name field
 #: it stands for, the name in UTF-8.
 _ZIP_UNICODE_PATH = 0x7075
-
-
-class UnpackError(Exception):
-    """A submission that cannot be opened safely; the message says why, for the teacher."""
 
 
 class Budget(object):
@@ -231,14 +224,6 @@ def what_it_is(path):
         if head.startswith(magic):
             return words
     return None
-
-
-def without_ending(name):
-    """``name`` without its archive ending (``exam_v2.tar.gz``: ``exam_v2``)."""
-    for ending in sorted(ARCHIVE_ENDINGS, key=len, reverse=True):
-        if name.lower().endswith(ending):
-            return name[:-len(ending)]
-    return name
 
 
 def open_archive(path, label):

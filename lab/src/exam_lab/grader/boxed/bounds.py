@@ -16,21 +16,12 @@ import json
 
 from exam_lab.grader.score.records import (MAX_ITEMS, MAX_TEXT, Items, Map, Maybe, OneOf, Optional, Row,
                                            Text)
+# A text cut in its middle and a list of notes closed within its cap: shared with root (score.schema).
+from exam_lab.grader.score.schema import CUT_MARK, closed, cut  # noqa: F401
 
-#: What stands for the middle of a text that was cut.
-CUT_MARK = ' [...] '
 #: The tighter caps :func:`fit` tries in turn on lists of text when a record is over its bytes:
 #: (items, characters of one).
 TIGHTER = ((100, 500), (20, 200), (5, 100), (1, 100))
-
-
-def cut(text, limit=MAX_TEXT):
-    """``text`` in at most ``limit`` characters: its middle replaced by CUT_MARK (a ``file:line``
-    keeps its file's start and its line)."""
-    if len(text) <= limit:
-        return text
-    head = (limit - len(CUT_MARK)) // 2
-    return text[:head] + CUT_MARK + text[len(text) - (limit - len(CUT_MARK) - head):]
 
 
 def kept(items, what, notes, limit=MAX_ITEMS, first=None, verb='kept', text=MAX_TEXT):
@@ -51,21 +42,6 @@ def kept(items, what, notes, limit=MAX_ITEMS, first=None, verb='kept', text=MAX_
         notes.append('%d %s (at most %d): the first %d %s' % (len(items), what, limit, limit,
                                                            'are %s' % verb if limit != 1 else 'is %s' % verb))
     return out
-
-
-def closed(notes, what='notes', limit=MAX_ITEMS, keep=()):
-    """``notes`` (texts for the teacher) within ``limit`` items, the last saying how many more there
-    were, each cut to MAX_TEXT; those in ``keep`` (the sentences of caps) are never left out."""
-    if len(notes) <= limit:
-        return [cut(n) for n in notes]
-    keep = set(keep)
-    room = limit - 1 - sum(1 for n in notes if n in keep)
-    out = []
-    for note in notes:
-        if note in keep or room > 0:
-            room -= note not in keep
-            out.append(cut(note))
-    return out[:limit - 1] + ['%d %s (at most %d): the first %d kept' % (len(notes), what, limit, min(len(out), limit - 1))]
 
 
 def fit(value, record_type, notes_key='notes'):

@@ -12,27 +12,23 @@ import shutil
 import tarfile
 
 from exam_lab.grader.boxed import archives
-from exam_lab.grader.boxed.archives import (ARCHIVE_ENDINGS, SKIPPED_DIRS, UNREADABLE, Plan, UnpackError, open_archive,
-                                            shown_name, tar_entries, unreadable_why, without_ending, write_plan,
+from exam_lab.grader.boxed.archives import (UNREADABLE, Plan, UnpackError, open_archive,
+                                            shown_name, tar_entries, unreadable_why, write_plan,
                                             zip_entries)
-from exam_lab.grader.score.identity import participant_number, student_name
+from exam_lab.grader.score import identity
+from exam_lab.grader.score.names import entry_kinds
+from exam_lab.grader.score.identity import LINKED, moodle_span  # noqa: F401 (LINKED: the listing's words)
 
-#: A class archive ("download all submissions") holds every student's uploads: its bounds as a whole
-#: (entries, bytes of the students it unpacks); each student's files are paid from MAX_FILES / MAX_BYTES.
-CLASS_FILES = 100000
-CLASS_BYTES = 4 * 1024 * 1024 * 1024
+# A class's bounds as a whole, root's staging and this box's unpacking alike (score.names).
+from exam_lab.grader.score.names import CLASS_BYTES, CLASS_FILES  # noqa: E402,F401
 #: What listing a class tar may read through, the members of students refused by their own bounds
 #: included: a compressed tar is decompressed to find each next entry, so a student's file over its own
 #: bounds (a 5 GB recording) is read, never kept, up to this bound of the class's.
 CLASS_READ_BYTES = 4 * CLASS_BYTES
-#: Characters kept at the end of a student's name too long to be a folder's (:func:`_fitting`): Moodle's
-#: ``_<participant>_assignsubmission_file_`` and more, at most 240 bytes in any script.
-_KEPT_END = 60
-
-
-#: Why a student's entry of a class folder that is a link is not graded (:func:`list_students`).
-LINKED = ('a link in the class folder, not a folder: the grader follows no link inside a class (put the '
-          'folder itself there, or grade it alone: make grade SUBMISSION=...)')
+#: Characters kept at the end of the parts of a name too long to be a folder's (:func:`_fitting`): of
+#: the student's name before Moodle's ``_<participant>_assignsubmission_<plugin>_``, and of the
+#: student's own file name after it (an archive's ending).
+_KEPT_END = 16
 
 
 def list_students(class_path, scratch, refused=None):
@@ -44,54 +40,12 @@ def list_students(class_path, scratch, refused=None):
     refused is listed all the same (an empty folder or file in its place) and ``refused`` (a dict)
     receives ``{its path: why}``. A class whose top holds archives instead of folders counts each
     archive as one student (named after it). A link is never followed; one named as Moodle names a
-    student's folder is listed and refused (:data:`LINKED`) when ``refused`` is given.
+    student's folder is listed and refused (:data:`~exam_lab.grader.score.identity.LINKED`) when ``refused`` is given.
     """
     class_path = os.path.abspath(class_path)
     if os.path.isfile(class_path):
         class_path = unpack_class(class_path, os.path.join(scratch, 'class'), {} if refused is None else refused)
-    students = []
-    for entry in sorted(os.listdir(class_path)):
-        full = os.path.join(class_path, entry)
-        if _hidden(entry) or entry in SKIPPED_DIRS:
-            continue
-        if os.path.islink(full):
-            # Never followed (what it names is nobody's upload); but one named as Moodle names a
-            # student's folder is that student's row, not graded, and why: never a student lost unsaid.
-            if refused is not None and participant_number(entry) is not None:
-                students.append((student_name(without_ending(entry)), full))
-                refused[full] = LINKED
-            continue
-        if os.path.isdir(full):
-            students.append((student_name(entry), full))
-        elif entry.lower().endswith(ARCHIVE_ENDINGS) or (refused is not None and full in refused):
-            # (a refused student's place is an empty file when its entry was not a folder)
-            students.append((student_name(without_ending(entry)), full))
-    return students + _flat_without_archive(class_path, students)
-
-
-def _flat_without_archive(class_path, students):
-    """The students of a flat download (Moodle's "Download submissions in folders" off: each file
-    ``<name>_<number>_assignsubmission_<plugin>_<file>`` at the top) none of whose files is an archive
-    (a report only, an online text): each its row all the same, its first file its submission (graded
-    "not graded", saying what it handed in), never left out unsaid."""
-    numbers = set(participant_number(os.path.basename(path)) for _, path in students)
-    found = []
-    for entry in sorted(os.listdir(class_path)):
-        full = os.path.join(class_path, entry)
-        number = participant_number(entry)
-        if number is None or number in numbers or _hidden(entry) or os.path.islink(full) or not os.path.isfile(full):
-            continue
-        numbers.add(number)
-        found.append((student_name(entry), full))
-    return found
-
-
-def _hidden(entry):
-    """A hidden name the listing passes over (``.DS_Store``, ``.git``, the ``._`` copies macOS leaves
-    beside each file), but never a folder Moodle named after a student whose full name starts with a dot:
-    ``.Anna Roy_77_assignsubmission_file_`` (Moodle's name never starts with ``._``: it writes ``_`` as
-    a space)."""
-    return entry.startswith('.') and (entry.startswith('._') or participant_number(entry) is None)
+    return identity.class_listing(class_path, entry_kinds(class_path), refused)
 
 
 def _class_entries(kind, opened, label):
@@ -174,17 +128,36 @@ def unpack_class(archive, target, refused):
 
 def _fitting(key):
     """A student's top entry as a name this file system takes: one of more than NAME_MAX bytes (Moodle
-    allows 100 characters each for a first and a last name: 300 bytes and more in Cyrillic or Chinese)
-    loses characters from its middle, its start and its end (the participant number, the plugin, an
-    archive's ending) kept, so that one long name stops no one else."""
-    def fits(name):
-        return len(name.encode('utf-8', 'surrogateescape')) <= archives.NAME_MAX
-    if fits(key):
+    allows 100 characters each for a first and a last name: 300 bytes and more in Cyrillic or Chinese;
+    a flat download's entry ends with the student's own file name) loses characters from the middle of
+    the student's file name, then from the middle of the student's name, so that one long name stops no
+    one else. Moodle's part, ``_<participant>_assignsubmission_<plugin>_``, is kept whole and first: the
+    participant number read from the name (:func:`~exam_lab.grader.score.identity.participant_number`)
+    is the one Moodle wrote, never one of the student's file name."""
+    if _size(key) <= archives.NAME_MAX:
         return key
-    head, tail = key[:-_KEPT_END], key[-_KEPT_END:]
-    while not fits(head + '-' + tail):
-        head = head[:-1]
-    return head + '-' + tail
+    span = moodle_span(key)
+    if span is None:
+        return _shortened(key, archives.NAME_MAX)
+    head, moodle, tail = key[:span[0]], key[span[0]:span[1]], key[span[1]:]
+    room = archives.NAME_MAX - _size(moodle)
+    tail = _shortened(tail, room - _size(head))  # the student's file name first, then its name
+    return _shortened(head, room - _size(tail)) + moodle + tail
+
+
+def _size(name):
+    return len(name.encode('utf-8', 'surrogateescape'))
+
+
+def _shortened(part, room):
+    """``part`` in at most ``room`` bytes when it can be: its middle cut (``-``), its last _KEPT_END
+    characters kept."""
+    if _size(part) <= room or not part:
+        return part
+    start, end = part[:-_KEPT_END], part[-_KEPT_END:]
+    while start and _size(start + '-' + end) > room:
+        start = start[:-1]
+    return start + '-' + end
 
 
 def _students_of(entries):
@@ -204,7 +177,7 @@ def _students_of(entries):
         (top, members), = groups.items()
         below = [(entry, parts) for entry, parts in members if len(parts) > 1]
         if below and not any(_file_at_top(entry, parts) for entry, parts in members) and \
-                participant_number(top) is None and \
+                identity.participant_number(top) is None and \
                 not any(parts[1:] == ['package.xml'] or parts[2:] == ['package.xml'] for _, parts in below):
             inner = {}
             for entry, parts in below:

@@ -4,11 +4,11 @@ The detector is copydetect (PyPI, pinned :data:`VERSION`): winnowing over the to
 the style of MOSS, with names, strings and comments normalised away (renaming variables or rewording
 comments does not hide a copy) and a boilerplate set whose fingerprints never count. It is installed
 on first use into a virtual environment of its own (``$EXAM_WS/similarity-venv``, seeing Debian's
-packages), and runs there as ``python -m exam_lab.grader.boxed.similarity JOB.json``; the grader's own
+packages: made by root, :mod:`~exam_lab.grader.host.similarity_setup`, never by this box's code), and runs there as ``python -m exam_lab.grader.boxed.similarity JOB.json``; the grader's own
 Python needs nothing new.
 
-What every student got is boilerplate: ``catkin_create_pkg``'s CMakeLists.txt and package.xml (made
-anew here, for both sheets), the launch file's skeleton, and the code of the sheets' packages (the
+What every student got is boilerplate (made by root: :func:`~exam_lab.grader.host.similarity_setup.boilerplate`):
+``catkin_create_pkg``'s CMakeLists.txt and package.xml (made anew, for both sheets), the launch file's skeleton, and the code of the sheets' packages (the
 drones, which students read and copy idioms from). Only a package's code is compared: Python, C++,
 launch files, CMakeLists.txt and package.xml; never its data (YAML, maps, logs, bags). What is read of
 one student is bounded (MAX_STUDENT_FILES, MAX_STUDENT_BYTES, its code first): a student who hands in
@@ -25,20 +25,17 @@ import subprocess
 import sys
 import tempfile
 
-from exam_lab.grader import workspace
 from exam_lab.grader.boxed import archives, bounds
 from exam_lab.grader.boxed.package import open_submission
 from exam_lab.grader.score import records
+from exam_lab.grader.score.names import CODE_NAMES, CODE_SUFFIXES, VERSION
 
-VERSION = '0.5.0'
 #: copydetect's noise threshold (k, characters of normalised code) and window.
 NOISE = 25
 WINDOW = 4
 #: Share of a submission's fingerprinted code found in the other's, from which a pair is flagged.
 THRESHOLD = 0.5
-#: Files compared (code, not data), and the most bytes read of one.
-CODE_SUFFIXES = ('.py', '.cpp', '.cc', '.cxx', '.c', '.h', '.hpp', '.launch', '.xml')
-CODE_NAMES = ('CMakeLists.txt',)
+#: Files compared (code, not data: score.names), and the most bytes read of one.
 MAX_FILE_BYTES = 200 * 1024
 #: What is compared of one student at most (a package's code is a few files of a few kB), its
 #: programs first (:func:`student_code`).
@@ -51,66 +48,8 @@ MAX_SCORES_BYTES = 8 << 20
 #: Languages by suffix, for files pygments does not know by name.
 LANGUAGES = {'.launch': 'xml', '.xml': 'xml', '.txt': 'cmake', '.py': 'python', '.cpp': 'cpp', '.cc': 'cpp',
              '.cxx': 'cpp', '.c': 'cpp', '.h': 'cpp', '.hpp': 'cpp'}
-#: The launch file's skeletons students write from the sheets' question 12 (the drone's node or its
-#: launch file, the exam node, the threshold as a parameter or an argument, in the usual orders).
-LAUNCH_TEMPLATES = [
-    """<launch>
-  <node pkg="{drone}" name="{drone}" type="{node}" output="screen"/>
-  <node pkg="exam" name="exam" type="exam_node.py" output="screen">
-    <param name="threshold" value="{limit}" />
-  </node>
-</launch>
-""",
-    """<launch>
-  <param name="threshold" value="{limit}" />
-  <node pkg="{drone}" name="{drone}" type="{node}" output="screen"/>
-  <node pkg="exam" name="exam" type="exam_node.py" output="screen"/>
-</launch>
-""",
-    """<launch>
-  <arg name="threshold" default="{limit}" />
-  <include file="$(find {drone})/launch/{drone}.launch" />
-  <node pkg="exam" type="exam_node.py" name="exam_node" output="screen">
-    <param name="threshold" value="$(arg threshold)" />
-  </node>
-</launch>
-""",
-]
-#: Packages whose code every student had (the sheets' drones).
-SHEET_PACKAGES = ('mydrone', 'submarinedrone', 'drone_sim', 'node_kit')
-
-
 class SimilarityError(Exception):
     """The detector could not be installed or run."""
-
-
-def venv_dir():
-    return os.path.join(workspace(), 'similarity-venv')
-
-
-def ensure_venv(path=None):
-    """The Python of the detector's virtual environment, made (with copydetect VERSION) when missing."""
-    path = path or venv_dir()
-    python = os.path.join(path, 'bin', 'python')
-    probe = [python, '-c', 'import importlib.metadata as m; print(m.version("copydetect"))']
-    try:
-        if os.path.exists(python) and subprocess.run(probe, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                                                     timeout=60).stdout.decode().strip() == VERSION:
-            return python
-    except (OSError, subprocess.SubprocessError):
-        pass
-    log = path + '.log'
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(log, 'w') as out:
-        for argv in ([sys.executable, '-m', 'venv', '--system-site-packages', '--clear', path],
-                     [python, '-m', 'pip', 'install', '-q', 'copydetect==%s' % VERSION]):
-            try:
-                done = subprocess.run(argv, stdout=out, stderr=subprocess.STDOUT, timeout=600)
-            except (OSError, subprocess.SubprocessError) as err:
-                raise SimilarityError('%s failed: %s (log: %s)' % (' '.join(argv[:4]), err, log))
-            if done.returncode != 0:
-                raise SimilarityError('%s failed (exit %d); log: %s' % (' '.join(argv[:4]), done.returncode, log))
-    return python
 
 
 def code_files(package):
@@ -177,53 +116,23 @@ def stage(submissions, target):
     return staged, notes
 
 
-def boilerplate(target):
-    """Write what every student got into ``target``; return it."""
-    os.makedirs(target, exist_ok=True)
-    for drone in ('mydrone', 'submarinedrone'):
-        where = os.path.join(target, 'catkin_create_pkg-%s' % drone)
-        os.makedirs(where)
-        try:
-            subprocess.run(['catkin_create_pkg', 'exam', 'rospy', 'std_msgs', drone], cwd=where, timeout=60,
-                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        except (OSError, subprocess.SubprocessError):
-            pass  # without catkin_create_pkg, its files count like any other
-    for index, template in enumerate(LAUNCH_TEMPLATES):
-        for drone, node, limit in (('mydrone', 'mydrone_node.py', 1300), ('submarinedrone', 'submarine_drone_node.py', 150)):
-            with open(os.path.join(target, 'template-%d-%s.launch' % (index, drone)), 'w') as f:
-                f.write(template.format(drone=drone, node=node, limit=limit))
-    import rospkg
-    packs = rospkg.RosPack()
-    for name in SHEET_PACKAGES:
-        try:
-            source = packs.get_path(name)
-        except rospkg.ResourceNotFound:
-            continue
-        for relative in code_files(source):
-            if '/test/' in '/' + relative:
-                continue
-            os.makedirs(os.path.dirname(os.path.join(target, name, relative)), exist_ok=True)
-            shutil.copyfile(os.path.join(source, relative), os.path.join(target, name, relative))
-    return target
-
-
-def check(submissions, out_dir, python=None, shared=None, scratch_dir=None):
+def check(submissions, out_dir, python, shared, scratch_dir=None):
     """Compare every pair of ``submissions`` (``[(name, folder or zip)]``); write
     ``out_dir/similarity.json`` and return it: ``{"pairs": [...], "students", "threshold", "notes"}``
     or ``{"error": why}`` when the detector could not run (the grades stand either way).
 
-    :param shared: the boilerplate folder (:func:`boilerplate`), made here when None.
+    :param python: the detector's venv's Python (:func:`~exam_lab.grader.host.similarity_setup.ensure_venv`, root's).
+    :param shared: the boilerplate folder (:func:`~exam_lab.grader.host.similarity_setup.boilerplate`, root's).
     :param scratch_dir: where the submissions are unpacked (the system's temp folder when None).
     """
     scratch = tempfile.mkdtemp(prefix='similarity-', dir=scratch_dir)
     try:
         staged, notes = stage(submissions, scratch)
-        job = {'students': staged, 'boilerplate': shared or boilerplate(os.path.join(scratch, 'boilerplate')),
+        job = {'students': staged, 'boilerplate': shared,
                'noise': NOISE, 'window': WINDOW, 'threshold': THRESHOLD, 'result': os.path.join(scratch, 'result.json')}
         with open(os.path.join(scratch, 'job.json'), 'w') as f:
             json.dump(job, f)
         try:
-            python = python or ensure_venv()
             env = dict(os.environ, PYTHONPATH=os.pathsep.join(
                 [os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))] +
                 [p for p in os.environ.get('PYTHONPATH', '').split(os.pathsep) if p]))

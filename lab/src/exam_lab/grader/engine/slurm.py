@@ -35,10 +35,10 @@ import subprocess
 import sys
 import time
 
-from exam_lab.grader import class_run, workspace
+from exam_lab.grader import class_run, contract, workspace
 from exam_lab.grader.host import sandbox, staging, underlay
 from exam_lab.grader.publish import grades, report
-from exam_lab.grader.score import kept, safe_text
+from exam_lab.grader.score import identity, kept, safe_text
 from exam_lab.grader.score.records import RecordError, shown
 
 #: Seconds between two looks at the queue: light on a shared controller, quick enough for a class.
@@ -159,43 +159,41 @@ def write_task_script(path, manifest, out_dir, sheet, unsandboxed):
     """The batch script of every task: the repository's environment, then :func:`run_task` on the line
     of the manifest named by ``$SLURM_ARRAY_TASK_ID``."""
     options = ['--out', out_dir] + (['--sheet', sheet] if sheet else []) + (['--unsandboxed'] if unsandboxed else [])
-    with open(path, 'w') as f:
-        f.write('#!/bin/bash\n'
-                '# One student of the class, graded on the node this task landed on '
-                '(written by exam_lab.grader.engine.slurm).\n'
-                'set -eo pipefail\n'
-                'export EXAM_WS=%s\n'
-                'source %s\n'
-                'exec python3 -m exam_lab.grader.engine.slurm task %s "$SLURM_ARRAY_TASK_ID" %s\n'
-                % (shlex.quote(workspace()), shlex.quote(os.path.join(_repo(), 'tools', 'env.sh')),
-                   shlex.quote(manifest), ' '.join(shlex.quote(o) for o in options)))
+    contract.write_text(path, '#!/bin/bash\n'
+                        '# One student of the class, graded on the node this task landed on '
+                        '(written by exam_lab.grader.engine.slurm).\n'
+                        'set -eo pipefail\n'
+                        'export EXAM_WS=%s\n'
+                        'source %s\n'
+                        'exec python3 -m exam_lab.grader.engine.slurm task %s "$SLURM_ARRAY_TASK_ID" %s\n'
+                        % (shlex.quote(workspace()), shlex.quote(os.path.join(_repo(), 'tools', 'env.sh')),
+                           shlex.quote(manifest), ' '.join(shlex.quote(o) for o in options)))
     os.chmod(path, 0o755)
 
 
-def _write_json(path, data):
-    """Whole or not at all: the host may look at any moment."""
-    with open(path + '.part', 'w') as f:
-        json.dump(data, f, indent=1, sort_keys=True)
-    os.rename(path + '.part', path)
+#: Most bytes of the manifest read by a task: a line per student, a class of thousands fits.
+MANIFEST_BYTES = 16 << 20
 
 
 def manifest_entry(manifest, index):
-    """Line ``index`` of the manifest: ``{"student", "submission"[, "refused"]}``. The host wrote it
+    """Line ``index`` of the manifest: ``{"student", "submission", "participant", "folder"[, "refused"]}``
+    (who it is as the listing read it: what the host checks the task's grade against). The host wrote it
     itself (:func:`_grade`, as whoever submits), of names it made (the class's listing) and folders it
     chose: no box's record, so it is read as the host's own file, but a line that is missing, cut
     short or of another shape (a manifest of another grader, a shared file system's error) stops
     the task with a sentence naming the file and the line, never a bare traceback."""
     where = '%s, line %d' % (manifest, index + 1)
     try:
-        with open(manifest, encoding='utf-8') as f:
-            lines = f.read().splitlines()
+        lines = contract.read_text(manifest, MANIFEST_BYTES).splitlines()
         entry = json.loads(lines[index]) if 0 <= index < len(lines) else None
-    except (OSError, UnicodeDecodeError, ValueError) as err:
+    except (OSError, ValueError) as err:  # ContractError is a ValueError
         raise RuntimeError('the Slurm manifest %s cannot be read: %s' % (where, err))
     if entry is None:
         raise RuntimeError('the Slurm manifest %s has no such line (%d line(s))' % (where, len(lines)))
     if not (isinstance(entry, dict) and isinstance(entry.get('student'), str) and
-            isinstance(entry.get('submission'), str) and isinstance(entry.get('refused', ''), str)):
+            isinstance(entry.get('submission'), str) and isinstance(entry.get('refused', ''), str) and
+            isinstance(entry.get('folder', ''), str) and
+            (entry.get('participant') is None or type(entry.get('participant')) is int)):
         raise RuntimeError('the Slurm manifest %s is not a student\'s line ({"student", "submission"}): %s'
                            % (where, safe_text.one_line(lines[index])[:200]))
     return entry
@@ -213,7 +211,8 @@ def run_task(manifest, index, out_dir, sheet=None, unsandboxed=False):
     # Which node graded it (a lost node's students are graded again elsewhere): in grade.json too.
     record = report.write_grade(os.path.join(out_dir, entry['student']),
                                 dict(record, graded_on=os.environ.get('SLURMD_NODENAME') or socket.gethostname()))
-    _write_json(os.path.join(os.path.dirname(manifest), 'results', '%d.json' % index), record)
+    # Whole or not at all (the contract's writer): the host may look at any moment.
+    contract.write_text(os.path.join(os.path.dirname(manifest), 'results', '%d.json' % index), json.dumps(record))
     return record
 
 
@@ -264,21 +263,24 @@ class _Array(object):
         return dict((key, value) for key, value in parse_squeue(out).items() if key[0] in self.jobs)
 
     def _result(self, index):
-        """The grade the task left in ``results/<index>.json``, None while there is none. It is read
-        as the grader's record (:class:`~exam_lab.grader.score.kept.GradeRecord`: capped, checked, its
-        text clean, an older one upgraded): it holds a student's text, written on a node. A file that
-        is not that student's grade raises :class:`RecordError` saying why (that student is not
-        graded, the class goes on: :meth:`look`)."""
+        """The grade the task left in ``results/<index>.json``, None while there is none, read through the
+        contract as the grader's record (:class:`~exam_lab.grader.score.kept.GradeRecord`): it holds a
+        student's text, written on a node. One that is not that student's grade (its name, participant
+        and Moodle's folder those of its manifest line) raises :class:`RecordError` saying why (that
+        student is not graded, the class goes on: :meth:`look`)."""
         path = os.path.join(self.base, 'results', '%d.json' % index)
-        if not os.path.isfile(path):
+        if not contract.exists(path, self.base):
             return None
-        record = kept.GradeRecord.read(path)
-        # The record's name is cleaned as it is made: compared as it would be (a name of the class's
-        # listing, letters, digits, space and -._, cleans to itself; identity.student_name).
-        name = self.students[index][0]
+        record = contract.read_record(path, kept.GradeRecord, under=self.base)
+        # Its name compared as it is cleaned when made (a listing's name cleans to itself: identity.student_name).
+        name, entry = self.students[index][0], os.path.basename(os.path.abspath(self.students[index][1]))
         if record.student != safe_text.clean(name):
             raise RecordError('%s: the grade of %s, not of %s' % (kept.GradeRecord.FILE, shown(record.student),
                                                                  shown(name)))
+        if (record.participant, record.folder) != (identity.participant_number(entry), entry):
+            raise RecordError('%s: the grade of participant %s (folder %s), not of participant %s (folder %s)' % (
+                kept.GradeRecord.FILE, record.participant, shown(record.folder), identity.participant_number(entry),
+                shown(entry)))
         return record.value
 
     def _finished(self, index, record):
@@ -438,10 +440,11 @@ def _grade(students, refused, base, out_dir, sheet, progress, unsandboxed, sbatc
     if students:
         underlay.ensure_underlay(underlay.default_underlay())  # here, once, rather than by the first tasks at once
         manifest = os.path.join(base, 'manifest.jsonl')
-        with open(manifest, 'w') as f:
-            for name, folder in students:
-                f.write(json.dumps(dict({'student': name, 'submission': os.path.abspath(folder)},
-                                        **({'refused': refused[folder]} if folder in refused else {}))) + '\n')
+        entries = [os.path.basename(os.path.abspath(folder).rstrip('/')) for _, folder in students]
+        contract.write_text(manifest, ''.join(json.dumps(dict(
+            {'student': name, 'submission': os.path.abspath(folder), 'participant': identity.participant_number(entry),
+             'folder': entry}, **({'refused': refused[folder]} if folder in refused else {}))) + '\n'
+            for (name, folder), entry in zip(students, entries)))
         script = os.path.join(base, 'task.sh')
         write_task_script(script, manifest, out_dir, sheet, unsandboxed)
         if progress:

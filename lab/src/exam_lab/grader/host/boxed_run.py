@@ -1,11 +1,12 @@
 """One of the grader's own modules run on student bytes in a box, as the box's uid, without network,
-within its bounds; its one record read back through :mod:`~exam_lab.grader.host.egress`
+within its bounds; its one record read back through :mod:`~exam_lab.grader.contract`
 (:class:`Boxed`): the inspection of an upload, a class archive's intake, the class's similarity check.
 """
 import os
 import sys
 
-from exam_lab.grader.host import egress, limits
+from exam_lab.grader import contract
+from exam_lab.grader.host import limits
 from exam_lab.grader.score import records
 
 #: Bounds of the boxes that read student bytes: (wall clock s, CPU s, address space bytes). One upload's
@@ -29,7 +30,7 @@ class Boxed(object):
     """One of the grader's own modules run on student bytes in ``box``, as its uid, without network:
     ``<work>/upload`` (staged by root, :func:`~exam_lab.grader.host.staging.stage_upload`) read-only at
     ``/box/upload``, ``<work>/out`` writable at ``/box/out``, the grader's source read-only; its one
-    record is read back through :func:`~exam_lab.grader.host.egress.read_record`. Unsandboxed, the same
+    record is read back through :func:`~exam_lab.grader.host.contract.read_record`. Unsandboxed, the same
     folders are used at their host paths.
 
     :param mounts: more ``(host, in the box, writable)``; ``(host, None, ...)`` keeps the host path.
@@ -71,14 +72,14 @@ class Boxed(object):
                                    mounts=self.places if self.box.bwrap else None, network=False)
         if status == 0:
             try:
-                return egress.read_record(os.path.join(self.out, record.FILE), record, record.MAX_BYTES)
+                return contract.read_record(os.path.join(self.out, record.FILE), record, record.MAX_BYTES)
             except records.RecordError as err:
                 why = 'its record was refused: %s' % err
         elif why is None:  # bwrap reports its child's death by signal N as exit 128 + N
             signum = -status if status < 0 else status - 128 if status > 128 else None
             why = 'it failed (exit %d)' % status if signum is None else \
                 'it was killed by signal %d (its bounds: %d s of CPU, %d MB of address space)' % (signum, cpu, memory >> 20)
-        tail = session_tail(egress.read_capped(log, 4096) or '')
+        tail = session_tail(contract.read_capped(log, 4096) or '')
         raise InspectionFailed('%s%s' % (why, ': %s' % tail if tail else ''))
 
 

@@ -28,7 +28,7 @@ runs through :meth:`Box.argv`::
   same box, as its uid, in a network namespace without even loopback, seeing only the upload that
   root staged byte for byte (:func:`~exam_lab.grader.host.staging.stage_upload`, read-only), the
   folder they write (the workspace, their output) and the grader's source (read-only). Root reads
-  back one record (:mod:`~exam_lab.grader.host.egress`).
+  back one record (:mod:`~exam_lab.grader.contract`).
 - **Environment**: empty (``--clearenv``) but for the variables
   :func:`~exam_lab.grader.score.boxenv.box_env` lets through.
 - **Limits** (:mod:`~exam_lab.grader.host.limits`): memory, processes and CPU by a cgroup of the box's

@@ -39,7 +39,7 @@ import sys
 import time
 
 from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
-from exam_lab.grader.host.egress import read_capped, read_record
+from exam_lab.grader.contract import read_capped, read_record
 from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.score.records import (
     MAX_ENDED, MAX_LOG_TEXT, JobRecord, Outcome, PlanRecord, ProbeRecord, RecordError, SessionRecord)

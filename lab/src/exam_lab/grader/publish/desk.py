@@ -15,6 +15,7 @@ import html
 import json
 import os
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import feedback, flightplot, gradescope, hand, moodle, page, proposals, report
 from exam_lab.grader.score import kept, safe_text
 from exam_lab.grader.score.records import RecordError, SimilarityRecord
@@ -61,10 +62,10 @@ def read_similarity(out):
     desk made again (``make rescore``); None when there is none. A file that is not that record (cut
     short, edited) is the record of why: the page says so where its pairs would be."""
     path = os.path.join(out, SimilarityRecord.FILE)
-    if not os.path.isfile(path):
+    if not contract.exists(path):
         return None
     try:
-        return SimilarityRecord.read(path)
+        return contract.read_record(path, SimilarityRecord)
     except RecordError as err:
         return similarity_failed('the run\'s %s cannot be read (make grade checks the class again): %s'
                                  % (SimilarityRecord.FILE, err))
@@ -77,13 +78,11 @@ def _title(out, title):
     the output folder's name."""
     named = os.path.join(out, 'page.json')
     if title:
-        with open(named, 'w') as f:
-            json.dump({'title': title}, f)
-    elif os.path.isfile(named):
+        contract.write_text(named, json.dumps({'title': title}))
+    elif contract.exists(named):
         try:
-            with open(named, 'rb') as f:
-                kept_title = json.loads(f.read(8192).decode('utf-8')).get('title')
-        except (OSError, ValueError, AttributeError):
+            kept_title = json.loads(contract.read_text(named, 8192)).get('title')
+        except (ValueError, AttributeError):  # ContractError is a ValueError: a link, a FIFO, too long
             kept_title = None
         title = kept_title if isinstance(kept_title, str) else None
     return safe_text.one_line(title or os.path.basename(out))
@@ -92,7 +91,7 @@ def _title(out, title):
 def _student(out, record, single):
     """Write one student's results.json and flight plot; return its page entry, whose ``problems``
     say what could not be made."""
-    folder = out if single else os.path.join(out, record['student'])
+    folder = out if single else contract.student_folder(out, record['student'])
     relative = '.' if single else os.path.relpath(folder, out)
     entry = {'plot': None, 'grade_md': '', 'folder': relative, 'documents': record.get('documents'),
              'problems': []}
@@ -135,6 +134,10 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         entry = entries[record['student']] = _student(out, record, single)
         entry['problems'][:0] = refused.get(id(record), [])
         lines += ['%s: %s' % (record['student'], problem) for problem in entry['problems']]
+    # One participant graded twice (two archives, two folders) is that participant's matter: its newest
+    # grade goes to the worksheet and the feedback zip, said here; everyone else's as always.
+    newest, twice = hand.newest(records)
+    lines += twice
     try:
         added = hand.write(os.path.join(out, hand.FILE), records)
         lines.append('hand points: %s (%d new row(s)): fill in the %d points the machine does not judge, '
@@ -150,16 +153,15 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         base = os.path.splitext(os.path.basename(worksheet))[0]
         target = os.path.join(out, '%s-filled.csv' % base)
         try:
-            summary = moodle.fill_file(worksheet, target, records, scale)
+            summary = moodle.fill_file(worksheet, target, newest, scale)
             lines += moodle.summary_lines(summary, target)
-            with open(os.path.join(out, 'worksheet.json'), 'w') as f:
-                json.dump(summary, f, indent=1, sort_keys=True)
+            contract.write_text(os.path.join(out, 'worksheet.json'), json.dumps(summary, indent=1, sort_keys=True))
         except (moodle.WorksheetError, OSError) as err:
             lines.append('worksheet NOT filled: %s' % err)
         except Exception as err:  # a bug on one record's text: the page must still say so
             lines.append('worksheet NOT filled (a grader bug, please report): %s' % _failure(err))
     try:
-        lines += feedback.write(out, records, single, show)
+        lines += feedback.write(out, newest, single, show)
     except Exception as err:  # the grades are written; the page must still say why the zip is not
         lines.append('moodle feedback NOT written (a grader bug, please report): %s' % _failure(err))
     # The desk's lines quote a worksheet's cells, hand.csv's, an error's words: one line each, made
@@ -181,8 +183,7 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
         problem = 'the page could not be made (a grader bug, please report): %s' % _failure(err)
         lines.append(problem)
         content = _plain_page(title, records, problem)
-    with open(os.path.join(out, 'index.html'), 'w') as f:
-        f.write(content)
+    contract.write_text(os.path.join(out, 'index.html'), content)
     lines.append('page: %s' % os.path.join(out, 'index.html'))
     return [safe_text.one_line(line) for line in lines]
 

@@ -21,12 +21,14 @@ Released, as the worksheet releases a grade (:data:`exam_lab.grader.publish.mood
 says so) or every hand point (the whole grade). Every other student is left out, and named with why.
 """
 import html
+import io
 import os
 import re
 import tempfile
 import time
 import zipfile
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import flightplot, hand, moodle, student_view
 from exam_lab.grader.publish.report import NOT_SCORED
 from exam_lab.grader.score import safe_text
@@ -220,7 +222,7 @@ def write(out, records, single=False, show=None):
     target = os.path.join(out, FILE)
     try:
         show = read_show() if show is None else show
-        hands = hand.read(os.path.join(out, hand.FILE)) if os.path.isfile(os.path.join(out, hand.FILE)) else {}
+        hands = hand.read(os.path.join(out, hand.FILE)) if contract.exists(os.path.join(out, hand.FILE)) else {}
     except (ValueError, hand.HandError) as err:
         return _nothing(target, safe_text.one_line(err))
     pages, waiting, numbers = [], [], {}
@@ -241,8 +243,8 @@ def write(out, records, single=False, show=None):
             waiting.append((record['student'], 'participant %d is also %s' % (
                 number, ', '.join(n for n in numbers[number] if n != record['student']))))
             continue
-        folder = out if single else os.path.join(out, record['student'])
         try:
+            folder = out if single else contract.student_folder(out, record['student'])
             ran = threshold_ran(folder)
             svg = plot_svg(folder) if show == 'evidence' else None
             entries[folder_name(moodle_name(record, number), number) + '/' + PAGE] = page(
@@ -253,14 +255,14 @@ def write(out, records, single=False, show=None):
     if not entries:
         lines = _nothing(target, 'no student\'s grade is released yet')
     else:
-        partial = target + '.part'
+        made = io.BytesIO()
         stamp = time.localtime()[:6]
-        with zipfile.ZipFile(partial, 'w', zipfile.ZIP_DEFLATED) as archive:
+        with zipfile.ZipFile(made, 'w', zipfile.ZIP_DEFLATED) as archive:
             for name in sorted(entries):
                 info = zipfile.ZipInfo(name, stamp)
                 info.compress_type = zipfile.ZIP_DEFLATED
                 archive.writestr(info, entries[name].encode('utf-8'))
-        os.replace(partial, target)
+        contract.write_bytes(target, made.getvalue())
         lines = ['moodle feedback: %s: a page for %d student(s), showing %s (lab/check_visibility.ini); upload it '
                  'in the assignment: View all submissions, "Upload multiple feedback files in a zip"'
                  % (target, len(entries), 'the points and the evidence' if show == 'evidence' else 'the points')]
@@ -272,6 +274,6 @@ def write(out, records, single=False, show=None):
 
 def _nothing(target, why):
     """No zip: an old one would upload stale pages, so it goes."""
-    if os.path.isfile(target):
-        os.remove(target)
+    if contract.exists(target):
+        os.remove(target)  # the entry itself, a link included
     return ['moodle feedback: %s NOT written: %s' % (target, why)]

@@ -5,9 +5,11 @@ Drawn from the probe's results as the grading kept them (:func:`load_runs`: the 
 the student's measurements, never a file of the judge's or a box's read back) with matplotlib's Agg
 backend (no display needed); times are seconds from the probe's start.
 """
+import io
 import math
 import os
 
+from exam_lab.grader import contract
 from exam_lab.grader.score.kept import MeasurementsRecord
 from exam_lab.grader.score.records import MEASUREMENTS
 from exam_lab.grader.score.flight import calls
@@ -37,9 +39,10 @@ def load_runs(folder):
     :class:`~exam_lab.grader.score.records.RecordError` (naming the file and the field) when they are
     not a record. Drawn as they are: a value out of range only costs what :class:`Clamp` leaves out."""
     path = os.path.join(folder, MEASUREMENTS)
-    if not os.path.isfile(path):
+    if not contract.exists(path):
         return []
-    runs = [(run['tag'], run['probe'] or run.get('refused_probe')) for run in MeasurementsRecord.read(path).session['runs']]
+    runs = [(run['tag'], run['probe'] or run.get('refused_probe'))
+            for run in contract.read_record(path, MeasurementsRecord).session['runs']]
     return [(tag, probe) for tag, probe in runs if probe is not None]
 
 
@@ -69,7 +72,9 @@ def draw(runs, path, title=''):
         if title:
             fig.suptitle(one_line(title), fontsize=11)  # a student's name: no control character
         fig.tight_layout()
-        fig.savefig(path)
+        image = io.BytesIO()
+        fig.savefig(image, format=os.path.splitext(path)[1][1:] or 'png')
+        contract.write_bytes(path, image.getvalue())
     finally:
         plt.close(fig)  # a plot that failed must not keep its figure for the class's next one
     return True

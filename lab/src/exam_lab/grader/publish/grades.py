@@ -3,10 +3,10 @@
 record of a grading whose session did not run (:func:`no_session`); the record of a submission that
 could not be graded; and the rescore of a run's OUT with today's rubric.
 """
-import glob
 import os
 import traceback
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import provenance, report, teacher
 from exam_lab.grader.score import kept, records, rubric
 
@@ -34,10 +34,7 @@ def keep_and_score(out_dir, measured):
     grader's bug shows here, not at the rescore), score it (:func:`score`), write grade.json and
     grade.md; return the grade record."""
     record = kept.MeasurementsRecord.make(dict(measured, version=kept.VERSION))
-    partial = os.path.join(out_dir, records.MEASUREMENTS + '.part')
-    with open(partial, 'w') as f:
-        f.write(record.to_json())
-    os.rename(partial, os.path.join(out_dir, records.MEASUREMENTS))
+    contract.write_record(os.path.join(out_dir, records.MEASUREMENTS), record)
     grade = score(record)
     report.write_grade(out_dir, grade)
     return grade
@@ -45,11 +42,13 @@ def keep_and_score(out_dir, measured):
 
 def graded_folders(out):
     """The folders of a run's OUT holding a grade made from measurements: OUT itself for one
-    submission, else one per student (in the order of their names)."""
-    if os.path.isfile(os.path.join(out, records.MEASUREMENTS)):
+    submission, else one per student (in the order of their names): the folders listed in OUT (a link
+    is none: :func:`~exam_lab.grader.contract.folders`), each holding an entry of that name (a FIFO
+    or a link there is one, for its reader to refuse: that student's line)."""
+    if contract.exists(os.path.join(out, records.MEASUREMENTS)):
         return [out]
-    return sorted(os.path.join(out, name) for name in os.listdir(out)
-                  if os.path.isfile(os.path.join(out, name, records.MEASUREMENTS)))
+    return [os.path.join(out, name) for name in contract.folders(out)
+            if contract.exists(os.path.join(out, name, records.MEASUREMENTS))]
 
 
 #: The words of a line of :func:`rescore` for a student it did not rescore.
@@ -73,13 +72,17 @@ def rescore(out):
     for folder in folders:
         name = os.path.basename(folder.rstrip('/'))
         try:
-            old = kept.GradeRecord.read(os.path.join(folder, 'grade.json')).value \
-                if os.path.isfile(os.path.join(folder, 'grade.json')) else {}
+            old = read_grade(out, folder) if contract.exists(os.path.join(folder, 'grade.json')) else {}
         except records.RecordError as err:
             changes.append('%s: %s (its grade.json kept as it is, not in grades.csv): %s' % (name, NOT_RESCORED, err))
             continue
         try:
-            measured = kept.MeasurementsRecord.read(os.path.join(folder, records.MEASUREMENTS))
+            measured = contract.read_record(os.path.join(folder, records.MEASUREMENTS), kept.MeasurementsRecord,
+                                            under=out)
+            if folder != out and measured.student != name:
+                raise records.RecordError('%s: the measurements of %s, in the folder %s (a student\'s folder '
+                                          'holds its own)' % (records.MEASUREMENTS, records.shown(measured.student),
+                                                              records.shown(name)))
         except records.RecordError as err:
             changes.append('%s: %s (its grade kept as it was): %s' % (name, NOT_RESCORED, err))
             if old:
@@ -100,6 +103,20 @@ def rescore(out):
     if folders and folders != [out]:
         report.write_csv(os.path.join(out, 'grades.csv'), graded)
     return graded, changes
+
+
+def read_grade(out, folder):
+    """The grade kept in ``folder`` of ``out`` (``grade.json``), read through the contract (no link,
+    a regular file, capped, :class:`~exam_lab.grader.score.kept.GradeRecord`'s checks: its total the
+    sum of its items, its status the rubric's); in a class's folder, the grade of the student of that
+    folder (one naming another student is not this folder's). Raises RecordError naming the file and
+    what is wrong."""
+    record = contract.read_record(os.path.join(folder, kept.GradeRecord.FILE), kept.GradeRecord, under=out).value
+    name = os.path.basename(folder.rstrip('/'))
+    if folder != out and record['student'] != name:
+        raise records.RecordError('%s: the grade of %s, in the folder %s (a student\'s folder holds its own)'
+                                  % (kept.GradeRecord.FILE, records.shown(record['student']), records.shown(name)))
+    return record
 
 
 def no_session(outcome, error, **more):
@@ -126,17 +143,31 @@ def bug_note():
     return 'grader error, please report: %s' % traceback.format_exc().replace('\n', ' | ')[-records.MAX_LOG_TEXT:]
 
 
+def graded_in(out):
+    """The folders of a run's OUT holding a grade.json: one per student folder (a folder listed, never a
+    link: :func:`~exam_lab.grader.contract.folders`), or OUT itself for the single submission."""
+    folders = [os.path.join(out, name) for name in contract.folders(out)
+               if contract.exists(os.path.join(out, name, kept.GradeRecord.FILE))]
+    if folders:
+        return folders
+    return [out] if contract.exists(os.path.join(out, kept.GradeRecord.FILE)) else []
+
+
 def records_in(out, with_folders=False):
     """The grade records of a run's OUT: one per student folder, or the single submission's, each read
-    as a :class:`~exam_lab.grader.score.kept.GradeRecord` (capped, checked, one of an older grader
-    brought to today's shape); raises RecordError naming the file of one that is not a grade.
-    ``with_folders``: ``(its folder, record)`` each (the student's files beside its grade)."""
-    paths = sorted(glob.glob(os.path.join(out, '*', 'grade.json'))) or \
-        [p for p in [os.path.join(out, 'grade.json')] if os.path.isfile(p)]
+    through the contract (:func:`read_grade`: no link, a regular file, capped, checked: its total the
+    sum of its items, its status the rubric's, the student of its folder); raises RecordError naming
+    the file of one that is not a grade. ``with_folders``: ``(its folder, record)`` each (the
+    student's files beside its grade)."""
     found = []
-    for path in paths:
+    for folder in graded_in(out):
         try:
-            found.append((os.path.dirname(path), kept.GradeRecord.read(path).value))
+            found.append((folder, read_grade(out, folder)))
         except records.RecordError as err:
-            raise records.RecordError('%s: %s' % (os.path.relpath(path, out), err))
+            where = os.path.relpath(os.path.join(folder, kept.GradeRecord.FILE), out)
+            why = str(err)  # named by its place in OUT, once
+            for said in (where + ': ', kept.GradeRecord.FILE + ': '):
+                if why.startswith(said):
+                    why = why[len(said):]
+            raise records.RecordError('%s: %s' % (where, why))
     return found if with_folders else [record for _, record in found]

@@ -8,6 +8,7 @@ copies this file; a class graded here gets one per student, to upload with Grade
 import json
 import os
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import student_view
 from exam_lab.grader.score.sheets import ITEMS
 
@@ -43,7 +44,5 @@ def results(record):
 def write(out_dir, record):
     """Write ``out_dir/results.json``; return its path."""
     path = os.path.join(out_dir, 'results.json')
-    with open(path, 'w') as f:
-        json.dump(results(record), f, indent=1, sort_keys=True)
-        f.write('\n')
+    contract.write_text(path, json.dumps(results(record), indent=1, sort_keys=True) + '\n')
     return path

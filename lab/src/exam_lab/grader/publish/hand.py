@@ -23,13 +23,15 @@ spreadsheet runs and read back as it was (:mod:`~exam_lab.grader.publish.cells`)
 import collections
 import csv
 import io
-import os
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import cells
 from exam_lab.grader.score.identity import identity
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 
 FILE = 'hand.csv'
+#: Most bytes of hand.csv read: a class of a thousand students with long remarks fits many times over.
+MAX_BYTES = 8 << 20
 #: The row that shows each column's maximum to the teacher (skipped when read).
 MAX_ROW = '(max)'
 COLUMNS = ['student', 'participant', 'sheet', 'machine'] + list(HAND_ITEMS) + ['remark']
@@ -73,9 +75,12 @@ def _max_row():
 
 
 def _rows(path):
-    """The rows of an existing hand.csv as dicts (a spreadsheet may add a BOM or use ';')."""
-    with open(path, newline='', encoding='utf-8-sig') as f:
-        text = f.read()
+    """The rows of an existing hand.csv as dicts (a spreadsheet may add a BOM or use ';'), read through
+    the contract (no link, a regular file, capped, UTF-8): HandError naming the file otherwise."""
+    try:
+        text = contract.read_text(path, MAX_BYTES)
+    except contract.ContractError as err:
+        raise HandError('%s: %s' % (path, str(err).split(': ', 1)[-1]))
     try:  # only the delimiter: a header without quotes makes the sniffer turn doubled quotes off
         delimiter = csv.Sniffer().sniff(text.split('\n', 1)[0], delimiters=',;\t').delimiter
     except csv.Error:
@@ -123,17 +128,27 @@ def _kept_rows(path):
     return kept
 
 
-def _unique_keys(records):
-    """HandError when two records are one student (two folders of OUT with one participant number)."""
-    seen, problems = {}, []
-    for record in records:
-        found = key(record)
-        if found in seen:
-            problems.append('%s and %s are both %s (two folders of one student in OUT: remove the stale one and '
-                            'run make rescore)' % (seen[found], record['student'], _who(found)))
-        seen.setdefault(found, record['student'])
-    if problems:
-        raise HandError('; '.join(problems))
+def newest(records):
+    """``(records, notes)``: one record per student (its :func:`key`), the newest graded where one
+    participant has several (two archives of a flat download, two folders of OUT after a student was
+    renamed in Moodle between two runs: by the grade's provenance date, the later folder on a tie),
+    in their order; ``notes`` says, for each such participant, which grade is used and which are not.
+    That participant's matter, never the class's: hand.csv, the worksheet and the feedback zip are
+    written for everyone, that participant with its newest grade."""
+    by_key = collections.OrderedDict()
+    for index, record in enumerate(records):
+        by_key.setdefault(key(record), []).append((str((record.get('provenance') or {}).get('date') or ''), index))
+    chosen = {max(graded)[1] for graded in by_key.values()}
+    notes = []
+    for found, graded in by_key.items():
+        if len(graded) > 1:
+            used = records[max(graded)[1]]
+            notes.append('%s has %d grades (%s): the newest, %s\'s, is used; %s not (two archives or two folders of '
+                         'one participant: remove the stale one and run make rescore)' % (
+                             _who(found), len(graded), ', '.join(records[i]['student'] for _, i in graded),
+                             used['student'], ', '.join(records[i]['student'] for _, i in graded
+                                                        if records[i] is not used)))
+    return [record for index, record in enumerate(records) if index in chosen], notes
 
 
 def write(path, records):
@@ -141,11 +156,12 @@ def write(path, records):
     each record's row is found by its :func:`key`, never by its name.
 
     :returns: how many students were added.
-    :raises HandError: the existing file holds a student twice or a participant that is no number, or
-        two records are one participant (nothing is written then).
+    :raises HandError: the existing file holds a student twice or a participant that is no number
+        (nothing is written then). One participant of several records has the row of its newest
+        (:func:`newest`).
     """
-    _unique_keys(records)
-    kept = _kept_rows(path) if os.path.isfile(path) else collections.OrderedDict()
+    records, _ = newest(records)
+    kept = _kept_rows(path) if contract.exists(path) else collections.OrderedDict()
     rows = collections.OrderedDict((found, row) for found, (_, row) in kept.items())
     added = 0
     for record in records:
@@ -166,14 +182,13 @@ def _save(path, rows):
     """``rows`` (``{key: row}``) into ``path`` at once: the columns make grade wrote, then any the
     teacher added, each cell one no spreadsheet runs."""
     columns = COLUMNS + sorted({c for row in rows.values() for c in row if c and c not in COLUMNS})
-    temporary = path + '.new'
-    with open(temporary, 'w', newline='', encoding='utf-8') as f:
-        writer = csv.DictWriter(f, columns, extrasaction='ignore')
-        writer.writeheader()
-        writer.writerow(_max_row())
-        for row in rows.values():
-            writer.writerow({c: cells.cell(row.get(c) or '') for c in columns})
-    os.replace(temporary, path)
+    text = io.StringIO(newline='')
+    writer = csv.DictWriter(text, columns, extrasaction='ignore')
+    writer.writeheader()
+    writer.writerow(_max_row())
+    for row in rows.values():
+        writer.writerow({c: cells.cell(row.get(c) or '') for c in columns})
+    contract.write_text(path, text.getvalue())
 
 
 def give(path, records, given):
@@ -197,7 +212,7 @@ def give(path, records, given):
             raise HandError('%s: %s is not a number from 0 to %s' % (item, value, _points(HAND_ITEMS[item][0])))
         if found not in keys:
             raise HandError('%s is no graded student of this run' % _who(found))
-    if not os.path.isfile(path) or any(found not in _kept_rows(path) for found, _, _, _ in given):
+    if not contract.exists(path) or any(found not in _kept_rows(path) for found, _, _, _ in given):
         write(path, records)  # the student's row added, every cell kept (else the machine's column is left as it is)
     rows = collections.OrderedDict((found, row) for found, (_, row) in _kept_rows(path).items())
     written, kept = [], []
@@ -265,10 +280,11 @@ def match(hands, records):
     :raises HandError: a row whose participant no longer matches: a row with a participant number no
         graded student has, shown with the name of a graded student who is another participant, or
         a row with no number shown with the name of a student who has one. Its points could be that
-        student's or not: both are named, nothing is guessed. Also two records of one participant.
+        student's or not: both are named, nothing is guessed. One participant of several records
+        (:func:`newest`): the row is its newest's, the others have none.
     """
-    _unique_keys(records)
-    by_key = {key(record): record for record in records}
+    chosen = {id(record) for record in newest(records)[0]}
+    by_key = {key(record): record for record in records if id(record) in chosen}
     by_name = {}
     for record in records:
         by_name.setdefault(record['student'], []).append(record)
@@ -294,7 +310,7 @@ def match(hands, records):
                          % (row.line, row.student, _who(found)))
     if problems:
         raise HandError('\n  '.join(problems))
-    return [hands.get(key(record)) for record in records], notes
+    return [hands.get(key(record)) if id(record) in chosen else None for record in records], notes
 
 
 def combine(record, hand):

@@ -21,6 +21,7 @@ feedback already in the worksheet as it was (a teacher's grade wins over the mac
 import html
 import re
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import cells, student_view
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import ITEMS
@@ -369,8 +370,7 @@ def fill_file(source, target, records, scale=False):
     except UnicodeDecodeError as err:
         raise WorksheetError('not UTF-8 (download the worksheet again from Moodle): %s' % err)
     filled, summary = fill(text, records, scale)
-    with open(target, 'wb') as f:
-        f.write(filled.encode('utf-8'))
+    contract.write_bytes(target, filled.encode('utf-8'))
     return summary
 
 

@@ -8,8 +8,10 @@ clean text as it is. A line for the terminal or a cell of grades.csv is put on o
 (:func:`~exam_lab.grader.score.safe_text.one_line`), which cleans it on the way for any caller.
 """
 import csv
+import io
 import os
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import cells
 from exam_lab.grader.score import kept, safe_text
 from exam_lab.grader.score.sheets import ITEMS, SHEETS
@@ -90,12 +92,9 @@ def markdown(record):
 def write_grade(out_dir, record):
     """Write ``grade.json`` and ``grade.md`` into ``out_dir``; return the grade as written (the value
     of its :class:`~exam_lab.grader.score.kept.GradeRecord`: checked, read-only)."""
-    os.makedirs(out_dir, exist_ok=True)
     record = kept.GradeRecord.make(record)
-    with open(os.path.join(out_dir, kept.GradeRecord.FILE), 'w') as f:
-        f.write(record.to_json() + '\n')
-    with open(os.path.join(out_dir, 'grade.md'), 'w') as f:
-        f.write(markdown(record.value))
+    contract.write_record(os.path.join(out_dir, kept.GradeRecord.FILE), record)
+    contract.write_text(os.path.join(out_dir, 'grade.md'), markdown(record.value))
     return record.value
 
 
@@ -103,15 +102,16 @@ def write_csv(path, records):
     """grades.csv: one row per student (its Moodle participant number beside the name, the key that
     stays when names clash), each item's points, the total; every cell one no spreadsheet runs
     (:mod:`~exam_lab.grader.publish.cells`)."""
-    with open(path, 'w', newline='') as f:
-        writer = csv.writer(f)
-        writer.writerow(['student', 'participant', 'sheet', 'status'] + list(ITEMS) + ['total', 'max'])
-        for record in records:
-            points = {e['id']: e['points'] for e in record['items']}
-            writer.writerow(cells.row([safe_text.one_line(record['student']), record.get('participant'),
-                                       record['sheet'], safe_text.one_line(record.get('status', 'graded'))] +
-                                      [_points(points.get(i, 0)) for i in ITEMS] +
-                                      [_points(record['total']), _points(record['max'])]))
+    text = io.StringIO(newline='')
+    writer = csv.writer(text)
+    writer.writerow(['student', 'participant', 'sheet', 'status'] + list(ITEMS) + ['total', 'max'])
+    for record in records:
+        points = {e['id']: e['points'] for e in record['items']}
+        writer.writerow(cells.row([safe_text.one_line(record['student']), record.get('participant'),
+                                   record['sheet'], safe_text.one_line(record.get('status', 'graded'))] +
+                                  [_points(points.get(i, 0)) for i in ITEMS] +
+                                  [_points(record['total']), _points(record['max'])]))
+    contract.write_text(path, text.getvalue())
 
 
 def table(records):

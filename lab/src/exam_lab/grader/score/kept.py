@@ -17,8 +17,9 @@ import copy
 
 from exam_lab.grader.score.records import (
     MAX_LOG_TEXT, MEASUREMENTS, STATIC, InspectRecord, Items, Map, Maybe, Number, OneOf, Optional, Outcome, Record,
-    SessionRecord, Text)
-from exam_lab.grader.score.sheets import SHEETS
+    RecordError, SessionRecord, Text, shown)
+from exam_lab.grader.score.sheets import ITEMS, SHEETS
+from exam_lab.grader.score.verdict import STATUSES
 
 #: The current shape of measurements.json and of grade.json. Version 1 (2026-11-27): the first with a
 #: version; the shapes before it have none (:func:`measurements_from_unversioned`).
@@ -163,6 +164,28 @@ class GradeRecord(Record):
     @classmethod
     def upgraded(cls, value):
         return grade_from_unversioned(value) if _unversioned(value) else value
+
+    def validate(self):
+        """A grade is the rubric's: each item one of the sheets' (once, out of its own maximum, its points
+        from 0 to it), the total the sum of the items' points, the maximum the sum of theirs, the status
+        one the rubric gives. A grade edited by hand (a total of 17 over no item) is no grade."""
+        seen = set()
+        for index, item in enumerate(self.items):
+            where = 'grade.json.items[%d]' % index
+            if item['id'] not in ITEMS or item['id'] in seen:
+                raise RecordError('%s.id: %s is %s' % (where, shown(item['id']), 'an item twice' if item['id'] in seen
+                                                       else 'no item of the rubric'))
+            seen.add(item['id'])
+            if item['max'] != ITEMS[item['id']][0] or not 0 <= item['points'] <= item['max']:
+                raise RecordError('%s: %s points out of %s, where the rubric gives %s at most'
+                                  % (where, item['points'], item['max'], ITEMS[item['id']][0]))
+        for key, total in (('total', sum(i['points'] for i in self.items)), ('max', sum(i['max'] for i in self.items))):
+            if abs(self.value[key] - total) > 1e-6:
+                raise RecordError('grade.json.%s: %s, but its %d item(s) come to %s' % (key, self.value[key],
+                                                                                       len(self.items), total))
+        if self.status not in STATUSES:
+            raise RecordError('grade.json.status: %s is no status the rubric gives (%s)'
+                              % (shown(self.status), ', '.join(STATUSES)))
 
 
 def grade_from_unversioned(value):

@@ -1,7 +1,7 @@
 """The typed records that cross the trust boundary: what a box hands back to root. Pure, no rospy.
 
 A box (:mod:`exam_lab.grader.boxed.inspect`, :mod:`~exam_lab.grader.boxed.intake`, the similarity
-check) writes one JSON object; root reads it only through :func:`exam_lab.grader.host.egress.read_record`,
+check) writes one JSON object; root reads it only through :func:`exam_lab.grader.contract.read_record`,
 which gives the bytes to a record's ``from_json``. That checks every field against the record's
 schema (types, ranges, string lengths, list lengths, no unknown keys; :mod:`exam_lab.grader.score.schema`)
 and raises :class:`RecordError` on anything unexpected: a record of an unexpected shape is a crash of
@@ -20,6 +20,12 @@ from exam_lab.grader.score.sheets import SHEETS
 #: What a grading measured, kept beside grade.json by the runner (:class:`~exam_lab.grader.score.kept.MeasurementsRecord`,
 #: its session a :class:`SessionRecord`): a rescore scores it again, the flight plot draws from it.
 MEASUREMENTS = 'measurements.json'
+
+
+class UnpackError(Exception):
+    """A submission (or a class archive) that cannot be opened safely; the message says why, for the
+    teacher. Raised in the box (boxed/archives.py) and by root of what a box said (the class's intake):
+    one type for both sides."""
 
 
 #: What the inspection read of the package for the rubric (``static`` of :func:`~exam_lab.grader.score.rubric.score`).
@@ -151,7 +157,7 @@ _NAME = Text(1000)
 _TIME = Number()
 _COUNT = Number(0, 1e12, integer=True)
 #: Most service calls (and answers) of one run: a node that calls in a loop is judged for it, not
-#: refused (the probe's result is read up to egress.FILE_CAP bytes: fewer than this many calls fit).
+#: refused (the probe's result is read up to contract.FILE_CAP bytes: fewer than this many calls fit).
 MAX_CALLS = 200000
 #: Most node deaths the judge's watch lists in one run (a node respawned in a loop).
 MAX_DEATHS = 20000
@@ -170,7 +176,7 @@ class ProbeRecord(Record):
     """The probe's result (:mod:`exam_lab.grader.judge.probe`, ``probe-<tag>.json``): what it measured of
     the student's node in one run, as the rubric reads it. Written by the judge's uid, of names and
     values the student's node chose (node and topic names, requests, published values): root reads it
-    through :func:`~exam_lab.grader.host.egress.read_record` and takes a result that does not match for
+    through :func:`~exam_lab.grader.contract.read_record` and takes a result that does not match for
     the run's crash. The keys after ``start_timeout`` up to ``rate`` are there as far as the flight got
     (a node that never started has no ``output``); the flight's legs are named by the probe
     (``schedule`` and ``legs`` keys)."""

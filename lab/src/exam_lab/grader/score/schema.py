@@ -20,6 +20,34 @@ MAX_TEXT = 2000
 MAX_ITEMS = 500
 
 
+#: What stands for the middle of a text that was cut.
+CUT_MARK = ' [...] '
+
+
+def cut(text, limit=MAX_TEXT):
+    """``text`` in at most ``limit`` characters: its middle replaced by CUT_MARK (a ``file:line``
+    keeps its file's start and its line)."""
+    if len(text) <= limit:
+        return text
+    head = (limit - len(CUT_MARK)) // 2
+    return text[:head] + CUT_MARK + text[len(text) - (limit - len(CUT_MARK) - head):]
+
+
+def closed(notes, what='notes', limit=MAX_ITEMS, keep=()):
+    """``notes`` (texts for the teacher) within ``limit`` items, the last saying how many more there
+    were, each cut to MAX_TEXT; those in ``keep`` (the sentences of caps) are never left out."""
+    if len(notes) <= limit:
+        return [cut(n) for n in notes]
+    keep = set(keep)
+    room = limit - 1 - sum(1 for n in notes if n in keep)
+    out = []
+    for note in notes:
+        if note in keep or room > 0:
+            room -= note not in keep
+            out.append(cut(note))
+    return out[:limit - 1] + ['%d %s (at most %d): the first %d kept' % (len(notes), what, limit, min(len(out), limit - 1))]
+
+
 class RecordError(ValueError):
     """A box's record that does not match its schema: the message says where and why."""
 
@@ -302,7 +330,7 @@ class Record(object):
     @classmethod
     def read(cls, path):
         """The record in the file ``path``, one the grader wrote itself (kept in OUT; for a box's, root
-        uses :func:`exam_lab.grader.host.egress.read_record`): read up to ``MAX_BYTES``, then as
+        uses :func:`exam_lab.grader.contract.read_record`): read up to ``MAX_BYTES``, then as
         :meth:`from_json`; raises :class:`RecordError` naming the file when it cannot be read."""
         try:
             with open(path, 'rb') as f:

@@ -1,11 +1,11 @@
 """What a box hands back is data root checks: one regular file, capped, never followed, of the record's
-schema (issue 26 point 1). No ROS, no box: the records are written here as a hostile box would."""
+schema. No ROS, no box: the records are written here as a hostile box would."""
 import json
 import os
 
 import pytest
 
-from exam_lab.grader.host import egress
+from exam_lab.grader import contract
 from exam_lab.grader.score import records
 
 
@@ -33,7 +33,7 @@ def write(tmp_path, value, name='inspect.json'):
 
 
 def test_a_good_record_is_read(tmp_path):
-    record = egress.read_record(write(tmp_path, inspect_record()), records.InspectRecord)
+    record = contract.read_record(write(tmp_path, inspect_record()), records.InspectRecord)
     assert record.uid == 61003 and record.threshold_value == 1300.0
     assert record.static['launch']['exam_type'] == 'exam_node.py'
     assert record.main_launch == 'src/exam/launch/.grader-main-exam.launch'
@@ -56,7 +56,7 @@ def test_a_good_record_is_read(tmp_path):
 ])
 def test_a_record_of_an_unexpected_shape_is_refused(tmp_path, change, words):
     with pytest.raises(records.RecordError) as refused:
-        egress.read_record(write(tmp_path, inspect_record(**change)), records.InspectRecord)
+        contract.read_record(write(tmp_path, inspect_record(**change)), records.InspectRecord)
     assert words in str(refused.value)
 
 
@@ -64,22 +64,22 @@ def test_nested_fields_are_checked_too(tmp_path):
     record = inspect_record()
     record['static']['launch']['comments'] = -1
     with pytest.raises(records.RecordError, match=r'static\.launch\.comments: -1 is outside'):
-        egress.read_record(write(tmp_path, record), records.InspectRecord)
+        contract.read_record(write(tmp_path, record), records.InspectRecord)
     del record['static']['launch']
     with pytest.raises(records.RecordError, match='launch is missing'):
-        egress.read_record(write(tmp_path, record), records.InspectRecord)
+        contract.read_record(write(tmp_path, record), records.InspectRecord)
 
 
 def test_not_json_and_non_numbers_are_refused(tmp_path):
     for raw in (b'{"uid": 1', b'\xff\xfe', b'[]', json.dumps(inspect_record()).replace('1300.0', 'NaN').encode()):
         with pytest.raises(records.RecordError):
-            egress.read_record(write(tmp_path, raw), records.InspectRecord)
+            contract.read_record(write(tmp_path, raw), records.InspectRecord)
 
 
 def test_an_oversized_record_is_refused_unread(tmp_path):
     path = write(tmp_path, inspect_record(notes=['x' * 1000] * 200))
     with pytest.raises(records.RecordError, match='bytes \\(at most 100000\\)'):
-        egress.read_record(path, records.InspectRecord, max_bytes=100000)
+        contract.read_record(path, records.InspectRecord, max_bytes=100000)
 
 
 def test_links_fifos_and_missing_files_are_refused(tmp_path):
@@ -87,23 +87,23 @@ def test_links_fifos_and_missing_files_are_refused(tmp_path):
     os.chmod(secret, 0o600)
     os.symlink(secret, str(tmp_path / 'inspect.json'))
     with pytest.raises(records.RecordError, match='a link, not followed'):
-        egress.read_record(str(tmp_path / 'inspect.json'), records.InspectRecord)
+        contract.read_record(str(tmp_path / 'inspect.json'), records.InspectRecord)
     os.mkfifo(str(tmp_path / 'fifo.json'))
     with pytest.raises(records.RecordError, match='not a regular file'):  # and never blocks
-        egress.read_record(str(tmp_path / 'fifo.json'), records.InspectRecord)
+        contract.read_record(str(tmp_path / 'fifo.json'), records.InspectRecord)
     with pytest.raises(records.RecordError, match='missing'):
-        egress.read_record(str(tmp_path / 'none.json'), records.InspectRecord)
+        contract.read_record(str(tmp_path / 'none.json'), records.InspectRecord)
 
 
 def test_an_intake_names_only_students_inside_its_folder(tmp_path):
     good = {'uid': 61000, 'students': [{'name': 'Jane Doe', 'path': 'class/Jane Doe_1_assignsubmission_file_'}]}
-    assert egress.read_record(write(tmp_path, good, 'intake.json'), records.IntakeRecord).students[0]['name'] == \
+    assert contract.read_record(write(tmp_path, good, 'intake.json'), records.IntakeRecord).students[0]['name'] == \
         'Jane Doe'
     for student in ({'name': '../../etc', 'path': 'class/x'}, {'name': 'x/y', 'path': 'class/x'},
                     {'name': '..', 'path': 'class/x'}, {'name': 'Jane', 'path': '/root'},
                     {'name': 'Jane', 'path': 'class/../../x'}):
         with pytest.raises(records.RecordError):
-            egress.read_record(write(tmp_path, dict(good, students=[student]), 'intake.json'), records.IntakeRecord)
+            contract.read_record(write(tmp_path, dict(good, students=[student]), 'intake.json'), records.IntakeRecord)
 
 
 def test_similarity_html_holds_only_the_highlight(tmp_path):
@@ -111,16 +111,16 @@ def test_similarity_html_holds_only_the_highlight(tmp_path):
              'html_a': "x = 1 <span class='highlight-red'>y &lt;= 2</span>", 'html_b': 'z'}
     good = {'pairs': [{'a': 'A', 'b': 'B', 'score_a': 0.9, 'score_b': 0.8, 'files': [match]}], 'students': 2,
             'threshold': 0.5, 'detector': 'copydetect 0.5.0', 'scores': [['A', 'B', 0.9, 0.8]], 'notes': []}
-    read = egress.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
+    read = contract.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
     assert read.value['pairs'][0]['files'][0]['html_a'] == match['html_a']
     match['html_b'] = '<script>alert(1)</script>'
     with pytest.raises(records.RecordError, match='markup other than'):
-        egress.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
-    assert egress.read_record(write(tmp_path, {'error': 'no venv', 'notes': []}, 'similarity.json'),
+        contract.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
+    assert contract.read_record(write(tmp_path, {'error': 'no venv', 'notes': []}, 'similarity.json'),
                               records.SimilarityRecord).value == {'error': 'no venv', 'notes': []}
     # The students' file names and code are made safe where the record is made; the highlight stays.
     match.update(file_a='a\x1b[2J.py', html_b="w\x07 <span class='highlight-green'>v\u202e</span>")
-    read = egress.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
+    read = contract.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
     assert read.pairs[0]['files'][0]['file_a'] == 'a.py'
     assert read.pairs[0]['files'][0]['html_b'] == "w <span class='highlight-green'>v</span>"
 
@@ -131,19 +131,19 @@ def test_a_cap_hit_is_a_sentence_naming_the_cap_and_the_value(tmp_path):
     files = ['scripts/n%d.py' % i for i in range(records.MAX_ITEMS + 1)]
     record = inspect_record(comments={'comments': 1, 'code': 2, 'files': files})
     with pytest.raises(records.RecordError) as refused:
-        egress.read_record(write(tmp_path, record), records.InspectRecord)
+        contract.read_record(write(tmp_path, record), records.InspectRecord)
     assert str(refused.value) == 'inspect.json.comments.files: 501 files (at most 500)'
     with pytest.raises(records.RecordError, match=r'^inspect.json.notes: 501 notes \(at most 500\)$'):
         records.write(str(tmp_path), records.InspectRecord, inspect_record(notes=['n'] * 501))
     with pytest.raises(records.RecordError, match=r'inspect.json: 1048577 bytes \(at most 1048576\)$'):
-        egress.read_record(write(tmp_path, b' ' * ((1 << 20) + 1)), records.InspectRecord)
+        contract.read_record(write(tmp_path, b' ' * ((1 << 20) + 1)), records.InspectRecord)
 
 
 def test_a_class_larger_than_a_list_cap_is_one_intake(tmp_path):
     """A class of more students than any other list may hold, one of them refused with its reason."""
     students = [{'name': 'S %d' % i, 'path': 'class/S %d' % i} for i in range(records.MAX_ITEMS + 100)]
     students[7]['refused'] = 'the files of S 7: 5001 more files, beyond the 5000 a submission may unpack'
-    got = egress.read_record(write(tmp_path, {'uid': 61000, 'students': students}, 'intake.json'),
+    got = contract.read_record(write(tmp_path, {'uid': 61000, 'students': students}, 'intake.json'),
                              records.IntakeRecord, records.IntakeRecord.MAX_BYTES)
     assert len(got.students) == 600 and got.students[7]['refused'].startswith('the files of S 7')
 
@@ -157,7 +157,7 @@ def test_the_inspections_text_is_made_safe_where_its_record_is_made(tmp_path):
                            static=dict(inspect_record()['static'], threshold_reason='reads \x1b]0;owned\x07it'),
                            facts={'participant': 1, 'folder': 'F\x1b[31m', 'documents': [{'name': 'r\x07.pdf', 'pages': 1}]},
                            handed_in_launch='exam/launch/\udcfe.launch', comments={'comments': 1, 'code': 2, 'files': [odd]})
-    record = egress.read_record(write(tmp_path, json.dumps(found).encode()), records.InspectRecord)
+    record = contract.read_record(write(tmp_path, json.dumps(found).encode()), records.InspectRecord)
     assert record.notes == ['link scripts/n\\xff.py dropped', 'bell'] and record.fixes == ['evil']
     assert record.static['threshold_reason'] == 'reads it' and record.facts['folder'] == 'F'
     assert record.facts['documents'] == [{'name': 'r.pdf', 'pages': 1}]
