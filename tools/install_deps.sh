@@ -23,6 +23,8 @@ packages=(
   # students' reports are read in a box: the text layer (poppler), OCR of scans and screenshots
   # (tesseract, French and English), an .odt or .docx handed in instead of a PDF (LibreOffice headless)
   tesseract-ocr tesseract-ocr-fra tesseract-ocr-eng libreoffice-writer-nogui
+  # the report reader's pictures (screenshots prepared for OCR, page images) are PIL's
+  python3-pil
   # class zips are tested as the usual tools make them (Info-ZIP, bsdtar, 7-Zip)
   zip unzip libarchive-tools p7zip-full
   "$@"

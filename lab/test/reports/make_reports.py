@@ -259,24 +259,29 @@ def french_report(out, shots):
 
 def english_table_report(out, shots):
     """Sheet 001 (underwater), in English, its answers in a table, out of order, question 6 missing."""
+    def cell(text):  # pasted into a cell as lines of a monospace font, which wrap as a word processor's do
+        escaped = text.replace('&', '&amp;').replace('<', '&lt;').replace('>', '&gt;').replace('\n', '<br>')
+        return '<p style="font-family: DejaVu Sans Mono; font-size: 7pt">%s</p>' % escaped if text else ''
+
     def row(q, command, output, comment):
-        return '<tr><td>%s</td><td>%s</td><td>%s</td><td>%s</td></tr>' % (q, command, output, comment)
+        return ('<tr><td width="45">%s</td><td width="110">%s</td><td width="280">%s</td><td width="185">%s</td></tr>'
+                % (q, command, cell(output), comment))
     rows = [
-        row('Q7', '<code>rostopic type /pressure_robot</code>', pre(out['rostopic type /pressure_robot'] + '\n' +
-                                                                    out['rosmsg info std_msgs/Float32']),
+        row('Q7', '<code>rostopic type /pressure_robot</code>', out['rostopic type /pressure_robot'] + '\n' +
+            out['rosmsg info std_msgs/Float32'],
             'The type is std_msgs/Float32: one field, float32 data, the pressure in Pa.'),
-        row('Q4', '<code>rosnode list</code>', pre(out['rosnode list']),
+        row('Q4', '<code>rosnode list</code>', out['rosnode list'],
             'Two nodes: the drone /submarine_drone and /rosout, started by roscore.'),
-        row('Q5', '<code>rosnode info /submarine_drone</code>', pre(out['rosnode info /submarine_drone']),
+        row('Q5', '<code>rosnode info /submarine_drone</code>', out['rosnode info /submarine_drone'],
             'Its publications, no subscriptions, its services; contacting node gives its address and port, Pid its '
             'process number; the connection is outbound to /rosout over TCPROS.'),
         row('Q9', '<code>catkin_create_pkg exam rospy std_msgs submarinedrone</code>', '',
             'Creates the package exam depending on rospy, std_msgs and submarinedrone.'),
         row('Q8', '<code>rostopic echo -n 3 /pressure_robot</code>, <code>rostopic hz /pressure_robot</code>',
-            pre(out['rostopic echo -n 3 /pressure_robot'] + '\n' + out['timeout -s INT 4 rostopic hz /pressure_robot']),
+            out['rostopic echo -n 3 /pressure_robot'] + '\n' + out['timeout -s INT 4 rostopic hz /pressure_robot'],
             'The robot\'s pressure is published at 2 Hz. The remote pressure (screenshot below) at 1 Hz.'),
     ]
-    table = ('<table border="1" cellpadding="4"><tr><th>Question</th><th>Command</th><th>Output</th>'
+    table = ('<table width="620" border="1" cellpadding="3"><tr><th>Question</th><th>Command</th><th>Output</th>'
              '<th>Comment</th></tr>%s</table>' % ''.join(rows))
     body = ('<p>Student: John Smith. ROS exam, underwater drone (submarinedrone).</p>' + table +
             '<p>Remote pressure:</p>' + image_tag(shots['remote']))

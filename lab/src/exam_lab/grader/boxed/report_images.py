@@ -113,9 +113,10 @@ def picture_regions(page, boxes, page_width, min_inches=(0.8, 0.25), min_ink=0.2
                     if 0 <= ny < rows and 0 <= nx < cols and grown[ny][nx] and not seen[ny][nx]:
                         seen[ny][nx] = True
                         stack.append((ny, nx))
-            top, bottom = min(y for y, _ in cells), max(y for y, _ in cells) + 1
-            left, right = min(x for _, x in cells), max(x for _, x in cells) + 1
-            share = sum(1 for y, x in cells if ink[y][x]) / float((bottom - top) * (right - left))
+            inked = [(y, x) for y, x in cells if ink[y][x]]  # its size is its ink's, not the grown cells'
+            top, bottom = min(y for y, _ in inked), max(y for y, _ in inked) + 1
+            left, right = min(x for _, x in inked), max(x for _, x in inked) + 1
+            share = len(inked) / float((bottom - top) * (right - left))
             if (right - left) * cell_points >= min_inches[0] * 72 and (bottom - top) * cell_points >= min_inches[1] * 72 \
                     and share >= min_ink:
                 regions.append((left * cell_points, top * cell_points, right * cell_points, bottom * cell_points))

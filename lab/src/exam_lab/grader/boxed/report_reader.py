@@ -90,8 +90,6 @@ def kind_of(path):
             head = f.read(1024)
     except OSError:
         return 'other'
-    if b'%PDF-' in head[:1024]:
-        return 'pdf'
     if head.startswith(b'\x89PNG\r\n\x1a\n') or head.startswith(b'\xff\xd8\xff'):
         return 'image'
     if head.startswith(b'{\\rtf'):
@@ -108,6 +106,9 @@ def kind_of(path):
                     return 'odt'
         except (zipfile.BadZipFile, OSError, KeyError, RuntimeError, NotImplementedError, EOFError):
             pass
+        return 'other'  # a zip holding a PDF stored as is holds "%PDF-" too: an archive, searched
+    if b'%PDF-' in head:  # (a PDF may start with up to 1 kB of anything)
+        return 'pdf'
     return 'other'
 
 

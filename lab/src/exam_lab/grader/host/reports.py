@@ -32,8 +32,9 @@ COPY_BYTES = 256 << 20
 #: What of the package's source is copied to code/ (the package as handed in: a few files of kB).
 CODE_FILES = 500
 CODE_BYTES = 32 << 20
-#: /etc files the reader's tools read beyond a ROS process's: fontconfig's (LibreOffice, poppler).
-READER_ETC = ('/etc/fonts',)
+#: /etc files the reader's tools read beyond a ROS process's: fontconfig's (LibreOffice, poppler) and
+#: LibreOffice's configuration (its registry: without it, it aborts).
+READER_ETC = ('/etc/fonts', '/etc/libreoffice')
 _PNG = b'\x89PNG\r\n\x1a\n'
 
 
