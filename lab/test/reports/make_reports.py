@@ -227,7 +227,7 @@ AERIAL = ['rosnode list', 'rosnode info /mydrone', 'rostopic list', 'rostopic ty
           'rosmsg info std_msgs/Float32', 'rostopic echo -n 3 /temperature', 'timeout -s INT 6 rostopic hz /temperature']
 SUBMARINE = ['rosnode list', 'rosnode info /submarine_drone', 'rostopic type /pressure_robot',
              'rosmsg info std_msgs/Float32', 'rostopic echo -n 3 /pressure_robot',
-             'timeout -s INT 4 rostopic hz /pressure_robot', 'rostopic echo -n 3 /pressure_remote',
+             'timeout -s INT 6 rostopic hz /pressure_robot', 'rostopic echo -n 3 /pressure_remote',
              'timeout -s INT 4 rostopic hz /pressure_remote']
 
 
@@ -260,6 +260,8 @@ def french_report(out, shots):
 def english_table_report(out, shots):
     """Sheet 001 (underwater), in English, its answers in a table, out of order, question 6 missing."""
     def cell(text):  # pasted into a cell as lines of a monospace font, which wrap as a word processor's do
+        # a line longer than the cell is broken where the cell ends (rosnode info's row of 80 dashes)
+        text = '\n'.join(line[i:i + 56] for line in text.split('\n') for i in range(0, max(1, len(line)), 56))
         escaped = text.replace('&', '&amp;').replace('<', '&lt;').replace('>', '&gt;').replace('\n', '<br>')
         return '<p style="font-family: DejaVu Sans Mono; font-size: 7pt">%s</p>' % escaped if text else ''
 
@@ -278,7 +280,7 @@ def english_table_report(out, shots):
         row('Q9', '<code>catkin_create_pkg exam rospy std_msgs submarinedrone</code>', '',
             'Creates the package exam depending on rospy, std_msgs and submarinedrone.'),
         row('Q8', '<code>rostopic echo -n 3 /pressure_robot</code>, <code>rostopic hz /pressure_robot</code>',
-            out['rostopic echo -n 3 /pressure_robot'] + '\n' + out['timeout -s INT 4 rostopic hz /pressure_robot'],
+            out['rostopic echo -n 3 /pressure_robot'] + '\n' + out['timeout -s INT 6 rostopic hz /pressure_robot'],
             'The robot\'s pressure is published at 2 Hz. The remote pressure (screenshot below) at 1 Hz.'),
     ]
     table = ('<table width="620" border="1" cellpadding="3"><tr><th>Question</th><th>Command</th><th>Output</th>'

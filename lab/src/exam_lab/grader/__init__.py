@@ -12,7 +12,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it),
   :mod:`~.boxed.derive` (which launch file and threshold are run; the derived launch files the grader
   runs), :mod:`~.boxed.documents` (participant number, PDF
-  reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own),
+  reports), :mod:`~.boxed.report_reader` (the student's report read: text layer, OCR; converted by
+  LibreOffice), :mod:`~.boxed.report_images` (its pictures prepared for OCR, PIL),
+  :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own),
   :mod:`~.boxed.bounds` (what a box puts into its record, cut to the record's caps with a sentence).
 - ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`
   (rospy: plays the drone with the harness's fake drone, measures; its entry point), :mod:`~.judge.graph`
@@ -27,7 +29,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder),
   :mod:`~.host.egress` (the only reader of what a box leaves: its record, capped, never a link, checked
   against its schema; its logs, capped), :mod:`~.host.boxed_run` (one of the grader's modules run in a
-  box on student bytes, its record read back) and :mod:`~.host.underlay` (the simulators' workspace,
+  box on student bytes, its record read back), :mod:`~.host.reports` (the report read in a box of its
+  own; the report's and the code's copies kept for the teacher) and :mod:`~.host.underlay` (the simulators' workspace,
   built once, under every student's package).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima),
   :mod:`~.score.rubric` (points, evidence and status from the measurements: :func:`~.score.rubric.score`)

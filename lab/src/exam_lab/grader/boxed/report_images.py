@@ -15,7 +15,7 @@ class PictureError(Exception):
 
 def open_image(path, max_pixels):
     """The image at ``path``, loaded, of at most ``max_pixels`` pixels; raises :class:`PictureError`."""
-    Image.MAX_IMAGE_PIXELS = max_pixels
+    Image.MAX_IMAGE_PIXELS = None  # PIL's own check refuses before its size is known: this one says it
     try:
         image = Image.open(path)
         width, height = image.size
