@@ -73,7 +73,8 @@ def test_a_word_document_with_its_answers_in_a_table_is_read(tmp_path, name, con
     assert record.state == 'read'
     assert [(f['kind'], f['converted'], f['state']) for f in record.files] == \
         [(name.rsplit('.', 1)[1], converted, 'read')]
-    q7 = page_with(record, ['Q7', 'std_msgs/Float32', 'float32 data', 'The type is std_msgs/Float32'], 'text')
+    # each cell's text on lines of its own, as the cell wraps it
+    q7 = page_with(record, ['Q7', 'std_msgs/Float32', 'float32 data', 'The type is', 'one field'], 'text')
     assert 'Q7' in q7['layout'] and 'float32 data' in q7['layout']
     # the table's columns side by side in the layout text: the question, its command, its output
     assert any('Q4' in line and 'rosnode list' in line for line in q7['layout'].splitlines())
