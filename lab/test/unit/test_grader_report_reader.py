@@ -1,13 +1,13 @@
-"""The report reader's pure parts (lab/src/exam_lab/grader/boxed/report_reader.py, report_images.py) and
+"""The report reader's pure parts (lab/src/exam_lab/grader/boxed/report_report_text.py, report_images.py) and
 the report's record (score/records.ReportRecord): no box, no tool run. The reading of real reports in
-a real box is test/grader/test_report_reader.py."""
+a real box is test/grader/test_report_report_text.py."""
 import os
 import re
 import zipfile
 
 import pytest
 
-from exam_lab.grader.boxed import report_reader as reader
+from exam_lab.grader.boxed import report_files, report_text
 from exam_lab.grader.score.records import RecordError, ReportRecord
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'data', 'reports')
@@ -27,48 +27,48 @@ TSV = '\n'.join([
 
 
 def test_tesseract_words_are_read_with_their_place_and_confidence():
-    words = reader.parse_tsv(TSV)
+    words = report_text.parse_tsv(TSV)
     assert [w.text for w in words] == ['rostopic', 'echo', '/pressure', 'remote', 'data:', '101349.66']
     assert words[2].box == (240, 20, 130, 36) and words[3].confidence == 40.5
-    assert reader.words_text(words) == 'rostopic echo /pressure remote\ndata: 101349.66'
+    assert report_text.words_text(words) == 'rostopic echo /pressure remote\ndata: 101349.66'
 
 
 def test_words_apart_by_an_underscore_are_joined_and_spaces_are_kept():
-    words = reader.parse_tsv(TSV)
-    joined = reader.join_underscores(words, lambda a, b: a == (240, 20, 130, 36))
-    assert reader.words_text(joined) == 'rostopic echo /pressure_remote\ndata: 101349.66'
+    words = report_text.parse_tsv(TSV)
+    joined = report_text.join_underscores(words, lambda a, b: a == (240, 20, 130, 36))
+    assert report_text.words_text(joined) == 'rostopic echo /pressure_remote\ndata: 101349.66'
     assert joined[2].box == (240, 20, 244, 36) and joined[2].confidence == 40.5
     # a word tesseract ended with the underscore itself ("/pressure_ remote") is joined once
     trailing = [words[2]._replace(text='/pressure_'), words[3]]
-    assert [w.text for w in reader.join_underscores(trailing, lambda a, b: True)] == ['/pressure_remote']
+    assert [w.text for w in report_text.join_underscores(trailing, lambda a, b: True)] == ['/pressure_remote']
     # never across lines
-    assert len(reader.join_underscores(words[3:5], lambda a, b: True)) == 2
+    assert len(report_text.join_underscores(words[3:5], lambda a, b: True)) == 2
 
 
 def test_ocr_facts_give_the_mean_confidence_and_the_unsure_words_once():
-    words = reader.parse_tsv(TSV) + reader.parse_tsv(TSV)
-    facts = reader.ocr_facts(words)
+    words = report_text.parse_tsv(TSV) + report_text.parse_tsv(TSV)
+    facts = report_text.ocr_facts(words)
     assert facts == {'confidence': 84.0, 'unsure': ['remote']}
-    assert reader.ocr_facts([]) == {'confidence': None, 'unsure': []}
+    assert report_text.ocr_facts([]) == {'confidence': None, 'unsure': []}
 
 
 def test_a_pictures_text_goes_where_the_picture_stands():
     lines = [{'text': 'Question 8', 'top': 100.0}, {'text': 'Les messages sont publiés à 0.778 Hz', 'top': 400.0},
              {'text': 'Question 9', 'top': 500.0}]
-    text = reader.merge_pictures(lines, [(480.0, 'catkin_create_pkg exam'), (150.0, 'average rate: 0.778')])
+    text = report_text.merge_pictures(lines, [(480.0, 'catkin_create_pkg exam'), (150.0, 'average rate: 0.778')])
     assert text.split('\n') == ['Question 8', '[picture 1, OCR]', 'average rate: 0.778', '[end of picture 1]',
                                 'Les messages sont publiés à 0.778 Hz', '[picture 2, OCR]', 'catkin_create_pkg exam',
                                 '[end of picture 2]', 'Question 9']
     # a picture below the last line (or of no known place) comes last
-    assert reader.merge_pictures(lines[:1], [(900.0, 'x')]).endswith('[picture 1, OCR]\nx\n[end of picture 1]')
+    assert report_text.merge_pictures(lines[:1], [(900.0, 'x')]).endswith('[picture 1, OCR]\nx\n[end of picture 1]')
 
 
 def test_a_region_is_read_from_the_picture_of_its_shape_only():
     pictures = [(760, 137, 'a.png'), (760, 270, 'b.png')]
-    assert reader.matching_picture((50, 100, 480, 177), pictures)[2] == 'a.png'     # 5.6 : 1
-    assert reader.matching_picture((50, 300, 480, 452), pictures)[2] == 'b.png'     # 2.8 : 1
-    assert reader.matching_picture((50, 300, 100, 450), pictures) is None           # a tall one: none
-    assert reader.matching_picture((0, 0, 10, 10), []) is None
+    assert report_text.matching_picture((50, 100, 480, 177), pictures)[2] == 'a.png'     # 5.6 : 1
+    assert report_text.matching_picture((50, 300, 480, 452), pictures)[2] == 'b.png'     # 2.8 : 1
+    assert report_text.matching_picture((50, 300, 100, 450), pictures) is None           # a tall one: none
+    assert report_text.matching_picture((0, 0, 10, 10), []) is None
 
 
 def test_a_files_kind_is_read_from_its_bytes_not_its_name(tmp_path):
@@ -80,18 +80,18 @@ def test_a_files_kind_is_read_from_its_bytes_not_its_name(tmp_path):
         zf.writestr('content.xml', '<x/>')
     with zipfile.ZipFile(str(tmp_path / 'exam.zip'), 'w') as zf:
         zf.writestr('exam/package.xml', '<package/>')
-    kinds = {name: reader.kind_of(str(tmp_path / name)) for name in sorted(os.listdir(str(tmp_path)))}
+    kinds = {name: report_files.kind_of(str(tmp_path / name)) for name in sorted(os.listdir(str(tmp_path)))}
     assert kinds == {'exam.zip': 'other', 'looks.pdf': 'image', 'notes.rtf': 'rtf', 'rapport.zip': 'odt',
                      'report.pdf': 'pdf'}
-    assert reader.kind_of(os.path.join(DATA, 'en_docx_table.docx')) == 'docx'
-    assert reader.kind_of(os.path.join(DATA, 'fr_odt.odt')) == 'odt'
+    assert report_files.kind_of(os.path.join(DATA, 'en_docx_table.docx')) == 'docx'
+    assert report_files.kind_of(os.path.join(DATA, 'fr_odt.odt')) == 'odt'
 
 
 def test_a_copys_name_is_safe_and_keeps_the_students_name():
-    assert reader.copy_name(0, 'Jeanne Martin_12_assignsubmission_file_rapport.pdf') == \
+    assert report_files.copy_name(0, 'Jeanne Martin_12_assignsubmission_file_rapport.pdf') == \
         '1-Jeanne Martin_12_assignsubmission_file_rapport.pdf'
-    assert reader.copy_name(2, 'exam.zip/exam/../é$(rm).pdf') == '3-___rm_.pdf'
-    assert reader.copy_name(1, '...') == '2-report'
+    assert report_files.copy_name(2, 'exam.zip/exam/../é$(rm).pdf') == '3-___rm_.pdf'
+    assert report_files.copy_name(1, '...') == '2-report'
 
 
 def test_reports_are_found_in_the_folder_and_in_its_archives_the_same_bytes_once(tmp_path):
@@ -106,10 +106,10 @@ def test_reports_are_found_in_the_folder_and_in_its_archives_the_same_bytes_once
         zf.writestr('exam/doc/annexe.docx', open(os.path.join(DATA, 'en_docx_table.docx'), 'rb').read())
         zf.writestr('exam/doc/figure.png', b'\x89PNG\r\n\x1a\n')  # a picture of the package: not a report
     notes = []
-    found = reader.find_reports(str(folder), str(tmp_path / 'scratch'), notes)
+    found = report_files.find_reports(str(folder), str(tmp_path / 'scratch'), notes)
     assert [name for name, _ in found] == ['capture.png', 'rapport.pdf', 'exam.zip/exam/doc/annexe.docx']
     assert notes == ["'exam.zip/exam/rapport.pdf': the same file as 'rapport.pdf', read once"]
-    alone = reader.find_reports(str(folder / 'rapport.pdf'), str(tmp_path / 'scratch2'), [])
+    alone = report_files.find_reports(str(folder / 'rapport.pdf'), str(tmp_path / 'scratch2'), [])
     assert [name for name, _ in alone] == ['rapport.pdf']
 
 

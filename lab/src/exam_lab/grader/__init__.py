@@ -13,7 +13,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.boxed.derive` (which launch file and threshold are run; the derived launch files the grader
   runs), :mod:`~.boxed.documents` (participant number, PDF
   reports), :mod:`~.boxed.report_reader` (the student's report read: text layer, OCR; converted by
-  LibreOffice), :mod:`~.boxed.report_images` (its pictures prepared for OCR, PIL),
+  LibreOffice), :mod:`~.boxed.report_files` (which files are the report, of what kind),
+  :mod:`~.boxed.report_text` (its text: lines, OCR words, underscores, pictures' places),
+  :mod:`~.boxed.report_images` (its pictures prepared for OCR, PIL),
   :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own),
   :mod:`~.boxed.bounds` (what a box puts into its record, cut to the record's caps with a sentence).
 - ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`

@@ -32,29 +32,24 @@ the files it names in ``/box/out/report/``. What it reads:
 No rospy, nothing of root's. Not PyMuPDF (AGPL): poppler, tesseract and PIL only.
 """
 import argparse
-import collections
 import concurrent.futures
-import hashlib
 import os
 import re
 import shutil
 import subprocess
 import sys
 import time
-import xml.etree.ElementTree as ET
-import zipfile
 
 from exam_lab.grader.boxed import archives, bounds
+from exam_lab.grader.boxed.report_files import FILE_BYTES, find_reports, kind_of, copy_name
+from exam_lab.grader.boxed.report_text import ToolFailed, matching_picture, merge_pictures, ocr_facts, \
+    parse_bbox, parse_tsv, join_underscores, records_clean, words_text
 from exam_lab.grader.score import records
-from exam_lab.grader.score.records import REPORT_FILE_PAGES, REPORT_FILES, REPORT_PAGE_TEXT, REPORT_PAGES, \
-    REPORT_UNSURE, REPORT_VERSION, ReportRecord
+from exam_lab.grader.score.records import REPORT_FILE_PAGES, REPORT_PAGE_TEXT, REPORT_PAGES, REPORT_VERSION, \
+    ReportRecord
 
 #: The reading's own time (the box's wall clock is a little more): pages past it are said, not read.
 SECONDS = 120.0
-#: Bytes of one file read as a report; how deep in the folder and in archives reports are looked for.
-FILE_BYTES = 50 << 20
-MAX_DEPTH = 4
-MAX_NESTING = 2
 #: A page larger than this (points, either side: 200 inches) is not rendered.
 MAX_PAGE_POINTS = 14400
 #: Pixels of the longest side: a page's PNG for the review page; a page rendered for OCR (about 300 dpi
@@ -64,14 +59,9 @@ OCR_PIXELS = 2500
 MAX_PICTURE_PIXELS = 40 * 1000 * 1000
 #: A page whose text layer holds fewer letters and digits than this is read by OCR.
 MIN_TEXT = 20
-#: Under this confidence (tesseract's 0-100), an OCR word is listed as unsure.
-CONFIDENCE_FLOOR = 60
 #: Each tool's bounds inside the box: (wall clock s, address space bytes).
 TOOL_BOUNDS = {'pdfinfo': (20, 1 << 30), 'pdftotext': (60, 1 << 30), 'pdfimages': (20, 1 << 30),
                'pdftoppm': (60, 1536 << 20), 'tesseract': (60, 1536 << 20), 'soffice': (90, 3 << 30)}
-#: Report files by their name's ending: a document in an archive; a picture only at the folder's top.
-DOCUMENT_ENDINGS = ('.pdf', '.odt', '.docx', '.doc', '.rtf')
-PICTURE_ENDINGS = ('.png', '.jpg', '.jpeg')
 #: A picture of a text page is read when it covers at least this (inches, both sides) and this share
 #: of its cells holds ink.
 MIN_PICTURE_INCHES = (0.8, 0.25)
@@ -79,109 +69,9 @@ MIN_PICTURE_INK = 0.2
 _CELL = 8  # pixels of the page's PNG per cell of the ink grid
 
 
-class ToolFailed(Exception):
-    """A tool that failed, or was killed by its bounds: the message is for the teacher."""
-
-
-def kind_of(path):
-    """The kind of a file, from its first bytes: one of records.REPORT_KINDS."""
-    try:
-        with open(path, 'rb') as f:
-            head = f.read(1024)
-    except OSError:
-        return 'other'
-    if head.startswith(b'\x89PNG\r\n\x1a\n') or head.startswith(b'\xff\xd8\xff'):
-        return 'image'
-    if head.startswith(b'{\\rtf'):
-        return 'rtf'
-    if head.startswith(b'\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1'):
-        return 'doc'
-    if head.startswith(b'PK\x03\x04'):
-        try:
-            with zipfile.ZipFile(path) as zf:
-                names = set(zf.namelist()[:1000])
-                if 'word/document.xml' in names:
-                    return 'docx'
-                if 'mimetype' in names and zf.read('mimetype')[:100].startswith(b'application/vnd.oasis.opendocument.text'):
-                    return 'odt'
-        except (zipfile.BadZipFile, OSError, KeyError, RuntimeError, NotImplementedError, EOFError):
-            pass
-        return 'other'  # a zip holding a PDF stored as is holds "%PDF-" too: an archive, searched
-    if b'%PDF-' in head:  # (a PDF may start with up to 1 kB of anything)
-        return 'pdf'
-    return 'other'
-
-
-def copy_name(index, name):
-    """The name of a file's copy in report/: its index and its own name, of safe characters only."""
-    base = re.sub(r'[^A-Za-z0-9._ -]', '_', os.path.basename(name)).strip(' .') or 'report'
-    return '%d-%s' % (index + 1, base[-150:])
-
-
-def find_reports(upload, scratch, notes):
-    """``[(name as the teacher knows it, path)]`` of the report files of a submission (a folder, or
-    one file: a document, a picture, an archive): its own files first, then the documents of its
-    archives (unpacked below ``scratch``, all within one budget), the same bytes once."""
-    budget, found, seen = archives.Budget(), [], {}
-    counter = [0]
-
-    def look(root, shown, nesting, pictures):
-        if os.path.isfile(root):
-            entries = [(root, shown)]
-        else:
-            entries = []
-            for dirpath, dirnames, filenames in os.walk(root):
-                depth = os.path.relpath(dirpath, root).count(os.sep)
-                dirnames[:] = sorted(d for d in dirnames if d not in archives.SKIPPED_DIRS and not d.startswith('.')
-                                     and not os.path.islink(os.path.join(dirpath, d))) if depth < MAX_DEPTH else []
-                for name in sorted(filenames):
-                    full = os.path.join(dirpath, name)
-                    if not os.path.islink(full) and os.path.isfile(full) and not name.startswith('.'):
-                        rel = os.path.relpath(full, root)
-                        entries.append((full, rel if shown is None else '%s/%s' % (shown, rel)))
-        inner = []
-        for full, name in entries:
-            lower = name.lower()
-            kind = kind_of(full)
-            if kind in ('pdf', 'odt', 'docx', 'doc', 'rtf') or lower.endswith(DOCUMENT_ENDINGS) or \
-                    (pictures and (kind == 'image' or lower.endswith(PICTURE_ENDINGS))):
-                found.append((name, full))
-            elif nesting < MAX_NESTING and kind == 'other' and archives.archive_kind(full):
-                inner.append((full, name))
-        for full, name in inner:
-            target = os.path.join(scratch, 'unpacked%d' % counter[0])
-            counter[0] += 1
-            try:
-                archives.safe_extract(full, target, budget=budget, notes=[], fixes=[])
-            except archives.UnpackError as err:
-                notes.append('%s: not searched for a report (%s)' % (archives.shown_name(name), err))
-                continue
-            look(target, name, nesting + 1, False)
-    look(upload, os.path.basename(upload) if os.path.isfile(upload) else None, 0, True)
-    unique = []
-    for name, full in found:
-        digest = _digest(full)
-        if digest is not None and digest in seen:
-            notes.append('%s: the same file as %s, read once' % (archives.shown_name(name), archives.shown_name(seen[digest])))
-            continue
-        seen[digest] = name
-        unique.append((name, full))
-    if len(unique) > REPORT_FILES:
-        notes.append('%d report files (at most %d): the first %d are read' % (len(unique), REPORT_FILES, REPORT_FILES))
-    return unique[:REPORT_FILES]
-
-
-def _digest(path):
-    try:
-        with open(path, 'rb') as f:
-            return hashlib.sha256(f.read(FILE_BYTES + 1)).hexdigest()
-    except OSError:
-        return None
-
-
-class Reader(object):
-    """One submission's report read into ``out`` (``out/report/``: the copies and the pages' PNGs;
-    ``out/scratch/``: conversions and renderings), within ``seconds``."""
+class Tools(object):
+    """The reading's folders (``out/report/``: the copies and the pages' PNGs; ``out/scratch/``:
+    conversions and renderings), its time (``seconds``) and its tools, each run within its bounds."""
 
     def __init__(self, out, seconds=SECONDS, workers=None):
         self.out, self.deadline = out, time.monotonic() + seconds
@@ -223,94 +113,9 @@ class Reader(object):
                                           'failed (exit %d)' % done.returncode, ': %s' % last[0][:300] if last else ''))
         return None if output else done.stdout[:16 << 20].decode('utf-8', 'replace')
 
-    def read(self, upload):
-        """The record's value of the reports in ``upload``."""
-        files, pages = [], []
-        found = find_reports(upload, self.scratch, self.notes)
-        if not found:
-            return self.value('no report handed in (no PDF, no document, no picture among the files)', files, pages)
-        for index, (name, path) in enumerate(found):
-            entry = {'name': bounds.cut(name, 255), 'kind': kind_of(path), 'converted': False, 'pages': 0, 'note': '',
-                     'state': 'not read', 'copy': None}
-            files.append(entry)
-            try:
-                size = os.path.getsize(path)
-                if size > FILE_BYTES:
-                    raise ToolFailed('%d MB (the reader reads at most %d MB)' % (size >> 20, FILE_BYTES >> 20))
-                entry['copy'] = self.keep(index, name, path)
-                read = self.read_file(index, entry, path, REPORT_PAGES - len(pages))
-            except ToolFailed as err:
-                entry['note'] = bounds.cut('%s: %s' % (archives.shown_name(name), err))
-                continue
-            pages.extend(read)
-            entry['pages'] = len(read)
-            if any(p['text'].strip() for p in read):
-                entry['state'] = 'read'
-            else:
-                entry['note'] = entry['note'] or '%s: no text and no picture the reader can read' % archives.shown_name(name)
-        if any(f['state'] == 'read' for f in files):
-            return self.value('', files, [p for p in pages if files[p['file']]['state'] == 'read'])
-        why = '; '.join(f['note'] for f in files if f['note']) or 'nothing could be read'
-        return self.value(bounds.cut(why), files, [])
 
-    def value(self, why, files, pages):
-        return {'version': REPORT_VERSION, 'state': 'read' if pages else 'not read', 'why': why if not pages else '',
-                'files': files, 'pages': pages, 'notes': self.notes, 'seconds': 0.0}
-
-    def keep(self, index, name, path):
-        """The file as handed in, copied to report/ (root copies it to OUT read-only)."""
-        copy = copy_name(index, name)
-        shutil.copyfile(path, os.path.join(self.report, copy))
-        return 'report/' + copy
-
-    def read_file(self, index, entry, path, room):
-        kind = entry['kind']
-        if kind in ('odt', 'docx', 'doc', 'rtf'):
-            path = self.convert(index, path)
-            entry['converted'] = True
-        elif kind == 'image':
-            return [self.read_picture(index, path)]
-        elif kind != 'pdf':
-            raise ToolFailed('not a PDF, a document or a picture the reader reads (a report is read from a PDF)')
-        info = self.pdf_info(path)
-        count = info['pages']
-        if count > REPORT_FILE_PAGES:
-            raise ToolFailed('%d pages, the reader reads %d' % (count, REPORT_FILE_PAGES))
-        if count > room:
-            self.notes.append('%s: pages %d-%d not read (the report\'s %d pages are read at most)'
-                              % (archives.shown_name(entry['name']), room + 1, count, REPORT_PAGES))
-            count = room
-        return self.read_pdf(index, path, count, info)
-
-    def convert(self, index, path):
-        """``path`` made a PDF by LibreOffice headless (its profile in the box's /tmp)."""
-        target = os.path.join(self.scratch, 'converted%d' % index)
-        os.makedirs(target)
-        source = os.path.join(target, 'report%s' % {'odt': '.odt', 'docx': '.docx', 'doc': '.doc', 'rtf': '.rtf'}
-                              [kind_of(path)])
-        shutil.copyfile(path, source)
-        self.tool('soffice', ['--headless', '--norestore', '--nolockcheck',
-                              '-env:UserInstallation=file://%s/lo-profile' % self.scratch,
-                              '--convert-to', 'pdf', '--outdir', target, source], what='LibreOffice\'s conversion to PDF')
-        pdf = os.path.join(target, 'report.pdf')
-        if not os.path.isfile(pdf):
-            raise ToolFailed('LibreOffice made no PDF of it')
-        return pdf
-
-    def pdf_info(self, path):
-        """``{"pages", "sizes": {page: (w, h) points}}``; ToolFailed for an encrypted or broken PDF."""
-        try:
-            text = self.tool('pdfinfo', ['-f', '1', '-l', str(REPORT_FILE_PAGES + 1), path])
-        except ToolFailed as err:
-            if 'password' in str(err).lower():
-                raise ToolFailed('an encrypted PDF (it opens with a password): ask for it without one')
-            raise ToolFailed('a broken PDF (%s)' % err)
-        pages = re.search(r'^Pages:\s+(\d+)', text, re.M)
-        if not pages:
-            raise ToolFailed('a broken PDF (no page count)')
-        sizes = {int(n): (float(w), float(h)) for n, w, h in
-                 re.findall(r'^Page\s+(\d+) size:\s+([\d.]+) x ([\d.]+)', text, re.M)}
-        return {'pages': int(pages.group(1)), 'sizes': sizes}
+class Pages(object):
+    """A PDF's pages: its text layer, its pictures, its pages' PNGs."""
 
     def read_pdf(self, index, path, count, info):
         """The pages of one PDF: the text layer, the pages' PNGs, OCR where there is no text."""
@@ -412,6 +217,10 @@ class Reader(object):
                 done[number] = 'report/' + target
         return done
 
+
+class Ocr(object):
+    """What tesseract reads: a page without text, the pictures of a text page, a picture handed in."""
+
     def ocr_page(self, path, info, page, lines, pictures=()):
         """OCR of a page without text (``lines`` None), or of the pictures of a text page, each where it
         stands (:func:`~exam_lab.grader.boxed.report_images.picture_regions`): read from the picture
@@ -483,124 +292,97 @@ class Reader(object):
                      'layout': '', 'pictures': 0, 'image': 'report/' + target}, **ocr_facts(words))
 
 
-def records_clean(text):
-    """A page's text without control characters (the form feed of a page's end among them)."""
-    from exam_lab.grader.score.safe_text import clean
-    return clean(text.replace('\f', '')).strip('\n')
+class Reader(Pages, Ocr, Tools):
+    """One submission's report read into ``out`` within ``seconds``."""
 
+    def read(self, upload):
+        """The record's value of the reports in ``upload``."""
+        files, pages = [], []
+        found = find_reports(upload, self.scratch, self.notes)
+        if not found:
+            return self.value('no report handed in (no PDF, no document, no picture among the files)', files, pages)
+        for index, (name, path) in enumerate(found):
+            entry = {'name': bounds.cut(name, 255), 'kind': kind_of(path), 'converted': False, 'pages': 0, 'note': '',
+                     'state': 'not read', 'copy': None}
+            files.append(entry)
+            try:
+                size = os.path.getsize(path)
+                if size > FILE_BYTES:
+                    raise ToolFailed('%d MB (the reader reads at most %d MB)' % (size >> 20, FILE_BYTES >> 20))
+                entry['copy'] = self.keep(index, name, path)
+                read = self.read_file(index, entry, path, REPORT_PAGES - len(pages))
+            except ToolFailed as err:
+                entry['note'] = bounds.cut('%s: %s' % (archives.shown_name(name), err))
+                continue
+            pages.extend(read)
+            entry['pages'] = len(read)
+            if any(p['text'].strip() for p in read):
+                entry['state'] = 'read'
+            else:
+                entry['note'] = entry['note'] or '%s: no text and no picture the reader can read' % archives.shown_name(name)
+        if any(f['state'] == 'read' for f in files):
+            return self.value('', files, [p for p in pages if files[p['file']]['state'] == 'read'])
+        why = '; '.join(f['note'] for f in files if f['note']) or 'nothing could be read'
+        return self.value(bounds.cut(why), files, [])
 
-def parse_bbox(path):
-    """The lines of ``pdftotext -bbox-layout``'s XHTML (see :meth:`Reader.word_boxes`), each page's
-    flows and blocks in their order."""
-    try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError) as err:
-        raise ToolFailed('its text layer could not be read (%s)' % err)
-    pages = {}
-    for number, page in enumerate(root.iter('{http://www.w3.org/1999/xhtml}page'), 1):
-        lines = []
-        for line in page.iter('{http://www.w3.org/1999/xhtml}line'):
-            words = [(w.text or '', tuple(float(w.get(k, 0)) for k in ('xMin', 'yMin', 'xMax', 'yMax')))
-                     for w in line.iter('{http://www.w3.org/1999/xhtml}word')]
-            if words:
-                lines.append({'text': ' '.join(t for t, _ in words), 'top': float(line.get('yMin', 0)),
-                              'bottom': float(line.get('yMax', 0)), 'boxes': [b for _, b in words]})
-        pages[number] = lines
-    return pages
+    def value(self, why, files, pages):
+        return {'version': REPORT_VERSION, 'state': 'read' if pages else 'not read', 'why': why if not pages else '',
+                'files': files, 'pages': pages, 'notes': self.notes, 'seconds': 0.0}
 
+    def keep(self, index, name, path):
+        """The file as handed in, copied to report/ (root copies it to OUT read-only)."""
+        copy = copy_name(index, name)
+        shutil.copyfile(path, os.path.join(self.report, copy))
+        return 'report/' + copy
 
-#: One word of tesseract's: where it is in its block, paragraph and line, its text, its confidence, its
-#: box ``(left, top, width, height)`` in the image's pixels.
-Word = collections.namedtuple('Word', 'block paragraph line text confidence box')
+    def read_file(self, index, entry, path, room):
+        kind = entry['kind']
+        if kind in ('odt', 'docx', 'doc', 'rtf'):
+            path = self.convert(index, path)
+            entry['converted'] = True
+        elif kind == 'image':
+            return [self.read_picture(index, path)]
+        elif kind != 'pdf':
+            raise ToolFailed('not a PDF, a document or a picture the reader reads (a report is read from a PDF)')
+        info = self.pdf_info(path)
+        count = info['pages']
+        if count > REPORT_FILE_PAGES:
+            raise ToolFailed('%d pages, the reader reads %d' % (count, REPORT_FILE_PAGES))
+        if count > room:
+            self.notes.append('%s: pages %d-%d not read (the report\'s %d pages are read at most)'
+                              % (archives.shown_name(entry['name']), room + 1, count, REPORT_PAGES))
+            count = room
+        return self.read_pdf(index, path, count, info)
 
+    def convert(self, index, path):
+        """``path`` made a PDF by LibreOffice headless (its profile in the box's /tmp)."""
+        target = os.path.join(self.scratch, 'converted%d' % index)
+        os.makedirs(target)
+        source = os.path.join(target, 'report%s' % {'odt': '.odt', 'docx': '.docx', 'doc': '.doc', 'rtf': '.rtf'}
+                              [kind_of(path)])
+        shutil.copyfile(path, source)
+        self.tool('soffice', ['--headless', '--norestore', '--nolockcheck',
+                              '-env:UserInstallation=file://%s/lo-profile' % self.scratch,
+                              '--convert-to', 'pdf', '--outdir', target, source], what='LibreOffice\'s conversion to PDF')
+        pdf = os.path.join(target, 'report.pdf')
+        if not os.path.isfile(pdf):
+            raise ToolFailed('LibreOffice made no PDF of it')
+        return pdf
 
-def parse_tsv(tsv):
-    """tesseract's TSV: its words (:data:`Word`), in its order."""
-    words = []
-    for row in tsv.splitlines()[1:]:
-        fields = row.split('\t')
-        if len(fields) < 12 or fields[0] != '5':
-            continue
+    def pdf_info(self, path):
+        """``{"pages", "sizes": {page: (w, h) points}}``; ToolFailed for an encrypted or broken PDF."""
         try:
-            confidence = float(fields[10])
-            box = tuple(int(v) for v in fields[6:10])
-            where = tuple(int(v) for v in fields[2:5])
-        except ValueError:
-            continue
-        text = fields[11].strip()
-        if text and confidence >= 0:
-            words.append(Word(where[0], where[1], where[2], text, min(100.0, confidence), box))
-    return words
-
-
-def join_underscores(words, underscore):
-    """``words`` with each pair of neighbours on a line that ``underscore(left box, right box)`` says are
-    joined by an underscore (tesseract drops the underscores of ``/pressure_remote``: it reads
-    ``/pressure remote``) made one word, ``pressure_remote``."""
-    out = []
-    for word in words:
-        last = out[-1] if out else None
-        if last is not None and last[:3] == word[:3] and underscore(last.box, word.box):
-            left, top = min(last.box[0], word.box[0]), min(last.box[1], word.box[1])
-            right = max(last.box[0] + last.box[2], word.box[0] + word.box[2])
-            bottom = max(last.box[1] + last.box[3], word.box[1] + word.box[3])
-            out[-1] = last._replace(text=last.text.rstrip('_') + '_' + word.text.lstrip('_'),
-                                    confidence=min(last.confidence, word.confidence),
-                                    box=(left, top, right - left, bottom - top))
-        else:
-            out.append(word)
-    return out
-
-
-def words_text(words):
-    """The words as lines (a line of tesseract's a line of text), paragraphs apart by a blank line."""
-    out, last = [], None
-    for word in words:
-        key, text = tuple(word[:3]), word.text
-        if last is None:
-            out.append(text)
-        elif key == last:
-            out[-1] += ' ' + text
-        else:
-            out.append(('\n' if key[:2] != last[:2] else '') + text)
-        last = key
-    return '\n'.join(out)
-
-
-def ocr_facts(words):
-    """``{"confidence", "unsure"}`` of OCR words: their mean confidence, those under the floor."""
-    if not words:
-        return {'confidence': None, 'unsure': []}
-    unsure, seen = [], set()
-    for text, confidence in ((w.text, w.confidence) for w in words):
-        if confidence < CONFIDENCE_FLOOR and text not in seen and len(unsure) < REPORT_UNSURE:
-            seen.add(text)
-            unsure.append(bounds.cut(records_clean(text), 100))
-    return {'confidence': round(sum(w.confidence for w in words) / len(words), 1), 'unsure': unsure}
-
-
-def matching_picture(region, pictures):
-    """The one of ``pictures`` (``(width, height, file)``) whose shape is the ``region``'s (within 25%),
-    the closest; None when none is."""
-    x0, y0, x1, y1 = region
-    wanted = (x1 - x0) / max(1e-6, y1 - y0)
-    best = min(pictures, key=lambda p: abs(p[0] / float(p[1]) / wanted - 1), default=None)
-    return best if best is not None and abs(best[0] / float(best[1]) / wanted - 1) <= 0.25 else None
-
-
-def merge_pictures(lines, blocks):
-    """The page's text with each picture's OCR (``[(top in points, text)]``) put before the first line
-    of the text layer below the picture's top, between ``[picture N, OCR]`` and ``[end of picture N]``."""
-    blocks = sorted(blocks)
-    out, n = [], 0
-    for line in lines:
-        while n < len(blocks) and blocks[n][0] <= line['top']:
-            out.append('[picture %d, OCR]\n%s\n[end of picture %d]' % (n + 1, blocks[n][1], n + 1))
-            n += 1
-        out.append(line['text'])
-    for k in range(n, len(blocks)):
-        out.append('[picture %d, OCR]\n%s\n[end of picture %d]' % (k + 1, blocks[k][1], k + 1))
-    return '\n'.join(out)
+            text = self.tool('pdfinfo', ['-f', '1', '-l', str(REPORT_FILE_PAGES + 1), path])
+        except ToolFailed as err:
+            if 'password' in str(err).lower():
+                raise ToolFailed('an encrypted PDF (it opens with a password): ask for it without one')
+            raise ToolFailed('a broken PDF (%s)' % err)
+        pages = re.search(r'^Pages:\s+(\d+)', text, re.M)
+        if not pages:
+            raise ToolFailed('a broken PDF (no page count)')
+        sizes = {int(n): (float(w), float(h)) for n, w, h in
+                 re.findall(r'^Page\s+(\d+) size:\s+([\d.]+) x ([\d.]+)', text, re.M)}
+        return {'pages': int(pages.group(1)), 'sizes': sizes}
 
 
 def main(argv=None):
