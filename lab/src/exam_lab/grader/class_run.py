@@ -9,7 +9,7 @@ import re
 import shutil
 
 from exam_lab.grader import contract, runner
-from exam_lab.grader.host import classfolder, sandbox, similarity_setup, staging
+from exam_lab.grader.host import classfolder, reports, sandbox, similarity_setup, staging
 from exam_lab.grader.host.boxed_run import INTAKE_BOUNDS, SIMILARITY_BOUNDS, Boxed, InspectionFailed
 from exam_lab.grader.host.underlay import default_underlay, ensure_underlay
 from exam_lab.grader.host.bwrap import can_isolate
@@ -190,6 +190,8 @@ def _refused_at_intake(name, folder, out_dir, sheet, why):
                 'extra': {'participant': identity.participant_number(folder_name), 'folder': folder_name,
                           'documents': [], 'seconds': 0.0}}
     contract.make_folder(out_dir)
+    reports.write(out_dir, records.ReportRecord.not_read(schema.cut('the class\'s intake refused this student\'s '
+                                                                     'files: %s' % why)))
     return grades.keep_and_score(out_dir, measured)
 
 

@@ -195,6 +195,36 @@ def copy_results(source, target, suffixes=('.log', '.json', '.md'), part=LOG_PAR
     return skipped
 
 
+def copy_tree(source, target, max_files, max_bytes):
+    """Copy a box's folder ``source`` to the new folder ``target``: its folders and regular files, each
+    read by :func:`read_bytes`, at most ``max_files`` files and ``max_bytes`` in all; links, FIFOs,
+    devices and files past the caps are left out. Returns the relative names left out."""
+    skipped, budget = [], {'files': max_files, 'bytes': max_bytes}
+    os.makedirs(target)
+    for dirpath, dirnames, filenames in os.walk(source):
+        rel = os.path.relpath(dirpath, source)
+        for name in sorted(dirnames):
+            if os.path.islink(os.path.join(dirpath, name)) or '\n' in name:
+                skipped.append(os.path.normpath(os.path.join(rel, name)))
+                dirnames.remove(name)
+            else:
+                os.mkdir(os.path.join(target, rel, name))
+        dirnames.sort()
+        for name in sorted(filenames):
+            shown = os.path.normpath(os.path.join(rel, name))
+            try:
+                if budget['files'] <= 0 or '\n' in name:
+                    raise ContractError(shown)
+                data = read_bytes(os.path.join(dirpath, name), budget['bytes'])
+            except ContractError:
+                skipped.append(shown)
+                continue
+            budget['files'] -= 1
+            budget['bytes'] -= len(data)
+            write_bytes(os.path.join(target, rel, name), data)
+    return skipped
+
+
 def folders(out):
     """The names of the folders in ``out``, sorted: real folders only (a link, even to a folder, is
     none); the folders a reader of OUT takes students from."""

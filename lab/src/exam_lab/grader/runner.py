@@ -44,7 +44,7 @@ import sys
 import time
 
 from exam_lab.grader import contract
-from exam_lab.grader.host import bwrap, limits, sandbox, staging
+from exam_lab.grader.host import bwrap, limits, reports, sandbox, staging
 from exam_lab.grader.host.boxed_run import INSPECT_BOUNDS, Boxed, InspectionFailed, session_tail
 from exam_lab.grader.host.bwrap import can_isolate
 from exam_lab.grader.host.session import budget_sentence
@@ -52,7 +52,7 @@ from exam_lab.grader.host.underlay import box_binds, default_underlay, ensure_un
 from exam_lab.grader.publish import grades, progress, teacher
 from exam_lab.grader.score import identity, records
 from exam_lab.grader.score.records import Outcome
-from exam_lab.grader.score.boxenv import BOX_WS
+from exam_lab.grader.score.boxenv import BOX_WS, CODE_COPY
 from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, SHEETS, margin_of
 from exam_lab.harness.supervisor import Supervisor, end_pids, marked
 
@@ -111,6 +111,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                 facts, comments = dict(found.facts, participant=facts['participant'], folder=facts['folder']), found.comments
                 if found.refused is not None:
                     raise records.UnpackError(found.refused)
+                notes.extend(reports.keep_code(os.path.join(work, 'out', CODE_COPY), out_dir))
                 chosen_sheet, static = found.sheet, found.static
                 job = plan_job(found)
                 if job is None:
@@ -131,6 +132,9 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
             session = grades.no_session(Outcome.GRADER_FAILED, 'the grader failed on this submission: %r' % err)
             notes.append(grades.bug_note())
         notes.extend(keep_logs(work, out_dir))
+        # The report, read after the flights in a box of its own: its time is not the student's budget.
+        progress.report(on_step, 'report')
+        reports.read_report(submission, out_dir, jobs=jobs)
         measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session.value,
                     'notes': notes, 'fixes': fixes, 'comments': comments, 'isolate': isolate, 'how_run': how_run,
                     'extra': dict(facts, **dict(extra or {}, seconds=round(time.monotonic() - start, 1)))}

@@ -7,6 +7,8 @@ files as the box's uid ahead of the run (a ``$(env HOME)`` there is the box's:
 #: Where the box sees its workspace, and its private HOME.
 BOX_WS = '/box/ws'
 BOX_HOME = '/box/home'
+#: The inspection's copy of the package as handed in (in its box's output), kept by root as OUT's code/.
+CODE_COPY = 'code'
 #: Variables of a box's environment, besides ROS_* and those a sourced workspace sets.
 PASSED = ('PATH', 'LANG', 'LC_ALL', 'PYTHONUNBUFFERED', 'PYTHONDONTWRITEBYTECODE')
 #: PATH entries a box keeps (the system's, ROS's, the workspace's): none of the grading user's own.
