@@ -223,7 +223,7 @@ def test_jobs_default_from_the_cores_the_memory_and_the_cpu_a_grading_takes():
     never 0; a grading that costs twice the CPU halves it."""
     from exam_lab.grader import class_run
     gib = 1 << 30
-    assert class_run.default_jobs(cores=2, memory=24 * gib) == 5  # 2 x 0.75 x 50.2 / 13.2 = 5.7
+    assert class_run.default_jobs(cores=2, memory=24 * gib) == 4  # 2 x 0.6 x 50.2 / 13.2 = 4.6
     assert class_run.default_jobs(cores=2, memory=24 * gib, cpu=2 * class_run.GRADING_CPU_S) == 2
     assert class_run.default_jobs(cores=2, memory=24 * gib, cpu=1.0, wall=100.0) == 24  # the memory's 24 GB
     assert class_run.default_jobs(cores=16, memory=8 * gib) == 8

@@ -160,6 +160,6 @@ def test_a_class_of_60_at_the_default_jobs_ends_within_75_minutes():
     """Every student at its budget: ceil(60 / JOBS) gradings in sequence, each at most its budget and
     what follows it."""
     jobs = class_run.default_jobs(cores=2, memory=64 << 30)
-    assert jobs == 5
+    assert jobs == 4
     assert class_run.worst_case(60, jobs) <= 75 * 60
-    assert class_run.worst_case(60, jobs) == math.ceil(60 / 5) * (runner.STUDENT_BUDGET + runner.AFTER_BUDGET_S)
+    assert class_run.worst_case(60, jobs) == math.ceil(60 / 4) * (runner.STUDENT_BUDGET + runner.AFTER_BUDGET_S)

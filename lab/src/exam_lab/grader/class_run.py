@@ -26,8 +26,10 @@ GRADING_CPU_S = 13.2
 GRADING_WALL_S = 50.2
 #: The part of the cores the default JOBS fills on average: what is left absorbs the bursts (two
 #: roslaunch starts at once, a build) so that no flight's node is starved; each box is held to
-#: cores/JOBS besides, and the judge outweighs it.
-CPU_SHARE = 0.75
+#: cores/JOBS besides, and the judge outweighs it. Measured 2026-12-01, classes of 12 on two cores
+#: shared with other work: JOBS=4 (60 %) kept every point at a load average of 7 to 22; JOBS=5 (75 %)
+#: lost 8 of 12 nodes' starts (not registered within START_TIMEOUT) at a load of 40.
+CPU_SHARE = 0.6
 #: Memory one grading is counted for when JOBS is not given: its processes use a few hundred MB (the
 #: bounds are higher: each box 2 GB, each master 384 MB, each probe 512 MB).
 JOB_MEMORY_BYTES = 1 << 30
