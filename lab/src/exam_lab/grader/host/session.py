@@ -22,15 +22,18 @@ Job (JSON, written by :mod:`exam_lab.grader.runner`): ``workspace`` (the student
 the box sees it), ``box`` (:meth:`~exam_lab.grader.host.sandbox.Box.describe`), ``underlay`` (setup.bash of
 the simulators' workspace), ``log_dir``, ``namespace`` (the drone's), ``build_timeout`` /
 ``run_timeout`` (s), ``budget`` (s the session may take, what is left of ``student_budget``, the
-student's whole grading: :class:`Budget`), ``judge_home`` (the judge's folder), ``runs``: the main run and, when the launch
+student's whole grading: :class:`~exam_lab.grader.host.run.Budget`), ``judge_home`` (the judge's folder), ``runs``: the main run and, when the launch
 file has a threshold the grader can change, the threshold run: each ``{"tag", "launch" (derived launch
-file, as the box sees it), "plan" (for the probe)}``. Writes ``<log_dir>/session.json``: ``{"build":
+file, as the box sees it), "plan" (for the probe)}`` (and, for the run flown in the submission's second
+box, its ``box`` and ``judge_home``), ``side_by_side`` (the two runs at once:
+:mod:`~exam_lab.grader.host.side_by_side`; otherwise one after the other, here). Writes ``<log_dir>/session.json``: ``{"build":
 {...}, "runs": [{"tag", "probe" (the probe's result or None), "probe_refused" (why a result was
 refused), "master" (its memory, its uid), "probe_uid", "launch": {...}}], "survivors": n, "launch_check",
 "budget_used" (the sentence when the budget stopped a step, else None), "outcome"}``: a
 :class:`~exam_lab.grader.score.records.SessionRecord` (checked, every text in it made safe there), and
 each probe's result as ``<log_dir>/probe-<tag>.json`` (its checked record; a result refused for its
-times or the master is kept in the run as ``refused_probe``).
+times or the master is kept in the run as ``refused_probe``), and each step's wall and CPU time as
+``<log_dir>/timings.json`` (:mod:`~exam_lab.grader.host.timings`).
 """
 import json
 import os
