@@ -6,6 +6,7 @@ import json
 import os
 import subprocess
 
+from exam_lab.grader import runner
 from exam_lab.grader.host import cgroups, side_by_side, timings
 from exam_lab.grader.judge import pilot, probe
 from exam_lab.grader.score import records
@@ -118,3 +119,10 @@ def test_two_supervisors_sharing_a_log_folder_end_their_own_processes_only(tmp_p
         stray.kill()
         stray.wait()
     assert kept.poll() is not None
+
+
+def test_the_two_runs_fly_side_by_side_only_where_the_cpu_allows():
+    """A machine whose load average is at its cores or above flies them one after the other."""
+    assert runner.cpu_allows_two_runs(cores=2, load=0.5)
+    assert not runner.cpu_allows_two_runs(cores=2, load=2.0) and not runner.cpu_allows_two_runs(cores=2, load=18.0)
+    assert runner.cpu_allows_two_runs(cores=16, load=8.0)

@@ -123,7 +123,8 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                     session = grades.no_session(Outcome.NOT_RUN, why, budget_used=why)
                 else:
                     how_run = teacher.how_run(box)
-                    with twin_box(job, work, underlay, box, isolate and side_by_side, jobs) as twin, \
+                    with twin_box(job, work, underlay, box, isolate and side_by_side and cpu_allows_two_runs(),
+                                  jobs) as twin, \
                             watch.stage('session'):
                         session = run_session(job, work=work, underlay=underlay, isolate=isolate, box=box, twin=twin,
                                               on_step=on_step, left=deadline - time.monotonic())
@@ -197,6 +198,16 @@ def plan_job(record):
                      'plan': dict(plan, kind='threshold', threshold=record.threshold_run_value)})
     return records.JobRecord.make({'namespace': record.namespace, 'build_timeout': BUILD_TIMEOUT,
                                    'run_timeout': RUN_TIMEOUT, 'runs': runs, 'handed_in_launch': record.handed_in_launch})
+
+
+def cpu_allows_two_runs(cores=None, load=None):
+    """Whether the machine has the CPU to fly a student's two runs at once: its load average over the
+    last minute (``load``) below its ``cores``. Two runs start two roslaunches at once; on a machine
+    already busy (measured 2026-12-01: a test session's classes at a load of 5 to 18 on two cores) their
+    nodes then missed START_TIMEOUT, so there the runs fly one after the other, as before."""
+    cores = cores or (len(os.sched_getaffinity(0)) if hasattr(os, 'sched_getaffinity') else os.cpu_count() or 1)
+    load = os.getloadavg()[0] if load is None else load
+    return load < cores
 
 
 @contextlib.contextmanager
