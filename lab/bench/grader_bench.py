@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The grader's speed, and whether grading students side by side keeps its timing checks fair.
 
-    python3 lab/bench/grader_bench.py [--students 60] [--jobs 4,6] [--out DIR] [--record]
+    python3 lab/bench/grader_bench.py [--students 60] [--jobs 4,6] [--out DIR] [--record] [--no-alone]
     python3 lab/bench/grader_bench.py --from-results DIR/results.json [--record]
 
 (from the repository, after ``make build`` and ``source tools/env.sh``; about 70 minutes on two cores (67 on 2026-11-27)). A full
@@ -15,6 +15,12 @@
    side: its wall time, and for every student the points and the timings the rubric judges (rate,
    WARNING latency, NORMAL latency) against the same package graded alone.
 
+Each grading times its own stages (``OUT/<student>/logs/timings.json``: :mod:`exam_lab.grader.host.timings`),
+read here, never timed again from outside; the legs' wall times are the probe's schedule
+(``probe-main.json``); while a class is graded, the machine's CPU use is sampled every BUSY_PERIOD_S
+(``/proc/stat``: every process of the machine, the other work's too). ``--no-alone`` skips phase 1 (a
+class measured against another, by the ratio of its stages).
+
 Prints a Markdown section and writes ``results.json`` in --out; ``--record`` also writes the section
 to lab/bench/grader.md, which lab/bench/report.py appends to docs/benchmarks.md ("The grader").
 """
@@ -26,6 +32,7 @@ import resource
 import shutil
 import sys
 import tempfile
+import threading
 import time
 
 from exam_lab.grader import class_run
@@ -84,6 +91,65 @@ def timings(out_dir, student):
     return result
 
 
+#: The legs of the main run, in the order flown (the probe's schedule): each one's wall time.
+LEGS = ('rest', 'short_up', 'short_down', 'long_up', 'long_down', 'deep_down')
+#: Seconds between two samples of the machine's CPU use.
+BUSY_PERIOD_S = 5.0
+
+
+def stage_times(out_dir, student):
+    """One grading's stages as it timed them (``{stage: {"wall", "cpu"}}``, s) with its main run's legs
+    (``leg:<name>``, wall only, from the probe's schedule): {} when it wrote none."""
+    try:
+        with open(os.path.join(out_dir, student, 'logs', 'timings.json')) as f:
+            stages = dict(json.load(f).get('stages') or {})
+    except (OSError, ValueError):
+        return {}
+    try:
+        with open(os.path.join(out_dir, student, 'logs', 'probe-main.json')) as f:
+            schedule = json.load(f).get('schedule') or {}
+    except (OSError, ValueError):
+        schedule = {}
+    ends = LEGS[1:] + ('end',)
+    for leg, end in zip(LEGS, ends):
+        if leg in schedule and end in schedule:
+            stages['leg:%s' % leg] = {'wall': round(schedule[end] - schedule[leg], 3), 'cpu': None}
+    return stages
+
+
+class Busy(object):
+    """The machine's CPU use (0 to 1, all cores) every BUSY_PERIOD_S while it runs: ``samples`` is
+    ``[[s since the start, use, load average]]``."""
+
+    def __init__(self):
+        self.samples, self._stop = [], threading.Event()
+        self._thread = threading.Thread(target=self._loop, daemon=True)
+
+    @staticmethod
+    def _stat():
+        with open('/proc/stat') as f:
+            values = [int(x) for x in f.readline().split()[1:]]
+        return sum(values), values[3] + values[4]  # idle and iowait
+
+    def _loop(self):
+        start, (total, idle) = time.monotonic(), self._stat()
+        while not self._stop.wait(BUSY_PERIOD_S):
+            now_total, now_idle = self._stat()
+            self.samples.append([round(time.monotonic() - start, 1),
+                                 round(1.0 - (now_idle - idle) / float(max(1, now_total - total)), 3),
+                                 round(os.getloadavg()[0], 2)])
+            total, idle = now_total, now_idle
+
+    def __enter__(self):
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        self._thread.join()
+        return False
+
+
 def children_cpu():
     """CPU seconds (user + system) of every process this one has waited for, its descendants' too: a
     grading's boxes, judges and tools all end before it returns, so the difference around it is its CPU."""
@@ -92,10 +158,15 @@ def children_cpu():
 
 
 def grade(folder, out, jobs):
-    """Grade the class in ``folder``: ``(wall s, CPU s of the whole class, {student: record})``."""
-    start, cpu = time.monotonic(), children_cpu()
-    records = class_run.grade_class(folder, out, jobs=jobs)
-    return time.monotonic() - start, children_cpu() - cpu, {r['student']: r for r in records}
+    """Grade the class in ``folder``: ``(wall s, CPU s of the whole class, {student: record}, the
+    machine's CPU use meanwhile)``. The class's CPU is its gradings' own count (their boxes' too)."""
+    start = time.monotonic()
+    with Busy() as busy:
+        records = class_run.grade_class(folder, out, jobs=jobs)
+    cpu = sum((stage_times(out, r['student']).get('session') or {}).get('cpu') or 0.0 for r in records) + sum(
+        (stage_times(out, r['student']).get(name) or {}).get('cpu') or 0.0 for r in records
+        for name in ('prepare', 'staging', 'inspection', 'logs', 'grade'))
+    return time.monotonic() - start, cpu, {r['student']: r for r in records}, busy.samples
 
 
 def points(record):
@@ -110,6 +181,7 @@ def main(argv=None):
     parser.add_argument('--out', default=None)
     parser.add_argument('--record', action='store_true', help='write the section to lab/bench/grader.md')
     parser.add_argument('--from-results', help='render the section of an earlier run\'s results.json')
+    parser.add_argument('--no-alone', action='store_true', help='skip grading each package alone')
     args = parser.parse_args(argv)
     if args.from_results:
         with open(args.from_results) as f:
@@ -123,27 +195,32 @@ def main(argv=None):
                'load_start': list(os.getloadavg()), 'command': 'python3 lab/bench/grader_bench.py '
                '--students %d --jobs %s' % (args.students, args.jobs)}
 
-    alone_dir = os.path.join(out, 'alone-class')
-    os.makedirs(alone_dir)
-    alone_students = make_class(alone_dir, len(kinds), kinds)
-    wall, cpu, records = grade(alone_dir, os.path.join(out, 'alone'), 1)
-    for student, kind in alone_students.items():
-        results['alone'][kind] = {'points': points(records[student]), 'seconds': records[student]['seconds'],
-                                  'timing': timings(os.path.join(out, 'alone'), student)}
-    results['alone_wall'], results['alone_cpu'] = wall, cpu
+    if not args.no_alone:
+        alone_dir = os.path.join(out, 'alone-class')
+        os.makedirs(alone_dir)
+        alone_students = make_class(alone_dir, len(kinds), kinds)
+        wall, cpu, records, _ = grade(alone_dir, os.path.join(out, 'alone'), 1)
+        for student, kind in alone_students.items():
+            results['alone'][kind] = {'points': points(records[student]), 'seconds': records[student]['seconds'],
+                                      'timing': timings(os.path.join(out, 'alone'), student),
+                                      'stages': stage_times(os.path.join(out, 'alone'), student)}
+        results['alone_wall'], results['alone_cpu'] = wall, cpu
 
     for jobs in [int(j) for j in args.jobs.split(',')]:
         folder = os.path.join(out, 'class-%d' % jobs)
         os.makedirs(folder)
         students = make_class(folder, args.students, kinds)
-        wall, cpu, records = grade(folder, os.path.join(out, 'graded-%d' % jobs), jobs)
+        wall, cpu, records, busy = grade(folder, os.path.join(out, 'graded-%d' % jobs), jobs)
         rows = []
         for student, kind in sorted(students.items()):
+            alone = results['alone'].get(kind)
             rows.append({'student': student, 'kind': kind, 'points': points(records[student]),
-                         'same_points': points(records[student]) == results['alone'][kind]['points'],
+                         'same_points': None if alone is None else points(records[student]) == alone['points'],
                          'seconds': records[student]['seconds'],
-                         'timing': timings(os.path.join(out, 'graded-%d' % jobs), student)})
-        results['classes'].append({'jobs': jobs, 'students': args.students, 'wall': wall, 'cpu': cpu, 'rows': rows})
+                         'timing': timings(os.path.join(out, 'graded-%d' % jobs), student),
+                         'stages': stage_times(os.path.join(out, 'graded-%d' % jobs), student)})
+        results['classes'].append({'jobs': jobs, 'students': args.students, 'wall': wall, 'cpu': cpu, 'rows': rows,
+                                   'busy': busy})
         print('JOBS=%d: %d students in %.0f s' % (jobs, args.students, wall), file=sys.stderr)
 
     results['load_end'] = list(os.getloadavg())
@@ -173,11 +250,12 @@ def render(results):
     one = [v['seconds'] for v in alone.values()]
     rows = ['| graded | wall time | per student | CPU per student | same points as alone | rate [Hz] | '
             'WARNING after [s] | NORMAL after [s] |', '|---|---|---|---|---|---|---|---|']
-    rows.append('| each of %d packages alone (JOBS=1) | %.0f s | %.0f-%.0f s | %s | (reference) | %s | %s | %s |' % (
-        len(alone), results['alone_wall'], min(one), max(one), _cpu(results.get('alone_cpu'), len(alone)),
-        _spread([v['timing']['hz'] for v in alone.values()]),
-        _spread([v['timing']['warning_s'] for k, v in alone.items() if k not in NOT_ON_TIME]),
-        _spread([v['timing']['normal_s'] for v in alone.values()])))
+    if alone:
+        rows.append('| each of %d packages alone (JOBS=1) | %.0f s | %.0f-%.0f s | %s | (reference) | %s | %s | %s |' % (
+            len(alone), results['alone_wall'], min(one), max(one), _cpu(results.get('alone_cpu'), len(alone)),
+            _spread([v['timing']['hz'] for v in alone.values()]),
+            _spread([v['timing']['warning_s'] for k, v in alone.items() if k not in NOT_ON_TIME]),
+            _spread([v['timing']['normal_s'] for v in alone.values()])))
     for klass in results['classes']:
         graded = klass['rows']
         rows.append('| class of %d, JOBS=%d | %.0f s | %.0f-%.0f s | %s | %d of %d | %s | %s | %s |' % (
@@ -190,9 +268,9 @@ def render(results):
     differ = ['%s (JOBS=%d): %s' % (r['student'], k['jobs'], ', '.join(
         '%s %s instead of %s' % (item, r['points'][item], alone[r['kind']]['points'][item])
         for item in sorted(r['points']) if r['points'][item] != alone[r['kind']]['points'][item]))
-        for k in results['classes'] for r in k['rows'] if not r['same_points']]
+        for k in results['classes'] for r in k['rows'] if r['same_points'] is False]
     largest = max([abs(sum(r['points'].values()) - sum(alone[r['kind']]['points'].values()))
-                   for k in results['classes'] for r in k['rows']] or [0.0])
+                   for k in results['classes'] for r in k['rows'] if r['kind'] in alone] or [0.0])
     kinds = ['| %s | %s | %.0f s |' % (kind, _total(v['points']), v['seconds']) for kind, v in sorted(alone.items())]
     when = results.get('date', '?')
     load = ''
@@ -204,17 +282,18 @@ def render(results):
     at_default = [k for k in results['classes'] if k['jobs'] == default]
     verdict = ''
     if at_default:
-        moved = [r for r in at_default[0]['rows'] if not r['same_points']]
+        moved = [r for r in at_default[0]['rows'] if r['same_points'] is False]
         verdict = ' At that JOBS the class of %d %s.' % (
             at_default[0]['students'], 'kept every point of every student' if not moved else
             'moved the points of %d student(s): the default is too high for this machine' % len(moved))
         above = [k for k in results['classes'] if k['jobs'] > default]
         if above and not moved:
-            kept = all(r['same_points'] for r in above[0]['rows'])
+            kept = not any(r['same_points'] is False for r in above[0]['rows'])
             verdict += (' So did JOBS=%d, the margin the default keeps for a machine that also does other work.'
                         if kept else ' JOBS=%d moved points: the default is the largest JOBS measured to move none.') \
                 % above[0]['jobs']
     slow = sorted(kind for kind, v in alone.items() if v['seconds'] > 90)
+    stages = stages_table(results)
     goals = []
     for klass in results['classes']:
         goals.append('class of %d at JOBS=%d: %.1f min%s' % (
@@ -231,8 +310,8 @@ def render(results):
         '(`JOBS`, each student on a master of its own) keeps its timing checks fair. The packages are our '
         'exam node and the student packages of `lab/test/grader/submissions/`; a class cycles through '
         'them. "Same points as alone": every item of the student equals that of its package graded alone. '
-        '"CPU per student": the CPU time of the whole class (every box, judge and grader process, as '
-        '`getrusage` counts the grader\'s children) over its students. '
+        '"CPU per student": the CPU time of the whole class over its students, as each grading counted it '
+        '(its boxes\' cgroups, its judge, the grader\'s own thread: `timings.json`). '
         'The timings are those the rubric judges, over every student of the row: the output rate '
         '(10 Hz +- 10 % passes), the WARNING after the first reading above the threshold (the rubric times it '
         'from the node\'s own value and passes 4.7 s up to the delay, one period of the slowest input and a tick: '
@@ -245,8 +324,9 @@ def render(results):
             'Every student got the points of its package alone (the largest difference of a total: 0).' if not differ else
             'Points that differed: %s. The largest difference of a total: %s point(s).' % (
                 '; '.join(differ), _total({'': largest})))), '',
-        '`JOBS` defaults to %d per core (`exam_lab.grader.class_run.default_jobs`: %d on this machine).%s' % (
-            class_run.JOBS_PER_CORE, default, verdict), '',
+        '`JOBS` defaults to what fills %.0f %% of the cores at %.1f s of CPU in %.1f s a grading, within the memory '
+        '(`exam_lab.grader.class_run.default_jobs`: %d on this machine).%s' % (
+            100 * class_run.CPU_SHARE, class_run.GRADING_CPU_S, class_run.GRADING_WALL_S, default, verdict), '',
         'Why side by side stays fair: each student has a master, a network namespace and processes of its own, '
         'so the only thing shared is the CPU, and the rubric\'s timings need little of it: each box is held to '
         'its part of the machine (cores/JOBS, at least half a core), the judge\'s master and probe weigh four '
@@ -254,8 +334,49 @@ def render(results):
         'comes between the first tick after 5 s and the next, its NORMAL within a tick: they sit 0.2 s and '
         'more inside the windows. Builds (CMake, a few seconds of CPU) are what the jobs contend for; a run\'s '
         'timing suffers only if its node is starved of the CPU for more than 0.2 s, which the spreads above '
-        'would show.', '',
+        'would show.', ''] + stages + [
         '| package | points alone | wall time alone |', '|---|---|---|'] + kinds)
+
+
+#: The stages of one grading as the table lists them (:mod:`exam_lab.grader.host.timings`), then the legs.
+STAGES = ('prepare', 'staging', 'inspection', 'session', 'launch_check', 'build', 'runs', 'main', 'threshold',
+          'logs', 'grade') + tuple('leg:%s' % leg for leg in LEGS)
+
+
+def stages_table(results):
+    """Where one grading's time goes, stage by stage (each grading's own timings.json), alone and in
+    each class: the mean wall and CPU time over the gradings that had the stage; and the machine's CPU
+    use while each class was graded."""
+    columns = ([('alone', list(results['alone'].values()))] if results['alone'] else []) + [
+        ('class of %d, JOBS=%d' % (k['students'], k['jobs']), k['rows']) for k in results['classes']]
+    if not any(row.get('stages') for _, rows in columns for row in rows):
+        return []
+    lines = ['Where a grading\'s time goes (mean wall / CPU s over the gradings that had the stage; "runs" are '
+             'the two runs together, "main" and "threshold" each run, side by side when `side_by_side`; the legs '
+             'are the main run\'s, wall only; CPU counts the boxes\' cgroups, the judge and the grader\'s '
+             'own thread):', '', '| stage | ' + ' | '.join(name for name, _ in columns) + ' |',
+             '|---|' + '---|' * len(columns)]
+    for stage in STAGES:
+        cells = []
+        for _, rows in columns:
+            had = [row['stages'][stage] for row in rows if stage in (row.get('stages') or {})]
+            if not had:
+                cells.append('-')
+                continue
+            wall = sum(h['wall'] for h in had) / len(had)
+            cpu = [h['cpu'] for h in had if h.get('cpu') is not None]
+            cells.append('%.1f / %s' % (wall, '%.1f' % (sum(cpu) / len(cpu)) if cpu else '-'))
+        lines.append('| %s | %s |' % (stage, ' | '.join(cells)))
+    for klass in results['classes']:
+        busy = klass.get('busy') or []
+        if busy:
+            lines.append('')
+            lines.append('The machine\'s CPU use while the class of %d was graded at JOBS=%d (every %.0f s, all of '
+                         'the machine\'s work: %s): mean %.0f %%, %d of %d samples above 90 %%.' % (
+                             klass['students'], klass['jobs'], BUSY_PERIOD_S,
+                             ' '.join('%.0f' % (100 * b[1]) for b in busy), 100 * sum(b[1] for b in busy) / len(busy),
+                             len([b for b in busy if b[1] > 0.9]), len(busy)))
+    return lines + ['']
 
 
 def _cpu(seconds, students):

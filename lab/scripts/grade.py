@@ -44,8 +44,8 @@ def main(argv=None):
     parser.add_argument('--sheet', choices=list(SHEETS), help='default: detected from the package')
     parser.add_argument('--out', help='output folder (default: $EXAM_WS/grades/<name>)')
     parser.add_argument('--jobs', type=int, default=None,
-                        help='students graded side by side (class; default: %d per core, %d here)'
-                        % (class_run.JOBS_PER_CORE, class_run.default_jobs()))
+                        help='students graded side by side (class; default: from the cores, the memory and '
+                        'the CPU a grading takes, %d here)' % class_run.default_jobs())
     parser.add_argument('--unsandboxed-student-code-can-read-and-damage-my-files', dest='unsandboxed',
                         action='store_true', help='grade even where no sandbox can be made (never as root: '
                         'as root the code runs as a user of its own, with limits)')

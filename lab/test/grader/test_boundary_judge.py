@@ -23,7 +23,8 @@ import time
 import pytest
 
 from exam_lab.grader import runner
-from exam_lab.grader.host import limits, session, uids, underlay
+from exam_lab.grader.host import limits, uids, underlay
+from exam_lab.grader.host import run as host_run
 from exam_lab.grader.score import rubric
 from exam_lab.grader.score.sheets import ITEMS
 from hostile_run import HOSTILE, JOBS, NAMES, VICTIM_NAME
@@ -158,4 +159,4 @@ def test_a_grading_past_its_budget_ends_at_it_and_says_so(tmp_path, monkeypatch)
     assert record['status'] == rubric.HAND_GRADE, evidence(record)
     assert record['status_reason'].startswith('its grading used up its budget of %.0f s' % BUDGET_S), record['status_reason']
     assert 'catkin_make was stopped after' in record['status_reason'], record['status_reason']
-    assert took >= BUDGET_S - 2 * session.STEP_STOP_S - 10, took  # stopped at the budget, not before
+    assert took >= BUDGET_S - 2 * host_run.STEP_STOP_S - 10, took  # stopped at the budget, not before

@@ -277,7 +277,7 @@ def test_no_sandbox_no_grading_unless_the_risk_is_named(monkeypatch, tmp_path):
 
 
 def test_probe_results_must_belong_to_the_run():
-    from exam_lab.grader.host.session import probe_problem
+    from exam_lab.grader.host.run import probe_problem
     plan = {'kind': 'main', 'delay': 5.0}
     real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0},
             'clock': {'use_sim_time': [None, None], 'messages': 0, 'publishers': []}}

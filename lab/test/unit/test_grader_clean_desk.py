@@ -20,7 +20,7 @@ import pytest
 from exam_lab.grader import class_run
 from exam_lab.grader.publish import grades, teacher
 from exam_lab.grader.score.records import MEASUREMENTS, SimilarityRecord
-from exam_lab.grader.host import session
+from exam_lab.grader.host import run as host_run
 
 from exam_lab.grader.publish import desk, flightplot, gradescope, moodle, page, progress, report
 from exam_lab.grader.score import safe_text
@@ -163,7 +163,7 @@ def test_no_control_character_reaches_an_output(output, tmp_path, monkeypatch, c
 def test_the_record_is_clean_where_it_is_made():
     """The boundary: the log tail as the session keeps it, the notes the runner makes of it, the
     record :func:`report.grade_record` makes of them."""
-    outcome = session.launch_outcome('[exam-1] started\n%s\n[exam-1] process has died [pid 3, exit code 1]\n'
+    outcome = host_run.launch_outcome('[exam-1] started\n%s\n[exam-1] process has died [pid 3, exit code 1]\n'
                                      % HOSTILE)
     assert CONTROL.findall(outcome['tail']) == [] and '17/17 graded' in outcome['tail']
     run = {'tag': 'main', 'launch': {'tail': HOSTILE}}

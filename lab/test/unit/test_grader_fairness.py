@@ -7,7 +7,7 @@ import pytest
 
 from exam_lab.grader.boxed import derive, launch, source
 
-from exam_lab.grader.host import session
+from exam_lab.grader.host import run as host_run
 from exam_lab.grader.judge import legs, pilot
 
 from exam_lab.grader.score import flight, records, rubric, tolerances, verdict
@@ -99,8 +99,8 @@ def test_a_late_warning_costs_the_delay_only():
     assert lost(record) == {'Q14b': 1.5}
     q13 = [i for i in rubric.score('altitude', STATIC, record) if i['id'] == 'Q13'][0]['evidence']
     assert 'the WARNING came late, 50.0 s' in q13
-    assert session.warning_latency(main_of(record)) == pytest.approx(50.0)
-    assert session.warning_latency({'schedule': schedule, 'calls': []}) is None
+    assert host_run.warning_latency(main_of(record)) == pytest.approx(50.0)
+    assert host_run.warning_latency({'schedule': schedule, 'calls': []}) is None
 
 
 @pytest.mark.parametrize('kind', ['std_msgs/Float64', 'std_msgs/Int32', 'std_msgs/UInt16'])
@@ -217,14 +217,18 @@ def test_reports_say_the_status():
     assert record['status'] == 'not graded' and record['status_reason'] == 'refused: x'
 
 
-def test_jobs_default_two_per_core_within_memory():
-    """JOBS when the teacher gives none: two gradings per core (make bench's grader stage measured that
-    no point moves), fewer when the memory cannot hold them, never 0."""
+def test_jobs_default_from_the_cores_the_memory_and_the_cpu_a_grading_takes():
+    """JOBS when the teacher gives none (issue 48 point 3): as many gradings as fill CPU_SHARE of the
+    cores at the CPU one grading measured in its wall time, fewer when the memory cannot hold them,
+    never 0; a grading that costs twice the CPU halves it."""
     from exam_lab.grader import class_run
     gib = 1 << 30
-    assert class_run.default_jobs(cores=2, memory=24 * gib) == 4
+    assert class_run.default_jobs(cores=2, memory=24 * gib) == 4  # 2 x 0.6 x 50.2 / 13.2 = 4.6
+    assert class_run.default_jobs(cores=2, memory=24 * gib, cpu=2 * class_run.GRADING_CPU_S) == 2
+    assert class_run.default_jobs(cores=2, memory=24 * gib, cpu=1.0, wall=100.0) == 24  # the memory's 24 GB
     assert class_run.default_jobs(cores=16, memory=8 * gib) == 8
     assert class_run.default_jobs(cores=1, memory=gib // 2) == 1
+    assert class_run.default_jobs(cores=1, memory=24 * gib, cpu=100.0, wall=1.0) == 1
     assert class_run.default_jobs() >= 1
 
 

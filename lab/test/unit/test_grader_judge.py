@@ -11,7 +11,7 @@ import tempfile
 import pytest
 
 from exam_lab.grader.host import cgroups, limits, sandbox, uids
-from exam_lab.grader.host.session import uid_of
+from exam_lab.grader.host.run import uid_of
 from exam_lab.grader.judge import legs
 from exam_lab.harness.supervisor import Supervisor, descendants
 from exam_lab.harness.wait import wait_until

@@ -10,6 +10,7 @@ import pytest
 from exam_lab.grader import runner
 from exam_lab.grader.publish import grades
 from exam_lab.grader.host import session
+from exam_lab.grader.host import run as host_run
 from exam_lab.grader.score import records
 from exam_lab.grader.score.records import ProbeRecord, RecordError, SessionRecord
 
@@ -133,25 +134,25 @@ def write(path, text):
 
 def test_the_session_takes_a_probe_result_that_is_not_one_for_the_runs_crash(tmp_path):
     good = write(str(tmp_path / 'good.json'), json.dumps(real_probe()))
-    value, why = session.probe_record(good)
+    value, why = host_run.probe_record(good)
     assert value == real_probe() and why is None
     for text, said in (('{"kind": "main"', 'not JSON'), ('[1, 2]', 'an object expected, got list'),
                        (json.dumps(dict(real_probe(), sneaky=True)), "unexpected key(s) 'sneaky'"),
                        (' ' * (ProbeRecord.MAX_BYTES + 1), 'bytes (at most')):
-        value, why = session.probe_record(write(str(tmp_path / 'bad.json'), text))
+        value, why = host_run.probe_record(write(str(tmp_path / 'bad.json'), text))
         assert value is None and why.startswith("the probe's result was refused (a crash of the run): ")
         assert said in why, why
     os.symlink(good, str(tmp_path / 'link.json'))
-    value, why = session.probe_record(str(tmp_path / 'link.json'))
+    value, why = host_run.probe_record(str(tmp_path / 'link.json'))
     assert value is None and 'a link, not followed' in why
 
 
 def test_a_refused_result_is_kept_for_the_plot_not_for_the_rubric():
     run = {'probe': real_probe()}
-    session.refuse(run, 'the master ended')
+    host_run.refuse(run, 'the master ended')
     assert run['probe'] is None and run['refused_probe'] == real_probe()
     assert run['probe_error'] == 'result refused: the master ended' and run['probe_refused'] == 'the master ended'
-    assert session.watched_deaths(real_probe()) == []
+    assert host_run.watched_deaths(real_probe()) == []
 
 
 def test_the_runner_reads_the_sessions_record_capped_and_checked(tmp_path):

@@ -1,5 +1,5 @@
 """What the session reads in roslaunch's output, and when it runs the threshold check."""
-from exam_lab.grader.host import session
+from exam_lab.grader.host import run as host_run
 
 DIED = ('\x1b[1mprocess[exam-1]: started with pid [17908]\x1b[0m\n'
         'Traceback (most recent call last):\n'
@@ -11,7 +11,7 @@ DIED = ('\x1b[1mprocess[exam-1]: started with pid [17908]\x1b[0m\n'
 
 
 def test_a_required_node_that_died():
-    outcome = session.launch_outcome(DIED, '/tmp/w/ws')
+    outcome = host_run.launch_outcome(DIED, '/tmp/w/ws')
     assert outcome['ended'] == [{'node': 'exam-1', 'how': 'died', 'detail': 'exit code 1'}]
     assert 'exam/scripts/exam_node.py' in outcome['tail'] and '/tmp/w' not in outcome['tail']
     assert 'killing on exit' not in outcome['tail'] and '\x1b' not in outcome['tail']
@@ -20,19 +20,19 @@ def test_a_required_node_that_died():
 def test_a_plain_node_that_finished_and_one_not_found():
     text = ('[exam-2] process has finished cleanly\n'
             'ERROR: cannot launch node of type [exam/exam_nod.py]: Cannot locate node of type [exam_nod.py]\n')
-    outcome = session.launch_outcome(text)
+    outcome = host_run.launch_outcome(text)
     assert outcome['ended'] == [{'node': 'exam-2', 'how': 'finished cleanly', 'detail': ''}]
     assert outcome['not_started'][0].startswith('ERROR: cannot launch node')
-    assert session.launch_outcome('[exam-1] killing on exit\n')['ended'] == []
+    assert host_run.launch_outcome('[exam-1] killing on exit\n')['ended'] == []
 
 
 def test_threshold_run_only_after_a_warning_in_the_long_excursion():
     probe = {'schedule': {'long_up': 10.0, 'long_down': 17.5}, 'calls': [[5.0, 'WARNING'], [9.0, 'NORMAL']]}
-    assert not session.warned_in_long_excursion(probe)
+    assert not host_run.warned_in_long_excursion(probe)
     probe['calls'].append([15.0, 'WARNING'])
-    assert session.warned_in_long_excursion(probe)
-    assert not session.warned_in_long_excursion(None)
-    assert not session.warned_in_long_excursion({'calls': [[1.0, 'WARNING']]})
+    assert host_run.warned_in_long_excursion(probe)
+    assert not host_run.warned_in_long_excursion(None)
+    assert not host_run.warned_in_long_excursion({'calls': [[1.0, 'WARNING']]})
 
 
 def test_sheet_detection(tmp_path):
@@ -63,23 +63,23 @@ def test_a_run_whose_node_set_the_time_is_refused():
     plan = {'kind': 'main', 'delay': 5.0}
     real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0},
             'clock': CLEAN_CLOCK}
-    assert session.probe_problem(real, 99.0, 131.0, **plan) is None
+    assert host_run.probe_problem(real, 99.0, 131.0, **plan) is None
     sim = dict(real, clock=dict(CLEAN_CLOCK, use_sim_time=[True, True]))
-    assert '/use_sim_time was set' in session.probe_problem(sim, 99.0, 131.0, **plan)
+    assert '/use_sim_time was set' in host_run.probe_problem(sim, 99.0, 131.0, **plan)
     late = dict(real, clock=dict(CLEAN_CLOCK, use_sim_time=[None, True]))
-    assert '/use_sim_time was set' in session.probe_problem(late, 99.0, 131.0, **plan)
+    assert '/use_sim_time was set' in host_run.probe_problem(late, 99.0, 131.0, **plan)
     ticking = dict(real, clock=dict(CLEAN_CLOCK, messages=40, publishers=['/exam']))
-    assert '/clock was published (40 messages by /exam)' in session.probe_problem(ticking, 99.0, 131.0, **plan)
+    assert '/clock was published (40 messages by /exam)' in host_run.probe_problem(ticking, 99.0, 131.0, **plan)
     unwatched = {k: v for k, v in real.items() if k != 'clock'}
-    assert 'did not say' in session.probe_problem(unwatched, 99.0, 131.0, **plan)
+    assert 'did not say' in host_run.probe_problem(unwatched, 99.0, 131.0, **plan)
 
 
 def test_a_run_whose_master_went_over_its_memory_is_refused():
     bounded = {'uid': 62000, 'memory': {'limit': 384 << 20, 'peak': 80 << 20, 'oom_kills': 0}}
-    assert session.master_problem(bounded, died=False) is None
+    assert host_run.master_problem(bounded, died=False) is None
     flooded = {'uid': 62000, 'memory': {'limit': 384 << 20, 'peak': 384 << 20, 'oom_kills': 1}}
-    assert 'over its memory bound of 384 MB' in session.master_problem(flooded, died=True)
-    assert 'ended during the run' in session.master_problem({'uid': 62000, 'memory': None}, died=True)
+    assert 'over its memory bound of 384 MB' in host_run.master_problem(flooded, died=True)
+    assert 'ended during the run' in host_run.master_problem({'uid': 62000, 'memory': None}, died=True)
 
 
 def test_a_refused_run_needs_a_hand_grade_with_its_reason():

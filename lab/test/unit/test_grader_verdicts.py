@@ -6,6 +6,7 @@ import os
 from exam_lab.grader import class_run, runner
 from exam_lab.grader.publish import teacher
 from exam_lab.grader.host import session
+from exam_lab.grader.host import run as host_run
 from exam_lab.grader.judge.graph import NodeWatch
 from exam_lab.grader.score import rubric
 
@@ -122,7 +123,7 @@ def test_a_watched_death_costs_what_a_death_costs():
     probe['node_watch'] = {'deaths': [{'node': '/chatter', 't': 12.0,
                                        'detail': 'started again during the run (pid 11, then 12)'}], 'nodes': []}
     assert points(session_)['runs'] == 2.0  # before the session reads the watch: the attack's 2/2
-    session_['runs'][0]['launch']['ended'].extend(session.watched_deaths(probe))
+    session_['runs'][0]['launch']['ended'].extend(host_run.watched_deaths(probe))
     assert points(session_)['runs'] == 1.0
     evidence = [i for i in rubric.score('altitude', STATIC, session_) if i['id'] == 'runs'][0]['evidence']
     assert 'node /chatter died (seen by the judge: started again during the run (pid 11, then 12))' in evidence
@@ -133,7 +134,7 @@ def test_a_watched_death_costs_what_a_death_costs():
 
 def test_each_step_gets_its_own_limit_or_what_is_left():
     clock = Clock()
-    budget = session.Budget(120.0, 270.0, clock=clock)
+    budget = host_run.Budget(120.0, 270.0, clock=clock)
     assert budget.limit(180.0, 5.0) == (115.0, True) and budget.limit(30.0, 5.0) == (30.0, False)
     clock.now += 100.0
     assert budget.left() == 20.0 and budget.left(30.0) == 0.0
@@ -145,7 +146,7 @@ def test_each_step_gets_its_own_limit_or_what_is_left():
 def test_a_used_budget_is_on_the_students_row():
     session_ = measured()
     session_['build'] = {'status': None, 'seconds': 115.0, 'tail': '', 'timeout': 115.0,
-                         'stopped': session.budget_sentence(270.0, 'catkin_make was stopped after 115 s')}
+                         'stopped': host_run.budget_sentence(270.0, 'catkin_make was stopped after 115 s')}
     session_['runs'], session_['budget_used'] = [], session_['build']['stopped']
     status, reason = rubric.status(STATIC, session_)
     assert status == rubric.HAND_GRADE and reason.startswith('its grading used up its budget of 270 s'), reason

@@ -25,7 +25,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   student's node, its inputs and output found), :mod:`~.judge.pilot` (the inputs set, the calibration,
   the legs flown) and :mod:`~.judge.legs` (the legs' holds and checks, pure).
 - ``host/`` -- root: :mod:`~.host.session` (builds and runs one submission: the student's steps in its
-  box, the master and the probe as the slot's judge uid), :mod:`~.host.sandbox` (the box: opened, its command lines, run, closed),
+  box, the master and the probe as the slot's judge uid), :mod:`~.host.run` (one run: its master, the
+  launch, the probe; what they said), :mod:`~.host.side_by_side` (the two runs at once, each in a box and
+  a network namespace of its own), :mod:`~.host.timings` (each stage's wall and CPU time), :mod:`~.host.sandbox` (the box: opened, its command lines, run, closed),
   :mod:`~.host.uids` (a slot's box and judge uids, under a lock; what runs as them ended),
   :mod:`~.host.cgroups` (the box's and the judge's cgroups), :mod:`~.host.limits` (their bounds;
   prlimit), :mod:`~.host.bwrap` (bubblewrap's command line; the session's network namespace),

@@ -19,26 +19,36 @@ from exam_lab.grader.score.names import CLASS_BYTES
 from exam_lab.grader.score.records import UnpackError
 from exam_lab.grader.score import kept as kept_records
 
-#: Gradings side by side per core when JOBS is not given. A grading mostly waits (its flight is timed),
-#: and each box's CPU is bounded to cores/JOBS, so two per core keep every point: measured by `make
-#: bench`'s grader stage on a class of 60 (docs/benchmarks.md, "The grader").
-JOBS_PER_CORE = 2
+#: What one grading costs, as it timed itself (``logs/timings.json``, :mod:`~exam_lab.grader.host.timings`):
+#: CPU s (its boxes' cgroups, its judge, the grader's own thread) and wall s, ``good_student`` graded
+#: alone with its two runs side by side, measured 2026-12-01 on two cores under a load average of 4
+#: to 8 (other work): 13.2 s of CPU in 50.2 s. A grading mostly waits: its flights are timed.
+GRADING_CPU_S = 13.2
+GRADING_WALL_S = 50.2
+#: The part of the cores the default JOBS fills on average: what is left absorbs the bursts (two
+#: roslaunch starts at once, a build) so that no flight's node is starved; each box is held to
+#: cores/JOBS besides, and the judge outweighs it. Measured 2026-12-01, classes of 12 on two cores
+#: shared with other work: JOBS=4 (60 %) kept every point at a load average of 7 to 22; JOBS=5 (75 %)
+#: lost 8 of 12 nodes' starts (not registered within START_TIMEOUT) at a load of 40.
+CPU_SHARE = 0.6
 #: Memory one grading is counted for when JOBS is not given: its processes use a few hundred MB (the
-#: bounds are higher: the box 2 GB, the master 384 MB, the probe 512 MB).
+#: bounds are higher: each box 2 GB, each master 384 MB, each probe 512 MB).
 JOB_MEMORY_BYTES = 1 << 30
 
 
-def default_jobs(cores=None, memory=None):
-    """JOBS when the teacher gives none: JOBS_PER_CORE per core this process may run on, no more than
-    the memory holds at JOB_MEMORY_BYTES each, at least 1."""
+def default_jobs(cores=None, memory=None, cpu=GRADING_CPU_S, wall=GRADING_WALL_S):
+    """JOBS when the teacher gives none, from what the machine has: as many gradings as fill CPU_SHARE
+    of the cores this process may run on, each using ``cpu`` s of CPU in ``wall`` s, no more than the
+    memory holds at JOB_MEMORY_BYTES each, at least 1."""
     if cores is None:
         cores = len(os.sched_getaffinity(0)) if hasattr(os, 'sched_getaffinity') else (os.cpu_count() or 1)
+    by_cpu = int(cores * CPU_SHARE * wall / cpu)
     if memory is None:
         try:
             memory = os.sysconf('SC_PAGE_SIZE') * os.sysconf('SC_PHYS_PAGES')
         except (ValueError, OSError):
-            memory = JOB_MEMORY_BYTES * JOBS_PER_CORE * cores
-    return max(1, min(JOBS_PER_CORE * cores, memory // JOB_MEMORY_BYTES))
+            memory = JOB_MEMORY_BYTES * by_cpu
+    return max(1, min(by_cpu, memory // JOB_MEMORY_BYTES))
 
 
 def worst_case(students, jobs):

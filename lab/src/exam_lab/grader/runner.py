@@ -37,6 +37,7 @@ student's bytes (refused, no node, a build that fails) is what the record says: 
 either way, never the class's. The simulators are an underlay built once
 (:mod:`~exam_lab.grader.host.underlay`); each student's package is built alone in an overlay on top.
 """
+import contextlib
 import os
 import random
 import shutil
@@ -44,10 +45,11 @@ import sys
 import time
 
 from exam_lab.grader import contract
-from exam_lab.grader.host import bwrap, limits, reports, sandbox, staging
+from exam_lab.grader.host import bwrap, cgroups, limits, reports, sandbox, staging, timings
 from exam_lab.grader.host.boxed_run import INSPECT_BOUNDS, Boxed, InspectionFailed, session_tail
 from exam_lab.grader.host.bwrap import can_isolate
-from exam_lab.grader.host.session import budget_sentence
+from exam_lab.grader.host.run import budget_sentence
+from exam_lab.grader.host.side_by_side import markers
 from exam_lab.grader.host.underlay import box_binds, default_underlay, ensure_underlay, package_path
 from exam_lab.grader.publish import grades, progress, teacher
 from exam_lab.grader.score import identity, records
@@ -73,7 +75,7 @@ SESSION_KILL_S = 5.0
 
 
 def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=None, isolate=None, keep=False,
-                     on_step=None, extra=None, unsandboxed=False, jobs=1):
+                     on_step=None, extra=None, unsandboxed=False, jobs=1, side_by_side=True):
     """Grade one submission; write grade.json and grade.md in ``out_dir``; return the record.
 
     :param on_step: called with each step's name as it starts (unpack, build, main flight...).
@@ -81,8 +83,15 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
     :param unsandboxed: run it even where no sandbox can be made (the teacher's flag that names the
         risk); otherwise :class:`~exam_lab.grader.host.sandbox.SandboxUnavailable` is raised there.
     :param jobs: how many submissions are graded side by side: the box's part of the CPU.
+    :param side_by_side: fly the main and the threshold run at once, each in a box, a network namespace
+        and on a master of its own (where the session is isolated and a second box can be had); else
+        one after the other in the one box (:func:`run_session`).
+
+    Each stage's wall and CPU time goes to ``out_dir/logs/timings.json`` (:mod:`~exam_lab.grader.host.timings`).
     """
     start = time.monotonic()
+    watch = timings.Stopwatch(cpu=time.thread_time)  # a class grades in threads: this one's, and its box's
+    prepared = watch.now()
     student = student or identity.student_name(os.path.basename(os.path.abspath(submission).rstrip('/')))
     refusal = sandbox.sandbox_refusal(unsandboxed)
     if refusal:
@@ -92,6 +101,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
     contract.make_folder(out_dir)  # a folder of OUT that is a link is refused here, before anything is run
     deadline = time.monotonic() + STUDENT_BUDGET  # the student's own time starts here, the simulators built
     work = staging.new_work('exam-grade-')
+    watch.record('prepare', *prepared)  # the sandbox's check and the underlay, once a process
     folder = os.path.basename(os.path.abspath(submission).rstrip('/'))
     notes, fixes, static, session, chosen_sheet, comments, how_run = [], [], {}, None, sheet, None, None
     facts = {'participant': identity.participant_number(folder), 'folder': folder, 'documents': []}
@@ -99,11 +109,16 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
         try:
             progress.report(on_step, 'unpack')
             # The teacher's path, followed: a link given on the command line is the upload it names.
-            (upload,) = staging.stage_work(work, [(folder, os.path.realpath(submission))])
+            with watch.stage('staging'):
+                (upload,) = staging.stage_work(work, [(folder, os.path.realpath(submission))])
             with sandbox.Box(work, box_binds(underlay), bwrap=sandbox.check() is None,
                              cpus=limits.box_cpus(jobs)) as box:
                 notes.extend(box.notes)
-                found = inspect(box, work, upload, sheet, timeout=deadline - time.monotonic())
+                with watch.stage('inspection'):
+                    counted = cgroups.cpu_use(box.cgroups)
+                    found = inspect(box, work, upload, sheet, timeout=deadline - time.monotonic())
+                    if counted is not None:
+                        watch.add_cpu(cgroups.cpu_use(box.cgroups) - counted)
                 notes.append(teacher.how_read(box, found.uid, INSPECT_BOUNDS))
                 notes.extend(found.notes)
                 fixes.extend(found.fixes)
@@ -122,8 +137,16 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                     session = grades.no_session(Outcome.NOT_RUN, why, budget_used=why)
                 else:
                     how_run = teacher.how_run(box)
-                    session = run_session(job, work=work, underlay=underlay, isolate=isolate, box=box, on_step=on_step,
-                                          left=deadline - time.monotonic())
+                    with twin_box(job, work, underlay, box, isolate and side_by_side and cpu_allows_two_runs(),
+                                  jobs) as twin, \
+                            watch.stage('session'):
+                        session = run_session(job, work=work, underlay=underlay, isolate=isolate, box=box, twin=twin,
+                                              on_step=on_step, left=deadline - time.monotonic())
+                    ran = timings.read(os.path.join(work, 'logs'))
+                    wall = watch.stages['session']['wall']  # the session's own CPU, the runner's wall clock
+                    watch.stages.update(ran.get('stages', {}))
+                    watch.stages['session']['wall'] = wall
+                    watch.extra['side_by_side'] = bool(ran.get('side_by_side'))
         except (records.UnpackError, staging.UploadRefused) as err:
             session = grades.no_session(Outcome.REFUSED, 'submission refused: %s' % err, refused=True)
         except InspectionFailed as err:
@@ -131,14 +154,21 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
         except Exception as err:  # a grader bug must not stop the class: say so and carry on
             session = grades.no_session(Outcome.GRADER_FAILED, 'the grader failed on this submission: %r' % err)
             notes.append(grades.bug_note())
-        notes.extend(keep_logs(work, out_dir))
+        with watch.stage('logs'):
+            notes.extend(keep_logs(work, out_dir))
         # The report, read after the flights in a box of its own: its time is not the student's budget.
         progress.report(on_step, 'report')
-        reports.read_report(submission, out_dir, jobs=jobs)
+        with watch.stage('report'):
+            reports.read_report(submission, out_dir, jobs=jobs)
         measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session.value,
                     'notes': notes, 'fixes': fixes, 'comments': comments, 'isolate': isolate, 'how_run': how_run,
                     'extra': dict(facts, **dict(extra or {}, seconds=round(time.monotonic() - start, 1)))}
-        return publish(out_dir, measured)
+        with watch.stage('grade'):
+            graded = publish(out_dir, measured)
+        watch.extra.update(jobs=jobs, wall=round(time.monotonic() - start, 3))
+        os.makedirs(os.path.join(out_dir, 'logs'), exist_ok=True)
+        watch.write(os.path.join(out_dir, 'logs'))
+        return graded
     finally:
         if not keep:
             shutil.rmtree(work, ignore_errors=True)  # never follows a link the box left (rmtree does not)
@@ -188,7 +218,36 @@ def plan_job(record):
                                    'run_timeout': RUN_TIMEOUT, 'runs': runs, 'handed_in_launch': record.handed_in_launch})
 
 
-def run_session(job, *, work, underlay, isolate, box, on_step=None, left=STUDENT_BUDGET):
+def cpu_allows_two_runs(cores=None, load=None):
+    """Whether the machine has the CPU to fly a student's two runs at once: its load average over the
+    last minute (``load``) below its ``cores``. Two runs start two roslaunches at once; on a machine
+    already busy (measured 2026-12-01: a test session's classes at a load of 5 to 18 on two cores) their
+    nodes then missed START_TIMEOUT, so there the runs fly one after the other, as before."""
+    cores = cores or (len(os.sched_getaffinity(0)) if hasattr(os, 'sched_getaffinity') else os.cpu_count() or 1)
+    load = os.getloadavg()[0] if load is None else load
+    return load < cores
+
+
+@contextlib.contextmanager
+def twin_box(job, work, underlay, box, wanted, jobs):
+    """The submission's second box, where one of its two runs flies beside the other (:func:`run_session`),
+    or None: not ``wanted`` (not isolated, or the teacher's choice), one run only, no sandbox (nothing to
+    isolate the runs from each other), or no free slot."""
+    if not wanted or job is None or len(job.runs) != 2 or not box.bwrap:
+        yield None
+        return
+    try:
+        twin = sandbox.Box(work, box_binds(underlay), bwrap=True, cpus=limits.box_cpus(jobs), name='box-twin').open()
+    except sandbox.SandboxUnavailable:
+        yield None
+        return
+    try:
+        yield twin
+    finally:
+        twin.close()
+
+
+def run_session(job, *, work, underlay, isolate, box, twin=None, on_step=None, left=STUDENT_BUDGET):
     """Run the session of one submission, its student steps in ``box``; return what it measured (or
     why it could not): its :class:`~exam_lab.grader.score.records.SessionRecord`.
 
@@ -198,14 +257,21 @@ def run_session(job, *, work, underlay, isolate, box, on_step=None, left=STUDENT
     :param isolate: in a network namespace of its own with only loopback
         (:func:`~exam_lab.grader.host.bwrap.network_namespace`).
     :param on_step: called with each step's name as the session starts it (:mod:`~exam_lab.grader.publish.progress`).
+    :param twin: a second box (:func:`twin_box`): the two runs fly side by side, each in a network
+        namespace of its own, one of them (drawn here: which one tells a node nothing) in ``twin`` with
+        a judge of its own.
     """
     log_dir = os.path.join(work, 'logs')
     judge_home = os.path.join(work, 'judge')
     for folder in (log_dir, judge_home):
         os.makedirs(folder, mode=0o700, exist_ok=True)
     runs = [dict(run, launch=os.path.join(box.workspace, run['launch'])) for run in job.runs]
+    if twin is not None:
+        os.makedirs(os.path.join(work, 'judge-twin'), mode=0o700, exist_ok=True)
+        drawn = random.SystemRandom().randrange(2)
+        runs[drawn] = dict(runs[drawn], box=twin.describe(), judge_home=os.path.join(work, 'judge-twin'))
     job = job.replaced(workspace=box.workspace, runs=runs, underlay=underlay, log_dir=log_dir, judge_home=judge_home,
-                       box=box.describe(), budget=left, student_budget=STUDENT_BUDGET)
+                       box=box.describe(), budget=left, student_budget=STUDENT_BUDGET, side_by_side=twin is not None)
     job_path = os.path.join(work, records.JobRecord.FILE)
     with open(job_path, 'w') as f:
         f.write(job.to_json())
@@ -214,8 +280,9 @@ def run_session(job, *, work, underlay, isolate, box, on_step=None, left=STUDENT
         argv = bwrap.network_namespace(argv)
     with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
         status, output, _ = sup.run('session', argv, timeout=left + SESSION_KILL_S, env=dict(os.environ, HOME=judge_home))
-    end_pids(marked(log_dir))  # anything the session started and left, whatever happened to it
-    survivors = box.end()  # the box's uid: nothing may be left once its PID namespaces are gone
+    for marker in markers(log_dir):  # anything the session started and left, whatever happened to it
+        end_pids(marked(marker))
+    survivors = box.end() + (twin.end() if twin is not None else 0)  # nothing may be left of the boxes' uids
     return session_outcome(log_dir, status, output, left, survivors)
 
 

@@ -132,9 +132,7 @@ def end_pids(pids, grace=5.0):
     """SIGINT each pid, then SIGKILL those still alive after ``grace`` seconds."""
     for pid in pids:
         _kill(pid, signal.SIGINT)
-    deadline = time.monotonic() + grace
-    while time.monotonic() < deadline and any(alive(pid) for pid in pids):
-        time.sleep(0.1)
+    wait_until(lambda: not any(alive(pid) for pid in pids), grace, period=0.05)
     for pid in pids:
         if alive(pid):
             _kill(pid, signal.SIGKILL)
@@ -191,15 +189,13 @@ class Master(object):
     def start(self, timeout=30.0):
         """Start roscore (again, after :meth:`kill`) and wait until it answers."""
         self.proc = self.supervisor.start(self.name, self.wrap + ['roscore', '-p', str(self.port)], self.env)
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if self.proc.poll() is not None:
-                raise RuntimeError('roscore on port %d exited with %s; see %s'
-                                   % (self.port, self.proc.returncode, self.supervisor.log(self.name)))
-            if self.is_online():
-                return self
-            time.sleep(0.1)
-        raise RuntimeError('roscore on port %d did not answer within %.0f s' % (self.port, timeout))
+        wait_until(lambda: self.proc.poll() is not None or self.is_online(), timeout, period=0.05)
+        if self.proc.poll() is not None:
+            raise RuntimeError('roscore on port %d exited with %s; see %s'
+                               % (self.port, self.proc.returncode, self.supervisor.log(self.name)))
+        if not self.is_online():
+            raise RuntimeError('roscore on port %d did not answer within %.0f s' % (self.port, timeout))
+        return self
 
     def is_online(self):
         try:
@@ -237,13 +233,16 @@ class Supervisor(object):
     :param env: the base environment (default: this process's).
     :param pid_file: if given, every started process's group id is appended to it at once, for a shell
         trap (the marker cleanup is the better way; this is for scripts that predate it).
+    :param marker: the run's marker (default the log folder): two supervisors that share a log folder,
+        side by side, each end their own processes only.
     """
 
-    def __init__(self, log_dir, env=None, pid_file=None):
+    def __init__(self, log_dir, env=None, pid_file=None, marker=None):
         self.log_dir = os.path.abspath(str(log_dir))
         os.makedirs(self.log_dir, exist_ok=True)
+        self.marker = marker or self.log_dir
         self.env = dict(os.environ if env is None else env)
-        self.env[MARKER] = self.log_dir
+        self.env[MARKER] = self.marker
         self.env.setdefault('ROS_LOG_DIR', os.path.join(self.log_dir, 'ros_log'))
         self.env.setdefault('ROS_HOME', os.path.join(self.log_dir, 'ros_home'))
         self.env['PYTHONUNBUFFERED'] = '1'
@@ -276,7 +275,7 @@ class Supervisor(object):
         :returns: the ``subprocess.Popen``; stdout and stderr go to :meth:`log`.
         """
         env = dict(self.env if env is None else env)
-        env[MARKER] = self.log_dir
+        env[MARKER] = self.marker
         ignoring = signal.getsignal(signal.SIGINT) == signal.SIG_IGN
         if ignoring:
             argv = DEFAULT_SIGINT + list(argv)
@@ -357,7 +356,7 @@ class Supervisor(object):
         """Stop what was started, newest first, then anything else that carries this run's marker."""
         for proc in reversed(list(self.procs)):
             self.stop(proc, grace)
-        end_pids(marked(self.log_dir), grace)
+        end_pids(marked(self.marker), grace)
 
 
 def _ignores_sigint(pid):

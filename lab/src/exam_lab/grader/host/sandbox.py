@@ -90,28 +90,32 @@ class Box(object):
     :param bwrap: False for the unsandboxed mode the teacher asked for by name: same user and limits.
     :param cpus: the box's CPU quota in cores (:func:`~exam_lab.grader.host.limits.box_cpus`); None: its
         weight only.
+    :param name: its work folder's name in ``work`` (a submission's second box, where one of its runs
+        flies beside the other, is ``box-twin``).
 
     Opened by a grader that is not root, a box with ``bwrap`` is *rootless* (the module's docstring): no
     slot, the grading user's uid (``owner``), and the network namespace it was opened in (``netns``).
     """
 
-    def __init__(self, work, binds=(), bwrap=True, cpus=None):
+    def __init__(self, work, binds=(), bwrap=True, cpus=None, name='box'):
         self.work, self.binds, self.bwrap, self.cpus = work, [os.path.realpath(b) for b in binds], bwrap, cpus
         self.slot, self._lock, self.cgroups, self.mounted = None, None, [], False
         #: The judge's cgroups: {"master": [folders], "probe": [folders]}.
         self.judge_cgroups = {}
-        self.folder = os.path.join(work, 'box')
+        self.name = name
+        self.folder = os.path.join(work, name)
         self.notes = []
         self.rootless, self.owner, self.netns = False, None, None
 
     def describe(self):
         """What the session needs to make this box's command lines (JSON): see :meth:`attached`."""
-        return {name: getattr(self, name) for name in ('work', 'bwrap', 'cpus', 'binds') + _OPENED}
+        return {name: getattr(self, name) for name in ('work', 'bwrap', 'cpus', 'binds', 'name') + _OPENED}
 
     @classmethod
     def attached(cls, described):
         """The box :meth:`describe` described, opened by another process (the runner holds it)."""
-        box = cls(described['work'], described['binds'], described['bwrap'], described.get('cpus'))
+        box = cls(described['work'], described['binds'], described['bwrap'], described.get('cpus'),
+                  described.get('name', 'box'))
         for name in _OPENED:
             setattr(box, name, described.get(name, getattr(box, name)))
         return box
@@ -151,7 +155,8 @@ class Box(object):
                                            self.uid if root else None, WORK_BYTES)  # unsandboxed: a copy, a HOME
         if not root and not self.bwrap:
             return self
-        name = 'exam-box-%d' % self.slot if root else 'exam-box-%d-%s' % (self.owner, os.path.basename(self.work))
+        name = 'exam-box-%d' % self.slot if root else 'exam-box-%d-%s%s' % (
+            self.owner, os.path.basename(self.work), '' if self.name == 'box' else '-' + self.name)
         self.cgroups = cgroups.make_cgroups(name, MEMORY_BYTES, BOX_SHARES, PROCESSES, self.cpus)
         if root:
             self.judge_cgroups = cgroups.judge_cgroups(self.slot)

@@ -8,7 +8,8 @@ import fcntl
 import os
 import pwd
 import signal
-import time
+
+from exam_lab.harness.wait import wait_until
 
 #: First uid of the boxes (isolate uses 60000+); slot N runs as BOX_UID_BASE + N.
 BOX_UID_BASE = 61000
@@ -103,9 +104,6 @@ def end_uid(uid):
                 os.kill(pid, signal.SIGKILL)
             except OSError:
                 pass
-        deadline = time.monotonic() + 5.0
-        while time.monotonic() < deadline and pids_of_uid(uid):
-            time.sleep(0.05)
-        if not pids_of_uid(uid):
+        if wait_until(lambda: not pids_of_uid(uid), 5.0, period=0.05):
             break
     return len(left)

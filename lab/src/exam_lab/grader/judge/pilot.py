@@ -147,15 +147,18 @@ class Flight(object):
     input's change) moves the drone, ``recorder`` reads the node's own value (None when it cannot be
     read), ``drone.service`` the calls it made, ``graph`` whether it still runs."""
 
-    def __init__(self, plan, fly, recorder, drone, graph):
+    def __init__(self, plan, fly, recorder, drone, graph, late_warning=None):
         self.plan, self.fly, self.recorder, self.drone, self.graph = plan, fly, recorder, drone, graph
+        #: s a late WARNING is waited for, asked again as the wait goes (the threshold run flown beside
+        #: the main run learns the main run's latency during its flight: :class:`~.probe.MainWord`).
+        self.late_warning = late_warning or (lambda: plan.late_warning)
 
     def leg(self, x, side, hold, late=0.0, late_from=None):
         """Fly at ``x`` for ``hold`` s counted from the node's own first value on ``side`` (the input's
         change when the output cannot be read, or when that value never comes within REACH_S); with
         ``late``, keep flying while the node still owes this side's call (:func:`owes`), up to ``late``
         s after ``late_from`` (default: that first value). Returns ``(the input's change, that first
-        value's time)``."""
+        value's time)``. ``late`` may be a function, asked on every look: the bound as it is known now."""
         since = self.fly(x)
         start = since
         if self.recorder is not None:
@@ -164,10 +167,11 @@ class Flight(object):
                                                if on_side(v, threshold, side)), None), REACH_S, period=0.05)
             start = reached if reached is not None else since
         time.sleep(max(0.0, start + hold - time.time()))
-        deadline = (start if late_from is None else late_from) + late
-        if late > 0 and deadline > time.time():
-            wait_until(lambda: not owes(self.drone.service.calls(), side, since) or not self.graph.student_nodes(),
-                       deadline - time.time(), period=0.1)
+        bound = late if callable(late) else (lambda: late)
+        begin = start if late_from is None else late_from
+        if bound() > 0 and begin + bound() > time.time():
+            wait_until(lambda: not owes(self.drone.service.calls(), side, since) or not self.graph.student_nodes()
+                       or time.time() >= begin + bound(), begin + bound() - time.time(), period=0.1)
         return since, start
 
     def fly_legs(self, lo, hi, near):
@@ -175,7 +179,7 @@ class Flight(object):
         change, and the end), ``legs`` (each checked on the node's own values) and, when the output
         could be read, ``rate`` (how often the node published during the flight)."""
         delay = self.plan.delay
-        late = self.plan.late_warning
+        late = self.late_warning
         late_normal = normal_wait(delay, self.drone.rates)
         schedule = {}
         schedule['rest'] = self.leg(lo, 'below', REST_S, late_normal)[0]

@@ -14,7 +14,7 @@ Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of que
 scenario around the threshold drawn for it), ``sheet``, ``threshold`` (student units), ``margin`` (how
 far beyond the threshold to fly), ``delay`` (s), ``start_timeout`` (s to wait for the node),
 ``late_warning`` (s a late WARNING is waited for, 0 for none); for "threshold" also ``warn_after``
-(s the main run's WARNING took).
+(s the main run's WARNING took) or, flown beside the main run, ``main_word`` (:class:`MainWord`).
 
 Every time is the wall clock's (``time.time()``), never rospy's ROS time: a student's node can set
 ``/use_sim_time`` on the master before the probe's ``init_node`` and publish ``/clock``, and rospy would
@@ -89,11 +89,10 @@ class Probe(object):
         the long excursion, not the late window."""
         warn_after = self.plan.warn_after
         if warn_after is not None:
-            self.plan = self.plan.replaced(late_warning=min(self.plan.late_warning,
-                                                            max(warn_after, self.plan.delay) + AFTER_S))
-        self.main_flight()
+            self.plan = self.plan.replaced(late_warning=late_bound(self.plan, warn_after))
+        self.main_flight(MainWord(self.plan).late_warning if self.plan.main_word else None)
 
-    def main_flight(self):
+    def main_flight(self, late_warning=None):
         """The scenario's steps 1 to 4: a step whose node, or whose readable output, is missing ends it."""
         # Inputs from the start: a node that waits for data before it subscribes to the rest still runs.
         self.inputs.fly(self.plan.threshold - self.plan.margin)
@@ -107,7 +106,7 @@ class Probe(object):
         if self.result['output']['topic'] is not None and self.recorder is not None:
             self.result['formula'], points = calibration.formula()
         self.result['calibration'], (lo, hi, near) = calibration.calibrate(points)
-        flight = Flight(self.plan, self.inputs.fly, self.recorder, self.drone, self.graph)
+        flight = Flight(self.plan, self.inputs.fly, self.recorder, self.drone, self.graph, late_warning)
         self.result.update(flight.fly_legs(lo, hi, near))
 
     def run(self):
@@ -132,6 +131,37 @@ class Probe(object):
         published = self.recorder.samples(self.t0) if self.recorder is not None else []
         self.result['trace'] = trace(published, self.inputs.flown)
         return self.result
+
+
+def late_bound(plan, warn_after):
+    """s the threshold run waits for a late WARNING when the main run's took ``warn_after`` s: as long,
+    no longer (and never past the plan's own ``late_warning``)."""
+    return min(plan.late_warning, max(warn_after, plan.delay) + AFTER_S)
+
+
+class MainWord(object):
+    """What the main run, flown beside this threshold run, says of its WARNING: the session writes
+    ``{"warned": whether it warned in its long excursion, "warn_after": its latency (s) or null}`` in
+    the plan's ``main_word`` once the main run's result is in (or the main run ended without one). Until
+    then the threshold run waits for a late WARNING as the main run does (the plan's ``late_warning``);
+    then as long as the main run's took (:func:`late_bound`), or not at all when the main run never
+    warned (the threshold run is then not scored)."""
+
+    def __init__(self, plan):
+        self.plan, self.said = plan, None
+
+    def late_warning(self):
+        if self.said is None and os.path.isfile(self.plan.main_word):
+            try:
+                with open(self.plan.main_word) as f:
+                    self.said = json.load(f)
+            except (OSError, ValueError):
+                pass
+        if self.said is None:
+            return self.plan.late_warning
+        if not self.said.get('warned') or not isinstance(self.said.get('warn_after'), (int, float)):
+            return 0.0
+        return late_bound(self.plan, self.said['warn_after'])
 
 
 #: Most seconds the probe keeps the drone up after writing its result, waiting to be stopped.

@@ -227,13 +227,15 @@ class PlanRecord(Record):
     start, the output topic expected, how long a late WARNING is waited for (``late_warning``; 0 when
     the code calls no service). Made by :func:`exam_lab.grader.runner.plan_job`; for the threshold run
     the session adds the main run's calibration (``fit``) and the node's WARNING latency
-    (``warn_after``)."""
+    (``warn_after``), or, when the two runs fly side by side, the file where it will say what the main
+    run's WARNING took (``main_word``: :class:`~exam_lab.grader.judge.probe.MainWord`)."""
     FILE = 'plan.json'
     MAX_BYTES = 1 << 16
     SCHEMA = {
         'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
         'margin': Number(0), 'delay': Number(0), 'start_timeout': Number(0), 'output': _NAME,
         'late_warning': Number(0), 'fit': Optional(Maybe(Row(_VALUE, _VALUE))), 'warn_after': Optional(Maybe(Number())),
+        'main_word': Optional(_PATH),
     }
 
 
@@ -241,7 +243,8 @@ class PlanRecord(Record):
 #: (:meth:`exam_lab.grader.host.sandbox.Box.describe`).
 _BOX = {'work': _PATH, 'bwrap': bool, 'cpus': Maybe(Number(0, 4096)), 'binds': [_PATH],
         'slot': Maybe(Number(0, 1e6, integer=True)), 'cgroups': [_PATH], 'judge_cgroups': Map(Text(50), [_PATH], 10),
-        'rootless': bool, 'owner': Maybe(Number(0, 2 ** 32, integer=True)), 'netns': Maybe(Text(200))}
+        'rootless': bool, 'owner': Maybe(Number(0, 2 ** 32, integer=True)), 'netns': Maybe(Text(200)),
+        'name': Optional(OneOf('box', 'box-twin'))}
 
 
 class JobRecord(Record):
@@ -250,13 +253,16 @@ class JobRecord(Record):
     launch file as handed in (for roslaunch's check). :func:`~exam_lab.grader.runner.plan_job` makes it
     from the inspection, the launch files relative to the workspace;
     :func:`~exam_lab.grader.runner.run_session` adds where the session runs (``workspace``, the
-    ``underlay``, the folders, the ``box``) and the student's ``budget``, the launch files then absolute."""
+    ``underlay``, the folders, the ``box``) and the student's ``budget``, the launch files then absolute;
+    with ``side_by_side``, the two runs fly at once, the threshold run in a ``box`` and a ``judge_home``
+    of its own."""
     FILE = 'job.json'
     MAX_BYTES = 1 << 20
     SCHEMA = {
         'namespace': Text(1000), 'build_timeout': Number(0), 'run_timeout': Number(0),
-        'runs': Items({'tag': OneOf('main', 'threshold'), 'launch': _PATH, 'plan': PlanRecord.SCHEMA}, 2),
-        'handed_in_launch': Maybe(_PATH),
+        'runs': Items({'tag': OneOf('main', 'threshold'), 'launch': _PATH, 'plan': PlanRecord.SCHEMA,
+                       'box': Optional(_BOX), 'judge_home': Optional(_PATH)}, 2),
+        'handed_in_launch': Maybe(_PATH), 'side_by_side': Optional(bool),
         'workspace': Optional(_PATH), 'underlay': Optional(_PATH), 'log_dir': Optional(_PATH),
         'judge_home': Optional(_PATH), 'box': Optional(_BOX), 'budget': Optional(Number()),
         'student_budget': Optional(Number(0)),

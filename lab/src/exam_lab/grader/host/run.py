@@ -1,0 +1,308 @@
+"""One run of a submission: a master, the student's launch in its box, the probe beside it; what its
+output and the probe's result say (:func:`run_one`), within what is left of the student's budget
+(:class:`Budget`). Root's side: it reads roslaunch's output and the probe's JSON, both capped, and
+parses no byte of the student's. :mod:`~exam_lab.grader.host.session` flies the runs of a session one
+after the other, :mod:`~exam_lab.grader.host.side_by_side` both at once.
+"""
+import json
+import os
+import re
+import sys
+import time
+
+from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
+from exam_lab.grader.contract import read_capped, read_record
+from exam_lab.grader.score.records import MAX_ENDED, MAX_LOG_TEXT, PlanRecord, ProbeRecord, RecordError
+from exam_lab.grader.score.safe_text import clean as clean_text
+from exam_lab.grader.score.sheets import request_meaning
+from exam_lab.harness.supervisor import ros_env, workspace_env
+from exam_lab.harness.wait import wait_until
+
+#: roslaunch's words for a node that ended: "[exam-1] process has died [pid 12, exit code 1, ...]";
+#: a required node's death is announced as "REQUIRED process [exam-1] has died!" first.
+_ENDED = re.compile(r'(?:\[([^\]\s]+)\] )?process has (died|finished cleanly)(?: \[pid \d+, (exit code -?\d+))?')
+_REQUIRED = re.compile(r'REQUIRED process \[([^\]]+)\] has died')
+#: Lines of the roslaunch log that say a node could not even be started.
+_NOT_STARTED = re.compile(r'^(ERROR: cannot launch node.*|RLException:.*|.*Invalid roslaunch XML.*)$', re.M)
+#: roslaunch's own chatter, left out of what the teacher reads.
+_CHATTER = re.compile(r'^(\.\.\. |Checking log|Press Ctrl-C|Done checking|started roslaunch|SUMMARY|=+|PARAMETERS|NODES'
+                      r'| \* /|  /|    \S+ \(|auto-starting|setting /run_id|process\[|ROS_MASTER_URI|\[\S+\] killing'
+                      r'|shutting down|done$|log file:|Initiating shutdown|all processes on machine|$)')
+#: Lines kept of a log for the teacher (its last MAX_LOG_TEXT characters at most: one line may be long).
+TAIL_LINES = 25
+
+
+def tail(text, lines=TAIL_LINES):
+    return '\n'.join(text.rstrip().splitlines()[-lines:])[-MAX_LOG_TEXT:]
+
+
+def clean(output):
+    """roslaunch's output without control characters (its colours and titles, a node's escape
+    sequences) and without its own chatter: what the nodes printed, and roslaunch's words about them."""
+    kept = []
+    for line in clean_text(output).splitlines():
+        if not _CHATTER.match(line.strip('=')) or 'process has' in line:
+            kept.append(line.strip('=') if line.startswith('=') else line)
+    return '\n'.join(kept)
+
+
+def launch_outcome(output, workspace=None):
+    """What roslaunch's output says about the student's nodes: ended ones and start failures.
+    Paths inside ``workspace`` are shown relative to its src/ (``exam/scripts/...``)."""
+    if workspace:
+        output = output.replace(workspace.rstrip('/') + '/src/', '').replace(workspace.rstrip('/'), '<ws>')
+    text = clean_text(output)
+    ended, required = [], None
+    for line in text.splitlines():
+        match = _REQUIRED.search(line)
+        if match:
+            required = match.group(1)
+        match = _ENDED.search(line)
+        if match:
+            ended.append({'node': match.group(1) or required or '?', 'how': match.group(2),
+                          'detail': match.group(3) or ''})
+    # A node respawned in a loop is reported ended as often: its first MAX_ENDED ends say it.
+    return {'ended': ended[:MAX_ENDED - WATCHED_DEATHS], 'not_started': [line[:500] for line in _NOT_STARTED.findall(text)[:50]],
+            'tail': tail(clean(output))}
+
+
+#: The most deaths of one run the judge's watch reports.
+WATCHED_DEATHS = 20
+
+
+def watched_deaths(probe):
+    """The deaths the probe's :class:`~exam_lab.grader.judge.graph.NodeWatch` saw (a node started again
+    or gone during the run) in its record (a :class:`~exam_lab.grader.score.records.ProbeRecord`'s
+    value: checked, its text clean), as entries of :func:`launch_outcome`'s ``ended``: they cost what a
+    death in roslaunch's words costs, and they are the judge's own, whatever roslaunch's log kept."""
+    return [{'node': d['node'][:100], 'how': 'died', 'detail': 'seen by the judge: %s' % d['detail'][:200]}
+            for d in probe['node_watch']['deaths'][:WATCHED_DEATHS]]
+
+
+def warned_in_long_excursion(probe):
+    """True when the main run saw a WARNING call while the value was above the threshold for long."""
+    schedule = (probe or {}).get('schedule') or {}
+    if 'long_up' not in schedule:
+        return False
+    return any(request_meaning(status) == 'WARNING' and schedule['long_up'] <= t <= schedule['long_down']
+               for t, status in probe.get('calls', []))
+
+
+def clock_problem(clock):
+    """Why a run whose probe saw ``clock`` (its ``ClockWatch``) is not the judge's to measure, or None:
+    someone set ``/use_sim_time`` or published ``/clock`` (the node under test counting on a clock of
+    its own making; the probe times on the wall clock regardless)."""
+    if not isinstance(clock, dict):
+        return 'the probe did not say whether /clock was published'
+    said = []
+    if any(clock.get('use_sim_time') or []):
+        said.append('/use_sim_time was set on the master')
+    if clock.get('messages') or clock.get('publishers'):
+        said.append('/clock was published (%s messages%s)' % (
+            clock.get('messages', 0),
+            ' by %s' % ', '.join(map(str, clock['publishers'])) if clock.get('publishers') else ''))
+    if said:
+        return '%s: the grader times the node on the wall clock only; grade it by hand' % ' and '.join(said)
+    return None
+
+
+def probe_problem(result, started, finished, *, kind, delay):
+    """Why the probe's ``result`` cannot be this run's measurement, or None: it has times, nobody set
+    the time (:func:`clock_problem`), every time it records (wall clock) must lie between the probe's
+    start and the result's arrival, and the flight must have lasted its schedule (in a ``kind``
+    'main' run, the long excursion at least the rule's ``delay``)."""
+    schedule = result.get('schedule') or {}
+    times = [t for t in [result.get('t0')] + list(schedule.values()) if isinstance(t, (int, float))]
+    if not times:
+        return 'the probe\'s result has no times'
+    problem = clock_problem(result.get('clock'))
+    if problem:
+        return problem
+    if min(times) < started - 1.0 or max(times) > finished + 1.0:
+        return 'the probe\'s times (%.1f to %.1f) are not within its run (%.1f to %.1f)' % (
+            min(times), max(times), started, finished)
+    if kind == 'main' and 'long_up' in schedule and 'long_down' in schedule \
+            and schedule['long_down'] - schedule['long_up'] < delay:
+        return 'the long excursion lasted %.1f s, less than the %.1f s delay' % (
+            schedule['long_down'] - schedule['long_up'], delay)
+    return None
+
+
+def warning_latency(probe):
+    """Seconds from the long excursion's start to the main run's first WARNING in it, or None."""
+    schedule = (probe or {}).get('schedule') or {}
+    times = [t for t, status in (probe or {}).get('calls', []) if request_meaning(status) == 'WARNING'
+             and schedule.get('long_up', float('inf')) <= t <= schedule.get('long_down', 0.0)]
+    return min(times) - schedule['long_up'] if times else None
+
+
+def capped_log(sup, name):
+    """What a process of the box printed, its middle cut beyond twice LOG_PART (:func:`read_capped`):
+    the orchestrator never reads more of what the student wrote."""
+    return read_capped(sup.log(name)) or ''
+
+
+def uid_of(pid):
+    """The real uid of the living process ``pid``, or None."""
+    try:
+        with open('/proc/%d/status' % pid) as f:
+            return int(next(line for line in f if line.startswith('Uid:')).split()[1])
+    except (OSError, StopIteration, ValueError, IndexError):
+        return None
+
+
+#: Seconds of the budget a run keeps for its end (roslaunch's, the probe's and the master's grace
+#: periods), a build or a check for its own (the kill at its limit, the box's end).
+RUN_STOP_S = 30.0
+STEP_STOP_S = 5.0
+#: The least seconds a run is started with (the master's start, the node's registration).
+MIN_RUN_S = 30.0
+
+
+def budget_sentence(total, what):
+    """The teacher's sentence for a grading that used up its budget of ``total`` s in ``what``."""
+    return ('its grading used up its budget of %.0f s (the most one student\'s grading may take, inspection, '
+            'build and runs together): %s' % (total, what))
+
+
+class Budget(object):
+    """What is left of the student's grading budget: ``seconds`` from the session's start (the runner's
+    share of ``total``, the student's whole budget). Each step's limit is its own or what is left,
+    whichever is less (:meth:`limit`); the first step the budget stopped or left out is :attr:`used`,
+    the sentence the teacher reads."""
+
+    def __init__(self, seconds, total, clock=time.monotonic):
+        self.clock, self.total = clock, total
+        self.deadline = clock() + seconds
+        self.used = None
+
+    def left(self, keep=0.0):
+        """Seconds left once ``keep`` s are kept back for stopping the step."""
+        return max(0.0, self.deadline - keep - self.clock())
+
+    def limit(self, cap, keep):
+        """``(limit, by_budget)``: the time limit of a step whose own limit is ``cap`` s."""
+        left = self.left(keep)
+        return (left, True) if left < cap else (cap, False)
+
+    def spend(self, what):
+        """Note that the budget ended ``what`` (the first such step is kept); returns the sentence."""
+        sentence = budget_sentence(self.total, what)
+        self.used = self.used or sentence
+        return sentence
+
+
+def master_problem(master, died):
+    """Why a run whose master ended early (``died``) or hit its memory bound (``master``: the cgroup's
+    :func:`~exam_lab.grader.host.cgroups.memory_use`) is not one to score, or None."""
+    memory = master.get('memory') or {}
+    if memory.get('oom_kills'):
+        return ('the master the node talks to went over its memory bound of %d MB (%d process(es) killed): '
+                'the node\'s parameters or messages filled it' % ((memory.get('limit') or 0) >> 20, memory['oom_kills']))
+    if died:
+        return 'the master the node talks to ended during the run'
+    return None
+
+
+def run_one(sup, job, run, base_env, box, budget):
+    """Start a master, the student's launch (in the box) and the probe; return the run's record. The
+    probe is waited for at most the run's limit or what is left of the ``budget``. The judge's folder
+    is the run's own (``run['judge_home']``) when it has one, else the job's."""
+    tag = run['tag']
+    log_dir, judge_dir = sup.log_dir, run.get('judge_home') or job.judge_home
+    reset_memory_peak(box.judge_cgroups.get('master', []))
+    killed_before = (memory_use(box.judge_cgroups.get('master', [])) or {}).get('oom_kills', 0)
+    master = sup.start_master(name='master-%s' % tag, wrap=box.judge_argv([], 'master'),
+                              timeout=max(1.0, min(30.0, budget.left(RUN_STOP_S))))
+    record = {'tag': tag, 'probe': None, 'master': {'uid': uid_of(master.proc.pid)}}
+    launch_env = ros_env(base_env, master.uri, os.path.join(box.home, 'ros-%s' % tag), ip='127.0.0.1')
+    launch = sup.start('launch-%s' % tag, box.argv(
+        ['bash', '-c', 'source "$1/devel/setup.bash" && exec roslaunch --screen "$2"', 'bash',
+         job.workspace, run['launch']], launch_env))
+    plan_path = os.path.join(judge_dir, 'plan-%s.json' % tag)
+    result_path = os.path.join(judge_dir, 'probe-%s.json' % tag)
+    plan = PlanRecord.make(run['plan'])
+    for path in (plan_path, os.path.join(log_dir, 'plan-%s.json' % tag)):  # the judge's, and the progress's
+        with open(path, 'w') as f:
+            f.write(plan.to_json())
+    probe_env = ros_env(master.env, master.uri, os.path.join(judge_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')
+    probe_env['ROS_NAMESPACE'] = job.namespace or '/'
+    started, started_wall = time.monotonic(), time.time()
+    probe = sup.start('probe-%s' % tag, box.judge_argv(
+        [sys.executable, '-m', 'exam_lab.grader.judge.probe', plan_path, result_path], 'probe'), probe_env)
+    # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
+    # nothing it does when its drone goes away (a failed service call, a crash) is counted.
+    limit, by_budget = budget.limit(job.run_timeout, RUN_STOP_S)
+    wait_until(lambda: os.path.isfile(result_path) or probe.poll() is not None or master.proc.poll() is not None,
+               limit, period=0.1)
+    record['seconds'] = time.monotonic() - started
+    if by_budget and not os.path.isfile(result_path) and probe.poll() is None:
+        record['budget'] = budget.spend('the %s run was stopped after %.0f s' % (tag, record['seconds']))
+    record['probe_uid'] = uid_of(probe.pid)  # lingering: its uid is the one it measured as
+    record['launch_running'] = launch.poll() is None
+    master_died = master.proc.poll() is not None
+    # Read before stopping: what the nodes print when the grader stops them is not their doing.
+    record['launch'] = launch_outcome(capped_log(sup, 'launch-%s' % tag), job.workspace)
+    sup.stop(launch)
+    record['survivors'] = box.end()
+    if os.path.lexists(result_path):
+        record['probe'], why = probe_record(result_path)
+        if why:
+            record['probe_error'] = why
+    if record['probe'] is not None:
+        record['launch']['ended'].extend(watched_deaths(record['probe']))  # whether or not the run is refused
+        with open(os.path.join(log_dir, 'probe-%s.json' % tag), 'w') as f:
+            json.dump(record['probe'], f, indent=1, sort_keys=True)
+        problem = probe_problem(record['probe'], started_wall, time.time(), kind=plan.kind, delay=plan.delay)
+        if problem:
+            refuse(record, problem)
+    elif 'probe_error' not in record and record.get('budget'):
+        record['probe_error'] = record['budget']
+    elif 'probe_error' not in record:
+        record['probe_error'] = ('no result within the run\'s time limit (%.0f s); ' % job.run_timeout
+                                 if probe.poll() is None else
+                                 'exit %s; ' % probe.poll()) + tail(sup.output('probe-%s' % tag), 15)
+    record['probe_status'] = sup.stop(probe, grace=5.0)
+    sup.stop(master.proc)
+    record['master']['memory'] = memory_use(box.judge_cgroups.get('master', []))
+    if record['master']['memory']:  # this run's kills: the slot's master cgroup serves every run
+        record['master']['memory']['oom_kills'] -= killed_before
+    problem = master_problem(record['master'], master_died)
+    if problem:
+        refuse(record, problem)
+    return record
+
+
+def probe_record(path):
+    """``(value, None)``: the probe's result in ``path`` as a checked
+    :class:`~exam_lab.grader.score.records.ProbeRecord`'s value (its text clean); ``(None, why)`` when
+    it is not one (too large, not JSON, a key or value the probe never writes): the run's crash, said
+    so, never data."""
+    try:
+        return read_record(path, ProbeRecord, ProbeRecord.MAX_BYTES).value, None
+    except RecordError as err:
+        return None, 'the probe\'s result was refused (a crash of the run): %s' % err
+
+
+def refuse(record, problem):
+    """A run's result that is not its measurement (``problem``: why): the rubric sees no probe; the
+    result stays in the record as ``refused_probe`` (the teacher's flight plot draws it)."""
+    if record['probe'] is not None:
+        record['refused_probe'] = record['probe']
+    record['probe'], record['probe_refused'] = None, problem
+    record['probe_error'] = 'result refused: %s' % problem
+
+
+def judge_environment(judge_dir, box):
+    """The judge's environment: the grader's, with a HOME and ROS folders of its own the box cannot
+    see, in ``judge_dir``, made the judge's own (0700, its uid's), where it writes as its uid."""
+    if box.judge_uid is not None:
+        os.chown(judge_dir, box.judge_uid, box.judge_uid)
+    os.chmod(judge_dir, 0o700)
+    return dict(os.environ, ROS_IP='127.0.0.1', HOME=judge_dir, PYTHONNOUSERSITE='1',
+                ROS_LOG_DIR=os.path.join(judge_dir, 'ros_log'), ROS_HOME=os.path.join(judge_dir, 'ros_home'))
+
+
+def base_environment(job):
+    """The box's environment before the student's setup is sourced: the underlay's."""
+    return workspace_env(job.underlay, {'PATH': os.environ.get('PATH', '/usr/bin:/bin'), 'LANG': 'C.UTF-8'})
