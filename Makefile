@@ -28,11 +28,11 @@ help:
 	@echo "make fairness [JOBS=n] [OUT=<dir>]  the grader on generated student answers (40 correct, 36 one-mistake,"
 	@echo "                    both sheets) as one class; its report into docs/grading.md (about 30 min)"
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
-	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv> [WORKSHEET_SCALE=1]] [ENGINE=local|slurm] [SLURM_ARGS='...']"
+	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv>] [ENGINE=local|slurm] [SLURM_ARGS='...']"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
 	@echo "make rescore OUT=<dir> [WORKSHEET=...]  today's rubric on a run's kept measurements (seconds, no ROS)"
-	@echo "make worksheet OUT=<dir> WORKSHEET=<Moodle grading worksheet.csv>"
-	@echo "                    the whole grade (machine + OUT/hand.csv) into the worksheet, on its scale"
+	@echo "make worksheet OUT=<dir> [WORKSHEET=<Moodle grading worksheet.csv>]"
+	@echo "                    the whole grades (machine + OUT/hand.csv, scaled) into OUT/moodle-worksheet.csv"
 	@echo "make check PACKAGE=<dir|zip> [SHEET=altitude|depth]"
 	@echo "                    a student's own check of their package, as an ordinary user (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
@@ -81,24 +81,24 @@ fairness: build
 	@$(ENV) && exec python3 lab/scripts/fairness.py $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)")
 
 # make grade SUBMISSION=<dir or zip> | CLASS=<dir or zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]
-#            [WORKSHEET=<Moodle's offline grading worksheet, filled into OUT>]
+#            [WORKSHEET=<Moodle's offline grading worksheet: kept in OUT, filled with the whole grades>]
 #            [ENGINE=slurm: one Slurm array task per student] [SLURM_ARGS=<sbatch's options, e.g. --partition=x>]
 grade: build
 	@$(ENV) && exec python3 lab/scripts/grade.py \
 	  $(if $(SUBMISSION),--submission "$(SUBMISSION)") $(if $(CLASS),--class "$(CLASS)") \
 	  $(if $(SHEET),--sheet "$(SHEET)") $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)") \
-	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") $(if $(WORKSHEET_SCALE),--worksheet-scale) \
+	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") \
 	  $(if $(ENGINE),--engine "$(ENGINE)") $(if $(SLURM_ARGS),--slurm-args "$(SLURM_ARGS)")
 
 # make rescore OUT=<make grade's OUT> [WORKSHEET=...]: today's rubric on the measurements the run kept
 rescore: build
-	@$(ENV) && exec python3 lab/scripts/rescore.py --out "$(OUT)" $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") \
-	  $(if $(WORKSHEET_SCALE),--worksheet-scale)
+	@$(ENV) && exec python3 lab/scripts/rescore.py --out "$(OUT)" $(if $(WORKSHEET),--worksheet "$(WORKSHEET)")
 
-# make worksheet OUT=<make grade's OUT> WORKSHEET=<Moodle's worksheet>: the machine's and the hand points
-# (OUT/hand.csv, filled by the teacher) as one grade on the worksheet's scale
+# make worksheet OUT=<make grade's OUT> [WORKSHEET=<Moodle's worksheet; default: the one kept in OUT>]: the
+# machine's and the hand points (OUT/hand.csv, filled by the teacher) as one grade on the worksheet's scale,
+# into OUT/moodle-worksheet.csv, the file to upload
 worksheet: build
-	@$(ENV) && exec python3 lab/scripts/worksheet.py --out "$(OUT)" --worksheet "$(WORKSHEET)"
+	@$(ENV) && exec python3 lab/scripts/worksheet.py --out "$(OUT)" $(if $(WORKSHEET),--worksheet "$(WORKSHEET)")
 
 # make check PACKAGE=<dir or zip> [SHEET=altitude|depth]: a student's own check, without root or sudo.
 # It builds the workspace but installs nothing: a student's machine has ROS already, not the teacher's tools.
