@@ -1,0 +1,160 @@
+"""Every command README.md and docs/*.md give runs as pasted (issue 49 point 2).
+
+Each shell block (```sh, ```bash, ```shell; in a console block each ``$ `` line) is read by
+``bash -n`` (its syntax), searched for a comment after a line continuation (``\\ # ...``: bash then
+ends the command there and runs the next line on its own: README's Noetic install once never
+installed chromium nor poppler that way), and each ``make`` it runs is checked against the Makefile:
+its targets are the Makefile's, and each ``VAR=value`` one the Makefile reads. Each check is shown
+failing on a planted error first.
+"""
+import glob
+import os
+import re
+import shlex
+import subprocess
+
+import pytest
+
+REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), '..', '..', '..'))
+DOCS = [os.path.join(REPO, 'README.md')] + sorted(glob.glob(os.path.join(REPO, 'docs', '*.md')))
+SHELL = ('sh', 'bash', 'shell')
+_FENCE = re.compile(r'^(?P<indent>[ >]*)```(?P<lang>[\w-]*)\s*$')
+#: Variables make itself gives meaning to on its command line (GNU make's manual, "Overriding").
+MAKE_OWN = {'SHELL', 'MAKEFLAGS'}
+
+
+def _read(path):
+    with open(path, encoding='utf-8') as f:
+        return f.read()
+
+
+def blocks(text):
+    """``[(first line number, language, text)]`` of the fenced blocks of a Markdown ``text``, each
+    line without the block's indent or quote marks."""
+    found, lines, i = [], text.splitlines(), 0
+    while i < len(lines):
+        opened = _FENCE.match(lines[i])
+        if not opened:
+            i += 1
+            continue
+        indent, body, start = len(opened.group('indent')), [], i + 1
+        i += 1
+        while i < len(lines) and not _FENCE.match(lines[i]):
+            body.append(lines[i][indent:] if len(lines[i]) >= indent else '')
+            i += 1
+        found.append((start + 1, opened.group('lang'), '\n'.join(body) + '\n'))
+        i += 1
+    return found
+
+
+def shell_of(language, text):
+    """The shell a block holds: a shell block whole, a console block's ``$ `` lines; else None."""
+    if language in SHELL:
+        return text
+    if language == 'console':
+        commands = [line[2:] for line in text.splitlines() if line.startswith('$ ')]
+        return '\n'.join(commands) + '\n' if commands else None
+    return None
+
+
+def makefile_rules(path=os.path.join(REPO, 'Makefile')):
+    """``(targets, variables)`` of the Makefile: every rule's target, every ``$(VAR)`` it reads."""
+    text = _read(path)
+    targets = set(re.findall(r'^([A-Za-z][\w.-]*)\s*:(?!=)', text, re.M))
+    variables = set(re.findall(r'\$\((\w+)\)', text)) | set(re.findall(r'^(\w+)\s*[?:]?=', text, re.M))
+    return targets, variables
+
+
+def make_calls(script):
+    """Each ``make`` a script runs: ``[[word, ...]]``, its words after ``make`` up to the command's end
+    (line continuations joined)."""
+    calls = []
+    joined = re.sub(r'\\\n', ' ', script)
+    for line in joined.splitlines():
+        line = re.sub(r'(^|\s)#.*$', '', line)
+        try:
+            lexer = shlex.shlex(line, posix=True, punctuation_chars=True)
+            lexer.whitespace_split = True
+            words = list(lexer)
+        except ValueError:
+            continue  # bash -n says what is wrong with it
+        command = []
+        for word in words + [';']:
+            if word and set(word) <= set(';&|()'):
+                if command:
+                    calls.append(command)
+                command = []
+            elif command or word == 'make':
+                command.append(word)
+    return [call[1:] for call in calls if call and call[0] == 'make']
+
+
+def problems(script, rules=None):
+    """What is wrong with a shell ``script`` as pasted, one line each ([] when nothing is)."""
+    targets, variables = rules or makefile_rules()
+    found = []
+    checked = subprocess.run(['bash', '-n'], input=script.encode('utf-8'), stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE)
+    if checked.returncode != 0:
+        found.append('bash -n: %s' % checked.stderr.decode('utf-8', 'replace').strip().replace('\n', '; '))
+    for number, line in enumerate(script.splitlines(), 1):
+        if re.search(r'\\[ \t]+#', line):
+            found.append('line %d: a comment after a line continuation ends the command there: %s'
+                         % (number, line.strip()))
+    for call in make_calls(script):
+        for word in call:
+            if word.startswith('-'):
+                continue
+            name = word.split('=', 1)[0] if '=' in word else None
+            if name is None and word not in targets:
+                found.append('make %s: no such target in the Makefile' % word)
+            elif name is not None and name not in variables | MAKE_OWN:
+                found.append('make ... %s=: the Makefile reads no variable %s' % (name, name))
+    return found
+
+
+def all_scripts():
+    for path in DOCS:
+        for line, language, text in blocks(_read(path)):
+            script = shell_of(language, text)
+            if script is not None:
+                yield '%s:%d' % (os.path.relpath(path, REPO), line), script
+
+
+SCRIPTS = list(all_scripts())
+
+
+def test_the_docs_have_shell_blocks_to_check():
+    where = {name.split(':')[0] for name, _ in SCRIPTS}
+    assert {'README.md', 'docs/grading.md', 'docs/report.md', 'docs/operations.md'} <= where, where
+    assert sum(len(make_calls(s)) for _, s in SCRIPTS) >= 10
+
+
+@pytest.mark.parametrize('where,script', SCRIPTS, ids=[name for name, _ in SCRIPTS])
+def test_every_shell_block_runs_as_pasted(where, script):
+    assert problems(script) == [], where
+
+
+def test_the_check_catches_each_kind_of_error():
+    rules = ({'grade', 'rescore'}, {'OUT', 'CLASS'})
+    assert problems('make grade CLASS=a.zip\nmake rescore OUT="a b"\n', rules) == []
+    assert len(problems('if true; then echo\n', rules)) == 1  # never closed: bash -n
+    noetic = 'sudo apt install a \\\n  b \\  # a comment\n  c\n'
+    assert problems(noetic, rules) == [
+        'line 2: a comment after a line continuation ends the command there: b \\  # a comment']
+    assert problems('cd x && make grades OUT=y\n', rules) == ['make grades: no such target in the Makefile']
+    assert problems('make grade \\\n  WORKSHEET_SCALE=1\n', rules) == [
+        'make ... WORKSHEET_SCALE=: the Makefile reads no variable WORKSHEET_SCALE']
+
+
+def test_the_makefile_is_read_as_it_is():
+    targets, variables = makefile_rules()
+    assert {'grade', 'rescore', 'worksheet', 'check', 'report', 'build'} <= targets
+    assert {'OUT', 'CLASS', 'WORKSHEET', 'PACKAGE', 'SHEET', 'JOBS'} <= variables
+    assert 'WORKSHEET_SCALE' not in variables
+
+
+def test_blocks_are_found_indented_and_quoted():
+    text = 'a\n\n   ```sh\n   make grade OUT=x\n   ```\n> ```console\n> $ ls\n> out\n> ```\n'
+    assert [(lang, body) for _, lang, body in blocks(text)] == [('sh', 'make grade OUT=x\n'), ('console', '$ ls\nout\n')]
+    assert shell_of('console', '$ ls\nout\n') == 'ls\n'
