@@ -158,3 +158,76 @@ def test_blocks_are_found_indented_and_quoted():
     text = 'a\n\n   ```sh\n   make grade OUT=x\n   ```\n> ```console\n> $ ls\n> out\n> ```\n'
     assert [(lang, body) for _, lang, body in blocks(text)] == [('sh', 'make grade OUT=x\n'), ('console', '$ ls\nout\n')]
     assert shell_of('console', '$ ls\nout\n') == 'ls\n'
+
+
+def grade_json_problems(text):
+    """The keys docs/grading.md lists for grade.json against GradeRecord's schema (the record's type
+    itself): every key, nothing more, the items' keys too."""
+    from exam_lab.grader.score.kept import GradeRecord
+    found = re.search(r'^- `grade\.json`[^`]*(?:`[^`]*`[^`]*)*?`(\{"version".*?\})`', text, re.M | re.S)
+    if found is None:
+        return ['docs/grading.md lists no keys of grade.json']
+    listed = re.sub(r'\s+', ' ', found.group(1))
+    items = re.search(r'"items": \[\{([^}]*)\}\]', listed)
+    top = set(re.findall(r'"(\w+)"', listed.replace(items.group(0), '"items"') if items else listed))
+    problems = ['%s: %s' % (what, sorted(keys)) for what, keys in (
+        ('not listed', set(GradeRecord.SCHEMA) - top), ('not a key of the record', top - set(GradeRecord.SCHEMA))) if keys]
+    item_keys = set(re.findall(r'"(\w+)"', items.group(1))) if items else set()
+    if item_keys != set(GradeRecord.SCHEMA['items'].schema):
+        problems.append('the items\' keys: %s' % sorted(item_keys))
+    return problems
+
+
+def test_grade_jsons_keys_are_its_records():
+    assert grade_json_problems(_read(os.path.join(REPO, 'docs', 'grading.md'))) == []
+
+
+def test_the_grade_json_check_catches_a_key_left_out():
+    text = _read(os.path.join(REPO, 'docs', 'grading.md'))
+    assert grade_json_problems(text.replace('"graded_on"}', '"x"}')) == [
+        "not listed: ['graded_on']", "not a key of the record: ['x']"]
+
+
+def noise_free_peak_problems(text):
+    """architecture.md's noise-free peak of the default flight: equation (1) (exam/src/exam/formulas.py)
+    on the drone's own noise-free values at the flight's highest point (mydrone's FLIGHTS, atmosphere)."""
+    import sys
+    for package in ('exam', 'mydrone'):
+        path = os.path.join(REPO, package, 'src')
+        if path not in sys.path:
+            sys.path.insert(0, path)
+    from exam import formulas
+    from mydrone import atmosphere, flights
+    top = max(h for _, h in flights.FLIGHTS['default'])
+    peak = '%.1f' % formulas.altitude(atmosphere.temperature_c(top), atmosphere.pressure_pa(top))
+    quoted = re.findall(r'noise-free estimate peaks at ([\d.]+) m', text)
+    return [] if quoted == [peak] else ['quoted %s, equation (1) gives %s m at %s m' % (quoted, peak, top)]
+
+
+def test_the_noise_free_peak_is_equation_ones():
+    assert noise_free_peak_problems(_read(os.path.join(REPO, 'docs', 'architecture.md'))) == []
+    assert len(noise_free_peak_problems('its noise-free estimate peaks at 1476.6 m')) == 1
+
+
+def window_problems(text):
+    """grading.md's widths of question 14b's WARNING window and the short excursion's longest time
+    above, per sheet (altitude, depth): from the rubric's tolerances and the drones' rates."""
+    from exam_lab.fairness.generator import DRONE_RATES
+    from exam_lab.grader.score import tolerances
+    slowest = [1.0 / min(DRONE_RATES[s].values()) for s in ('altitude', 'depth')]
+    width = ['%g' % round(tolerances.WARNING_EARLY_S + max(tolerances.WARNING_LATE_S, p + 1.0 / tolerances.RATE_HZ), 2)
+             for p in slowest]
+    above = ['%g' % round(2.5 + p, 2) for p in slowest]
+    start = '%g' % (5.0 - tolerances.WARNING_EARLY_S)
+    problems = []
+    if 'the window is %s s wide on the altitude sheet, %s s on the depth sheet' % tuple(width) not in text:
+        problems.append('the window is %s s / %s s wide' % tuple(width))
+    if '(%s s / %s s < %s s, the window\'s start)' % (above[0], above[1], start) not in text:
+        problems.append('the short excursion: %s s / %s s < %s s' % (above[0], above[1], start))
+    return problems
+
+
+def test_the_windows_quoted_are_the_rubrics():
+    text = re.sub(r'\s+', ' ', _read(os.path.join(REPO, 'docs', 'grading.md')))
+    assert window_problems(text) == []
+    assert len(window_problems(text.replace('1.69 s wide', '0.8 s wide'))) == 1
