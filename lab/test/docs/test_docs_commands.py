@@ -217,12 +217,14 @@ def window_problems(text):
     slowest = [1.0 / min(DRONE_RATES[s].values()) for s in ('altitude', 'depth')]
     width = ['%g' % round(tolerances.WARNING_EARLY_S + max(tolerances.WARNING_LATE_S, p + 1.0 / tolerances.RATE_HZ), 2)
              for p in slowest]
-    above = ['%g' % round(2.5 + p, 2) for p in slowest]
+    from exam_lab.grader.judge import legs
+    above = ['%g' % round(legs.SHORT_S + p + tolerances.LAG_SLACK_S, 2) for p in slowest]  # the lag tolerance
     start = '%g' % (5.0 - tolerances.WARNING_EARLY_S)
     problems = []
     if 'the window is %s s wide on the altitude sheet, %s s on the depth sheet' % tuple(width) not in text:
         problems.append('the window is %s s / %s s wide' % tuple(width))
-    if '(%s s / %s s < %s s, the window\'s start)' % (above[0], above[1], start) not in text:
+    if 'at most %g s + the lag tolerance below (%s s / %s s < %s s, the window\'s start)' % (
+            legs.SHORT_S, above[0], above[1], start) not in text:
         problems.append('the short excursion: %s s / %s s < %s s' % (above[0], above[1], start))
     return problems
 
@@ -231,3 +233,43 @@ def test_the_windows_quoted_are_the_rubrics():
     text = re.sub(r'\s+', ' ', _read(os.path.join(REPO, 'docs', 'grading.md')))
     assert window_problems(text) == []
     assert len(window_problems(text.replace('1.69 s wide', '0.8 s wide'))) == 1
+
+
+def drone_start_problems(readme, architecture, report):
+    """The drone's first line after the command, quoted for "the report's run" and for README's run of
+    the profile example: the number each of those runs printed (report.md is made by make report from its
+    run; README's measured sentence gives its own)."""
+    flat = [re.sub(r'\s+', ' ', t) for t in (readme, architecture, report)]
+    reports = re.findall(r"the flight's time 0, ([\d.]+) s after the command", flat[2])
+    readmes = re.findall(r"the drone's first line came ([\d.]+) s after the command", flat[0])
+    if len(reports) != 1 or len(readmes) != 1:
+        return ['the runs no longer say when the drone started: %s, %s' % (reports, readmes)]
+    problems = []
+    for name, text, other in (('README.md', flat[0], r'in the run below'), ('architecture.md', flat[1], r"in the README's")):
+        quoted = re.findall(r"([\d.]+) s in the report's run, ([\d.]+) s %s" % other, text)
+        if quoted != [(reports[0], readmes[0])]:
+            problems.append('%s quotes %s, the runs say %s' % (name, quoted, (reports[0], readmes[0])))
+    return problems
+
+
+def test_the_drones_start_is_each_runs_own():
+    texts = [_read(os.path.join(REPO, p)) for p in ('README.md', 'docs/architecture.md', 'docs/report.md')]
+    assert drone_start_problems(*texts) == []
+    assert len(drone_start_problems(texts[0].replace("5.5 s in the report's run", "0.9 s in the report's run"),
+                                    *texts[1:])) == 1
+
+
+def threshold_run_problems(text):
+    """The threshold run's range docs/grading.md quotes, from score/sheets.py (LOWERED_BY, margin_of)."""
+    from exam_lab.grader.score import sheets
+    low, high = sheets.LOWERED_BY
+    top = '%g' % sheets.threshold_run_value(1300.0, 0.0)
+    bottom = '%g' % (1300.0 - high * sheets.margin_of(1300.0))
+    said = 'the threshold lowered by %g to %g margins (from %s m to %s m for 1300 m' % (low, high, top, bottom)
+    return [] if said in text else ['not said: %s' % said]
+
+
+def test_the_threshold_runs_range_is_the_sheets():
+    text = re.sub(r'\s+', ' ', _read(os.path.join(REPO, 'docs', 'grading.md')))
+    assert threshold_run_problems(text) == []
+    assert len(threshold_run_problems(text.replace('from 975 m to 780 m', 'from 1040 m to 780 m'))) == 1
