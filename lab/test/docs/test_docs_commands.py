@@ -273,3 +273,24 @@ def test_the_threshold_runs_range_is_the_sheets():
     text = re.sub(r'\s+', ' ', _read(os.path.join(REPO, 'docs', 'grading.md')))
     assert threshold_run_problems(text) == []
     assert len(threshold_run_problems(text.replace('from 975 m to 780 m', 'from 1040 m to 780 m'))) == 1
+
+
+def fairness_count_problems(makefile, grading):
+    """How many answers make fairness grades, as its help line and docs/grading.md say: the generator's
+    matrix (lab/src/exam_lab/fairness/generator.py, the script's default count)."""
+    from exam_lab.fairness import generator
+    matrix = generator.answers()
+    correct = sum(1 for a in matrix if a.mistake is None)
+    mistakes = len(matrix) - correct
+    rules = len(generator.MISTAKES)
+    said = {'Makefile': re.findall(r'generated student answers \((\d+) correct, (\d+) one-mistake', makefile),
+            'docs/grading.md': re.findall(r'grades them as one class: (\d+) correct answers.*?for each of (\d+) '
+                                          r'rules of the rubric two one-mistake', re.sub(r'\s+', ' ', grading))}
+    want = {'Makefile': [(str(correct), str(mistakes))], 'docs/grading.md': [(str(correct), str(rules))]}
+    return ['%s says %s, the generator makes %s' % (k, said[k], want[k]) for k in said if said[k] != want[k]]
+
+
+def test_the_fairness_counts_are_the_generators():
+    makefile, grading = _read(os.path.join(REPO, 'Makefile')), _read(os.path.join(REPO, 'docs', 'grading.md'))
+    assert fairness_count_problems(makefile, grading) == []
+    assert len(fairness_count_problems(makefile.replace('(42 correct', '(40 correct'), grading)) == 1
