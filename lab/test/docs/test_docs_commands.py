@@ -294,3 +294,35 @@ def test_the_fairness_counts_are_the_generators():
     makefile, grading = _read(os.path.join(REPO, 'Makefile')), _read(os.path.join(REPO, 'docs', 'grading.md'))
     assert fairness_count_problems(makefile, grading) == []
     assert len(fairness_count_problems(makefile.replace('(42 correct', '(40 correct'), grading)) == 1
+
+
+def bench_figure_problems(grading, bench):
+    """The figures docs/grading.md derives from the grader's benchmark record (lab/bench/grader.md, made
+    by grader_bench.py --record): the run's load average, the class of 60 at the default JOBS against the
+    worst case, and the Slurm course's waves of a correct student's time alone. When the benchmark runs
+    again, this test names each figure to write anew."""
+    from exam_lab.grader import class_run
+    flat = re.sub(r'\s+', ' ', grading)
+    load = re.search(r'Load average \(1, 5, 15 min\) at start ([\d.]+), [\d.]+, [\d.]+, at end ([\d.]+),', bench)
+    default = str(class_run.default_jobs(cores=2, memory=24 << 30))
+    wall = re.search(r'^\| class of 60, JOBS=%s \| (\d+) s \|' % default, bench, re.M)
+    alone = re.search(r'^\| good_student \| [\d.]+ \| (\d+) s \|$', bench, re.M)
+    if not (load and wall and alone):
+        return ['lab/bench/grader.md no longer holds the load average, the class of 60 or good_student']
+    seconds = int(alone.group(1))
+    expected = [
+        'load average %s at the start of the run, %s at its end' % load.groups(),
+        'against %.1f minutes for the class above' % (int(wall.group(1)) / 60.0),
+        'A correct student takes %d s graded alone' % seconds,
+        'about 10 x %d s = %.1f minutes once the tasks start' % (seconds, 10 * seconds / 60.0),
+        'twenty waves of %d s, %.1f minutes' % (seconds, 20 * seconds / 60.0),
+    ]
+    return ['not said (from lab/bench/grader.md): %s' % e for e in expected if e not in flat]
+
+
+def test_the_figures_from_the_grader_benchmark_are_its_records():
+    grading = _read(os.path.join(REPO, 'docs', 'grading.md'))
+    bench = _read(os.path.join(REPO, 'lab', 'bench', 'grader.md'))
+    assert bench_figure_problems(grading, bench) == []
+    assert bench_figure_problems(grading, bench.replace('at start 9.52', 'at start 1.00')) == [
+        'not said (from lab/bench/grader.md): load average 1.00 at the start of the run, 0.62 at its end']
