@@ -326,3 +326,40 @@ def test_the_figures_from_the_grader_benchmark_are_its_records():
     assert bench_figure_problems(grading, bench) == []
     assert bench_figure_problems(grading, bench.replace('at start 9.52', 'at start 1.00')) == [
         'not said (from lab/bench/grader.md): load average 1.00 at the start of the run, 0.62 at its end']
+
+
+def leg_name_problems(grading):
+    """The plot's leg names (publish/flightplot.py LEG_NAMES) against the first column of the manual's
+    table of the legs, in the flight's order."""
+    from exam_lab.grader.publish import flightplot
+    section = grading[grading.index('### The legs of the flight'):]
+    table = re.findall(r'^\| ([a-z][a-z ]+) \| ', section, re.M)
+    names = [flightplot.LEG_NAMES[leg] for leg in ('rest', 'short_up', 'short_down', 'long_up', 'long_down', 'deep_down')]
+    manual = [name for name in table if name != 'leg'][:len(names)]
+    return [] if manual == names else ['the manual names the legs %s, the plot %s' % (manual, names)]
+
+
+def test_the_plots_leg_names_are_the_manuals():
+    grading = _read(os.path.join(REPO, 'docs', 'grading.md'))
+    assert leg_name_problems(grading) == []
+    assert len(leg_name_problems(grading.replace('| just below | just below |', '| gap below | just below |'))) == 1
+
+
+def test_the_plot_counts_the_calls_grade_md_counts(tmp_path, monkeypatch):
+    """The legend's count of calls is question 13's (rest to end); a call of the calibration before the
+    rest is counted apart, never in it."""
+    import matplotlib
+    matplotlib.use('Agg')
+    from matplotlib.axes import Axes
+    from exam_lab.grader.publish import flightplot
+    labels = []
+    original = Axes.plot
+    monkeypatch.setattr(Axes, 'plot', lambda self, *a, **k: labels.append(k.get('label')) or original(self, *a, **k))
+    schedule = {'rest': 5.0, 'short_up': 8.0, 'short_down': 11.0, 'long_up': 13.5, 'long_down': 21.0,
+                'deep_down': 23.0, 'end': 25.0}
+    probe = {'t0': 0.0, 'threshold': 1300.0, 'sheet': 'altitude', 'schedule': schedule,
+             'calls': [[2.0, 'WARNING'], [3.0, 'NORMAL'], [18.5, 'WARNING'], [21.2, 'NORMAL']],
+             'answers': [[t, r, True] for t, r in [[2.0, 'WARNING'], [3.0, 'NORMAL'], [18.5, 'WARNING'], [21.2, 'NORMAL']]],
+             'trace': {'published': [[0.5, 1170.0], [20.0, 1430.0]], 'oracle': []}}
+    assert flightplot.draw([('main', probe)], str(tmp_path / 'flight.png'))
+    assert 'WARNING calls (1 in the flight, 1 before)' in labels and 'NORMAL calls (1 in the flight, 1 before)' in labels

@@ -219,7 +219,7 @@ def test_refused_calls_on_the_plot(tmp_path, monkeypatch):
         return original(self, *args, **kwargs)
     monkeypatch.setattr(Axes, 'plot', plot)
     assert flightplot.draw([('main', probe)], str(tmp_path / 'flight.png'))
-    assert 'REFUSED "warning" call (1)' in labels and 'REFUSED "normal" call (1)' in labels, labels
+    assert 'REFUSED "warning" calls (1 in the flight)' in labels and 'REFUSED "normal" calls (1 in the flight)' in labels, labels
 
 
 def test_grade_md_says_what_to_look_at():
