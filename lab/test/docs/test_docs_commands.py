@@ -363,3 +363,49 @@ def test_the_plot_counts_the_calls_grade_md_counts(tmp_path, monkeypatch):
              'trace': {'published': [[0.5, 1170.0], [20.0, 1430.0]], 'oracle': []}}
     assert flightplot.draw([('main', probe)], str(tmp_path / 'flight.png'))
     assert 'WARNING calls (1 in the flight, 1 before)' in labels and 'NORMAL calls (1 in the flight, 1 before)' in labels
+
+
+def opener_problems(repo, path, text):
+    """Lines of a Python excerpt printed without the statement whose block holds them (read with ast
+    from the file itself): pasted, such a line lands in whatever block is printed above it."""
+    import ast
+    with open(os.path.join(repo, path)) as f:
+        tree = ast.parse(f.read())
+    shown = set()
+    for part in re.match(r'# \S+, lines (.*)$', text.splitlines()[0]).group(1).split(', '):
+        first, _, last = part.partition('-')
+        shown.update(range(int(first), int(last or first) + 1))
+    problems = []
+    for parent in ast.walk(tree):
+        for field in ('body', 'orelse', 'finalbody', 'handlers'):
+            for child in getattr(parent, field, None) or []:
+                if isinstance(parent, ast.Module) or not hasattr(child, 'lineno'):
+                    continue
+                if child.lineno in shown and parent.lineno not in shown:
+                    problems.append('line %d without line %d, which opens its block' % (child.lineno, parent.lineno))
+    return sorted(set(problems))
+
+
+def test_every_excerpt_of_the_report_is_printed_whole_at_its_indent():
+    """Issue 49: question 10's subscribers were printed under a callback (their block, def main():, left
+    out): pasted, they landed inside it. Every Python excerpt shows the lines opening its blocks, and the
+    report prints each excerpt as excerpts.py makes it."""
+    import sys
+    sys.path.insert(0, os.path.join(REPO, 'lab', 'report'))
+    import excerpts
+    report = _read(os.path.join(REPO, 'docs', 'report.md'))
+    quoted = re.sub(r'^> ?', '', report, flags=re.M)
+    for name in sorted(excerpts.EXCERPTS):
+        text = excerpts.excerpt(REPO, name)
+        assert text in quoted, '%s: not in docs/report.md as excerpts.py makes it (make report)' % name
+        path = excerpts.EXCERPTS[name][0]
+        if path.endswith('.py'):
+            assert opener_problems(REPO, path, text) == [], name
+    real = excerpts.openers
+    try:
+        excerpts.openers = lambda lines, first: []  # the excerpts as they were printed before
+        old = excerpts.excerpt(REPO, 'q10.altitude')
+    finally:
+        excerpts.openers = real
+    assert opener_problems(REPO, excerpts.ALTITUDE, old) == [
+        'line 52 without line 43, which opens its block', 'line 53 without line 43, which opens its block']
