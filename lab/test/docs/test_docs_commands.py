@@ -409,3 +409,47 @@ def test_every_excerpt_of_the_report_is_printed_whole_at_its_indent():
         excerpts.openers = real
     assert opener_problems(REPO, excerpts.ALTITUDE, old) == [
         'line 52 without line 43, which opens its block', 'line 53 without line 43, which opens its block']
+
+
+def pdf_pages(path):
+    """The text of each page of a PDF (pdftotext -layout), or None when pdftotext is missing."""
+    import shutil
+    if shutil.which('pdftotext') is None:
+        return None
+    text = subprocess.run(['pdftotext', '-layout', path, '-'], stdout=subprocess.PIPE, check=True).stdout
+    return text.decode('utf-8', 'replace').split('\f')
+
+
+def report_pdf_problems(markdown, pages, limit=10):
+    """The report's PDF: the questions part within ``limit`` pages (the appendices start on page
+    limit + 1 at the latest), and no command of a console block wrapped (each on one line of a page)."""
+    problems = []
+    starts = [n for n, page in enumerate(pages, 1) if re.search(r'^\s*Appendices\s*$', page, re.M)]
+    if not starts or starts[0] > limit + 1:
+        problems.append('the questions take %s pages (the appendices start on page %s)' % (
+            starts[0] - 1 if starts else '?', starts[0] if starts else '?'))
+    lines = {re.sub(r'\s+', ' ', l).strip() for page in pages for l in page.splitlines()}
+    for name, language, body in blocks(markdown):
+        if language != 'console':
+            continue
+        for command in (l for l in body.splitlines() if l.startswith('$ ')):
+            wanted = re.sub(r'\s+', ' ', command).strip()
+            if not any(wanted in line for line in lines):
+                problems.append('wrapped or missing in the PDF: %s' % wanted)
+    return problems
+
+
+def test_the_report_pdf_teaches_the_questions_first_and_wraps_no_command():
+    pages = pdf_pages(os.path.join(REPO, 'docs', 'report.pdf'))
+    if pages is None:
+        pytest.skip('pdftotext (poppler-utils) is not installed: the PDF is not checked')
+    markdown = re.sub(r'^> ?', '', _read(os.path.join(REPO, 'docs', 'report.md')), flags=re.M)
+    assert report_pdf_problems(markdown, pages) == []
+
+
+def test_the_report_pdf_check_catches_a_long_questions_part_and_a_wrapped_command():
+    pages = ['title\n1. Build', 'q\n$ rosrun exam_lab\n    exam_node_step10.py', '\nAppendices\n']
+    markdown = '```console\n$ rosrun exam_lab exam_node_step10.py\n```\n'
+    assert report_pdf_problems(markdown, pages, limit=1) == [
+        'the questions take 2 pages (the appendices start on page 3)',
+        'wrapped or missing in the PDF: $ rosrun exam_lab exam_node_step10.py']
