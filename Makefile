@@ -25,16 +25,16 @@ help:
 	@echo "make bench          benchmarks of the exam node against the naive baseline"
 	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
 	@echo "make mutation       mutation testing of the nodes' code against its tests (about 30 min)"
-	@echo "make fairness [JOBS=n] [OUT=<dir>]  the grader on generated student answers (40 correct, 36 one-mistake,"
+	@echo "make fairness [JOBS=n] [OUT=<dir>]  the grader on generated student answers (42 correct, 36 one-mistake,"
 	@echo "                    both sheets) as one class; its report into docs/grading.md (about 30 min)"
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
-	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv> [WORKSHEET_SCALE=1]] [ENGINE=local|slurm] [SLURM_ARGS='...']"
+	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv>] [ENGINE=local|slurm] [SLURM_ARGS='...']"
 	@echo "                    grade students' exam packages by running them (docs/grading.md)"
 	@echo "make rescore OUT=<dir> [WORKSHEET=...]  today's rubric on a run's kept measurements (seconds, no ROS)"
 	@echo "make review OUT=<dir> [AGREEMENT=1]  the hand points of a class in one pass, on a page served to this"
 	@echo "                    machine only (the URL it prints; Ctrl-C stops); AGREEMENT=1: the teacher against the proposals"
-	@echo "make worksheet OUT=<dir> WORKSHEET=<Moodle grading worksheet.csv>"
-	@echo "                    the whole grade (machine + OUT/hand.csv) into the worksheet, on its scale"
+	@echo "make worksheet OUT=<dir> [WORKSHEET=<Moodle grading worksheet.csv>]"
+	@echo "                    the whole grades (machine + OUT/hand.csv, scaled) into OUT/moodle-worksheet.csv"
 	@echo "make check PACKAGE=<dir|zip> [SHEET=altitude|depth] [REPORT=<your report.pdf>]"
 	@echo "                    a student's own check of their package, as an ordinary user (docs/grading.md)"
 	@echo "make clean          remove the build workspace .ws/"
@@ -83,29 +83,29 @@ fairness: build
 	@$(ENV) && exec python3 lab/scripts/fairness.py $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)")
 
 # make grade SUBMISSION=<dir or zip> | CLASS=<dir or zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]
-#            [WORKSHEET=<Moodle's offline grading worksheet, filled into OUT>]
+#            [WORKSHEET=<Moodle's offline grading worksheet: kept in OUT, filled with the whole grades>]
 #            [ENGINE=slurm: one Slurm array task per student] [SLURM_ARGS=<sbatch's options, e.g. --partition=x>]
 grade: build
 	@$(ENV) && exec python3 lab/scripts/grade.py \
 	  $(if $(SUBMISSION),--submission "$(SUBMISSION)") $(if $(CLASS),--class "$(CLASS)") \
 	  $(if $(SHEET),--sheet "$(SHEET)") $(if $(OUT),--out "$(OUT)") $(if $(JOBS),--jobs "$(JOBS)") \
-	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") $(if $(WORKSHEET_SCALE),--worksheet-scale) \
+	  $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") \
 	  $(if $(ENGINE),--engine "$(ENGINE)") $(if $(SLURM_ARGS),--slurm-args "$(SLURM_ARGS)")
 
 # make rescore OUT=<make grade's OUT> [WORKSHEET=...]: today's rubric on the measurements the run kept
 rescore: build
-	@$(ENV) && exec python3 lab/scripts/rescore.py --out "$(OUT)" $(if $(WORKSHEET),--worksheet "$(WORKSHEET)") \
-	  $(if $(WORKSHEET_SCALE),--worksheet-scale)
+	@$(ENV) && exec python3 lab/scripts/rescore.py --out "$(OUT)" $(if $(WORKSHEET),--worksheet "$(WORKSHEET)")
 
 # make review OUT=<make grade's OUT> [AGREEMENT=1]: the review page (127.0.0.1, a token in the URL it prints)
 review: build
 	@$(if $(OUT),,$(error make review needs OUT=<the folder make grade wrote>))
 	@$(ENV) && exec python3 lab/scripts/review.py --out "$(OUT)" $(if $(AGREEMENT),--agreement)
 
-# make worksheet OUT=<make grade's OUT> WORKSHEET=<Moodle's worksheet>: the machine's and the hand points
-# (OUT/hand.csv, filled by the teacher) as one grade on the worksheet's scale
+# make worksheet OUT=<make grade's OUT> [WORKSHEET=<Moodle's worksheet; default: the one kept in OUT>]: the
+# machine's and the hand points (OUT/hand.csv, filled by the teacher) as one grade on the worksheet's scale,
+# into OUT/moodle-worksheet.csv, the file to upload
 worksheet: build
-	@$(ENV) && exec python3 lab/scripts/worksheet.py --out "$(OUT)" --worksheet "$(WORKSHEET)"
+	@$(ENV) && exec python3 lab/scripts/worksheet.py --out "$(OUT)" $(if $(WORKSHEET),--worksheet "$(WORKSHEET)")
 
 # make check PACKAGE=<dir or zip> [SHEET=altitude|depth] [REPORT=<pdf>]: a student's own check, without root or sudo.
 # It builds the workspace but installs nothing: a student's machine has ROS already, not the teacher's tools.

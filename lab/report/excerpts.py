@@ -5,8 +5,10 @@ ranges of one file, each given by a regular expression for its first line and on
 first match at or after the first line), so an edit of the simple answer moves the excerpt with it; a
 range whose first or last line is no longer there is an error, never a hole or a wrong part. Ranges
 that do not touch are joined by a line ``# ...`` (``<!-- ... -->`` in XML), indented like the next
-range, so the reader sees where code was left out. The first line of an excerpt names its file.
-No rospy here.
+range, so the reader sees where code was left out. A Python range that starts inside a block brings the
+lines that open its blocks (``def main():``, ``while ...:``), so every line shows at the indent it has
+in the file and an excerpt pasted lands where the file has it (a subscriber under ``def main():``, never
+under the callback printed above it). The first line of an excerpt names its file. No rospy here.
 """
 import os
 import re
@@ -77,6 +79,25 @@ def line_ranges(lines, ranges, where):
     return found
 
 
+def _indent(line):
+    return len(line) - len(line.lstrip())
+
+
+def openers(lines, first):
+    """The indices of the lines that open the blocks line ``first`` is in (``def main():``, then
+    ``while ...:``), outermost first: for each, the nearest line above with less indent that is not
+    blank nor a comment."""
+    found, level = [], _indent(lines[first])
+    for i in range(first - 1, -1, -1):
+        text = lines[i].strip()
+        if level == 0:
+            break
+        if text and not text.startswith('#') and _indent(lines[i]) < level:
+            found.append(i)
+            level = _indent(lines[i])
+    return found[::-1]
+
+
 def excerpt(repo, name):
     """The text of excerpt ``name``: a comment line naming the file and its lines, then the ranges."""
     if name not in EXCERPTS:
@@ -85,8 +106,11 @@ def excerpt(repo, name):
     with open(os.path.join(repo, path)) as f:
         lines = f.read().splitlines()
     xml = path.endswith(('.launch', '.xml'))
+    found = line_ranges(lines, ranges, '%s (%s)' % (path, name))
+    if not xml:
+        found = sorted(set(found) | {(i, i) for first, _ in found for i in openers(lines, first)})
     merged = []
-    for first, last in line_ranges(lines, ranges, '%s (%s)' % (path, name)):
+    for first, last in found:
         if merged and first <= merged[-1][1] + 1:
             merged[-1] = (merged[-1][0], max(last, merged[-1][1]))
         else:

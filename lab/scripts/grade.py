@@ -7,8 +7,10 @@
 
 Besides the grades, OUT/index.html (the page for the teacher), each student's results.json
 (Gradescope) and flight.png, the hand points proposed (OUT/proposals.csv, from the reference outputs
-of the sheet's drone, run once: OUT/reference-<sheet>.json), for a class the similarity check and, with --worksheet, Moodle's
-offline grading worksheet filled (the teacher's desk: lab/src/exam_lab/grader/publish/desk.py).
+of the sheet's drone, run once: OUT/reference-<sheet>.json), for a class the similarity check and,
+with --worksheet, Moodle's offline grading worksheet with the whole grades once the hand points are
+given (the teacher's desk: lab/src/exam_lab/grader/publish/desk.py). The last lines are the commands
+that come next, OUT quoted.
 
 Prints the score table (every line cleaned of control characters: it carries students' text);
 exits 0 whenever grading completed, whatever the scores, and 1 when the
@@ -42,17 +44,16 @@ def main(argv=None):
     what.add_argument('--submission', help='a folder holding the exam package, or its zip')
     what.add_argument('--class', dest='klass', help='a folder (or zip) with one sub-folder per student')
     parser.add_argument('--sheet', choices=list(SHEETS), help='default: detected from the package')
-    parser.add_argument('--out', help='output folder (default: $EXAM_WS/grades/<name>)')
+    parser.add_argument('--out', help='output folder (default: $EXAM_WS/grades/<name without its archive ending, '
+                        'spaces and parentheses as _>)')
     parser.add_argument('--jobs', type=int, default=None,
                         help='students graded side by side (class; default: from the cores, the memory and '
                         'the CPU a grading takes, %d here)' % class_run.default_jobs())
     parser.add_argument('--unsandboxed-student-code-can-read-and-damage-my-files', dest='unsandboxed',
                         action='store_true', help='grade even where no sandbox can be made (never as root: '
                         'as root the code runs as a user of its own, with limits)')
-    parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV) to fill")
-    parser.add_argument('--worksheet-scale', action='store_true',
-                        help="scale the grades to the worksheet's maximum grade (default: the machine's points "
-                        "out of 17, said on the terminal and in each comment)")
+    parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV), kept in OUT and filled "
+                        "with the whole grades (machine + hand points) as they are given")
     parser.add_argument('--no-similarity', action='store_true', help='skip the similarity check (class)')
     parser.add_argument('--engine', choices=['local', 'slurm'], default='local',
                         help='where a class is graded: here, JOBS at a time, or one Slurm array task per student')
@@ -67,8 +68,7 @@ def main(argv=None):
     if not os.path.exists(target):
         say('grade: %s does not exist' % target, sys.stderr)
         return 1
-    name = os.path.basename(os.path.abspath(target).rstrip('/'))
-    out = os.path.abspath(args.out or os.path.join(workspace(), 'grades', name))
+    out = os.path.abspath(args.out or os.path.join(workspace(), 'grades', moodle.out_name(os.path.abspath(target))))
     try:
         if args.submission:
             record = runner.grade_submission(args.submission, out, sheet=args.sheet, on_step=progress.StepProgress(),
@@ -83,8 +83,8 @@ def main(argv=None):
             say('grade.json and grade.md in %s' % out)
             for line in reference.keep_for(out, [record.get('sheet') or 'altitude']):
                 say(line)
-            for line in desk.finish(out, [record], single=True, worksheet=args.worksheet,
-                                    scale=args.worksheet_scale):
+            for line in desk.finish(out, [record], single=True, worksheet=args.worksheet) + \
+                    desk.next_commands(out, [record]):
                 say(line)
         else:
             jobs = args.jobs or class_run.default_jobs()
@@ -109,7 +109,7 @@ def main(argv=None):
                 say(line)
             for line in desk.finish(out, records, similar=None if args.no_similarity else
                                     class_run.class_similarity(args.klass, out, records), worksheet=args.worksheet,
-                                    scale=args.worksheet_scale, title=moodle.class_name(args.klass)):
+                                    title=moodle.class_name(args.klass)) + desk.next_commands(out, records):
                 say(line)
     except RuntimeError as err:
         say('grade: %s' % err, sys.stderr)

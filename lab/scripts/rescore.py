@@ -1,14 +1,15 @@
 #!/usr/bin/env python3
 """Grade a class again with today's rubric, from the measurements its run kept: nothing is run again.
 
-    rescore.py --out OUT [--worksheet WORKSHEET.csv [--worksheet-scale]]     (make rescore OUT=...)
+    rescore.py --out OUT [--worksheet WORKSHEET.csv]     (make rescore OUT=...)
 
 For each student of OUT (or the one submission graded there), the rubric is applied to the
 measurements.json that ``make grade`` kept beside its grade.json; grade.json (with the points it had,
-``previous``, and its provenance), grade.md, grades.csv, the page, results.json, moodle-feedback.zip and hand.csv (the
-teacher's points kept) are written again, each student's report.json read back as its record (the
-report is never read again: a student whose report was not read, or whose report.json is not a record
-of the grader, is said), and each student whose points or status moved is printed
+``previous``, and its provenance), grade.md, grades.csv, the page, results.json, moodle-feedback.zip, hand.csv (the
+teacher's points kept) and moodle-worksheet.csv (from the worksheet kept in OUT) are written again, each
+student's report.json read back as its record (the report is never read again: a student whose report
+was not read, or whose report.json is not a record of the grader, is said), and each student whose
+points or status moved is printed
 with the items that moved; a student whose measurements.json or grade.json is not a record of the
 grader is listed as not rescored (its files left as they were; the exit status is 1). No ROS, no
 sandbox, no root. A change of the rubric that needs measurements
@@ -26,8 +27,7 @@ from exam_lab.grader.score import safe_text
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--out', required=True, help='the folder make grade wrote')
-    parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV) to fill again")
-    parser.add_argument('--worksheet-scale', action='store_true', help="scale to the worksheet's maximum grade")
+    parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV); default: the one kept in OUT")
     args = parser.parse_args(argv)
     out = os.path.realpath(args.out)  # the teacher's path, followed once; nothing below it is
     if not os.path.isdir(out) or not grades.graded_folders(out):
@@ -56,8 +56,9 @@ def main(argv=None):
     # The run's similarity check, read as its record (capped, checked, its text clean); one that is
     # not is said where its pairs would be.
     similar = None if single else desk.read_similarity(out)
-    for line in desk.finish(out, records, single=single, similar=similar, worksheet=args.worksheet,
-                            scale=args.worksheet_scale):
+    for line in desk.finish(out, records, single=single, similar=similar, worksheet=args.worksheet):
+        print(line)
+    for line in desk.next_commands(out, records):
         print(line)
     return 1 if refused else 0
 

@@ -94,10 +94,11 @@ def test_the_bounds_check_catches_a_stale_value():
 
 
 def test_default_jobs_is_quoted_as_the_code_computes_it():
-    # "two per core" in the docs is class_run.JOBS_PER_CORE; 4 on this two-core machine with its memory.
-    assert class_run.JOBS_PER_CORE == 2
+    # The docs quote default_jobs's measured CPU of a grading and its share of the cores.
     text = prose(read(GRADING) + read(os.path.join(REPO, 'docs', 'benchmarks.md')))
-    assert 'two per core' in text or '2 per core' in text
+    said = '%g %% of the cores at the CPU one grading was measured to take, %g s in %g s' % (
+        class_run.CPU_SHARE * 100, class_run.GRADING_CPU_S, class_run.GRADING_WALL_S)
+    assert said in text, said
     quoted = re.findall(r'`JOBS=(\d+)`?,? the default', text) + re.findall(r'the default JOBS=(\d+)', text)
     assert all(int(q) == class_run.default_jobs(cores=2, memory=24 << 30) for q in quoted), quoted
 
@@ -321,7 +322,7 @@ def test_the_code_width_check_catches_a_long_line():
 
 def test_the_report_prints_the_whole_simple_answer():
     report = read(os.path.join(REPO, 'docs', 'report.md'))
-    appendix = report[report.index('## E. The simple answer, whole'):]
+    appendix = report[report.index('## D. The simple answer, whole'):report.index("## E. This project's node")]
     for path in ('package.xml', 'CMakeLists.txt', 'scripts/exam_node.py', 'scripts/exam_submarine_node.py',
                  'launch/exam.launch', 'launch/exam_submarine.launch'):
         body = read(os.path.join(REPO, 'docs', 'simple_answer', 'exam', path)).rstrip()
@@ -540,22 +541,22 @@ def quoted_output(pattern, text=None):
     return found[0]
 
 
-def not_scaled_problems(text=None):
+def no_grade_yet_problems(text=None):
+    """The line make grade prints before any hand point is given, as docs/grading.md quotes it."""
     from exam_lab.grader.publish import moodle
-    quote = quoted_output(r'`(NOT SCALED: [^`]+)`', text)
-    maximum, machine = re.match(r"NOT SCALED: the worksheet's maximum grade is ([\d.]+), .* out of ([\d.]+)$", quote).groups()
-    lines = moodle.summary_lines({'graded': [], 'machine_max': [float(machine)], 'maxima': [float(maximum)],
-                                  'scaled': False, 'kept': [], 'unmatched': [], 'no_submission': []}, 'w.csv')
-    return [] if any(quote in line for line in lines) else ['not printed: %s' % quote]
+    quote = quoted_output(r'`(worksheet: no whole grade yet[^`]+)`', text)
+    lines = moodle.summary_lines({'graded': [], 'maxima': [], 'kept': [], 'unmatched': [], 'no_submission': []},
+                                 moodle.UPLOAD)
+    return [] if quote in lines else ['not printed: %s' % quote]
 
 
-def test_the_not_scaled_line_is_the_worksheets():
-    assert not_scaled_problems() == []
+def test_the_no_grade_yet_line_is_the_worksheets():
+    assert no_grade_yet_problems() == []
 
 
-def test_the_not_scaled_check_catches_a_reworded_line():
-    text = prose(read(GRADING)).replace('the grades written are', 'the grades are')
-    assert len(not_scaled_problems(text)) == 1
+def test_the_no_grade_yet_check_catches_a_reworded_line():
+    text = prose(read(GRADING)).replace('alone are no grade', 'are no grade')
+    assert len(no_grade_yet_problems(text)) == 1
 
 
 def synthetic_grade(total_before=None):
@@ -571,10 +572,11 @@ def synthetic_grade(total_before=None):
 
 def feedback_problems(text=None):
     import html
-    from exam_lab.grader.publish import moodle
-    quote = quoted_output(r'\("(The grade is out of [^"]+)"\)', text)
-    maximum = float(re.search(r'the maximum grade ([\d.]+)', quote).group(1))
-    return [] if quote in html.unescape(moodle.feedback(synthetic_grade(), maximum=maximum)) else [
+    from exam_lab.grader.publish import hand, moodle
+    quote = quoted_output(r'\("(The grade is these points scaled to [^"]+)"\)', text)
+    maximum = float(re.search(r'scaled to ([\d.]+)', quote).group(1))
+    whole = hand.combine(synthetic_grade(), None)
+    return [] if quote in html.unescape(moodle.feedback(whole, maximum=maximum)) else [
         'not in the feedback comment: %s' % quote]
 
 
@@ -583,7 +585,7 @@ def test_the_feedback_comment_quoted_is_moodles():
 
 
 def test_the_feedback_check_catches_a_reworded_comment():
-    text = prose(read(GRADING)).replace("(the machine's items), not out of", "(the machine's items), not of")
+    text = prose(read(GRADING)).replace("scaled to 20 (x 20/30)", "scaled to 20 (x 20/17)")
     assert len(feedback_problems(text)) == 1
 
 
@@ -635,16 +637,19 @@ def test_the_rescore_change_check_catches_wrong_arithmetic():
 
 
 def missing_hand_points_problems(text=None):
-    """The worksheet's line for a student without all hand points (``Paul Martin: Q5, Q6, ...``):
-    worksheet.py's format, hand items of score/sheets.py in their order."""
+    """The worksheet's line for a student without all hand points (``Paul Martin (hand points not
+    given yet in hand.csv: Q5, Q6, ...)``): publish/moodle.py's format, hand items of score/sheets.py
+    in their order."""
     from exam_lab.grader.score.sheets import HAND_ITEMS
-    format_literal('lab/scripts/worksheet.py',
-                   "'  %s: %s' % (safe_text.one_line(record['student']), ', '.join(record['missing']))")
-    quote = quoted_output(r'\(`([A-Z][\w ]+: (?:\w+, )+\.\.\.)`\)', text)
-    named = quote.split(': ', 1)[1].split(', ')[:-1]
+    format_literal('lab/src/exam_lab/grader/publish/moodle.py', "'  left blank in %s: %s (%s)'")
+    literal = format_literal('lab/src/exam_lab/grader/publish/moodle.py', "'hand points not given yet in hand.csv: %s'")
+    quote = quoted_output(r'`([A-Z][\w ]+ \(hand points not given yet in hand\.csv: (?:\w+, )+\.\.\.\))`', text)
+    if literal.strip("'").split('%s')[0] not in quote:
+        return ['not the worksheet\'s words: %s' % quote]
+    named = quote.split(': ', 1)[1].rstrip(')').split(', ')[:-1]
     if not named or not set(named) <= set(HAND_ITEMS):
         return ['not hand items: %s' % named]
-    return [] if named == [i for i in HAND_ITEMS if i in named] else ['not in the order worksheet.py lists them']
+    return [] if named == [i for i in HAND_ITEMS if i in named] else ['not in the order the worksheet lists them']
 
 
 def test_the_worksheets_missing_hand_points_line_is_the_scripts():
@@ -655,7 +660,7 @@ def test_the_missing_hand_points_check_catches_a_wrong_item():
     assert missing_hand_points_problems(prose(read(GRADING)).replace('Q5, Q6, ...', 'Q11, Q6, ...')) == [
         "not hand items: ['Q11', 'Q6']"]
     assert missing_hand_points_problems(prose(read(GRADING)).replace('Q5, Q6, ...', 'Q6, Q5, ...')) == [
-        'not in the order worksheet.py lists them']
+        'not in the order the worksheet lists them']
 
 
 def slurm_problems(text=None):

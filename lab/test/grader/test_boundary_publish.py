@@ -37,8 +37,10 @@ def _read(path):
 def test_the_desk_is_written_and_make_grade_succeeds(graded):
     assert graded['status'] == 0, graded['stderr'][-3000:]
     out = graded['out']
-    for name in ('grades.csv', 'index.html', 'worksheet-filled.csv', 'worksheet.json'):
+    for name in ('grades.csv', 'index.html', 'worksheet-as-downloaded.csv', 'worksheet.json', 'hand.csv'):
         assert os.path.isfile(os.path.join(out, name)), name
+    # No hand point given: no file to upload (the machine's points alone are no grade).
+    assert not os.path.exists(os.path.join(out, 'moodle-worksheet.csv'))
     for student in (NOISY, VICTIM_NAME):
         assert os.path.isfile(os.path.join(out, student, 'results.json')), student
         assert os.path.isfile(os.path.join(out, student, 'flight.png')), student
@@ -59,7 +61,7 @@ def test_the_class_summary_has_no_control_character(graded):
 
 def test_no_output_for_the_teacher_has_a_control_character(graded):
     out = graded['out']
-    paths = [os.path.join(out, name) for name in ('grades.csv', 'index.html', 'worksheet-filled.csv')]
+    paths = [os.path.join(out, name) for name in ('grades.csv', 'index.html', 'worksheet.json', 'hand.csv')]
     for student in (NOISY, VICTIM_NAME):
         paths += [os.path.join(out, student, name) for name in ('grade.md', 'grade.json', 'results.json')]
     found = {}

@@ -22,10 +22,10 @@ from exam_lab.grader.publish import grades, teacher
 from exam_lab.grader.score.records import MEASUREMENTS, SimilarityRecord
 from exam_lab.grader.host import run as host_run
 
-from exam_lab.grader.publish import desk, flightplot, gradescope, moodle, page, progress, report
+from exam_lab.grader.publish import desk, flightplot, gradescope, hand, moodle, page, progress, report
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.kept import GradeRecord
-from exam_lab.grader.score.sheets import ITEMS
+from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 from test_grader_desk import probe_result
 from test_grader_probe_record import keep_runs
 
@@ -116,10 +116,25 @@ def as_read(tmp_path, record):
     return GradeRecord.read(str(tmp_path / 'grade.json')).value
 
 
+def all_hand_points(record):
+    """``record`` made whole with every hand point given (what the worksheet is filled with)."""
+    return hand.combine(record, hand.Hand(record['student'], {i: top for i, (top, _) in HAND_ITEMS.items()},
+                                          'seen', record.get('participant')))
+
+
+def give_hand_points(out, records):
+    """hand.csv in ``out`` with every hand point given for ``records``, as a teacher fills it."""
+    from test_grader_hand import fill
+    os.makedirs(str(out), exist_ok=True)
+    hand.write(os.path.join(str(out), hand.FILE), records)
+    fill(os.path.join(str(out), hand.FILE), {(r['student'], i): str(top) for r in records
+                                             for i, (top, _) in HAND_ITEMS.items()})
+
+
 def out_worksheet(tmp_path, record, monkeypatch, capsys):
-    filled, summary = moodle.fill(WORKSHEET, [dict(as_read(tmp_path, record), status='graded')])
+    filled, summary = moodle.fill(WORKSHEET, [all_hand_points(dict(as_read(tmp_path, record), status='graded'))])
     assert len(summary['graded']) == 1  # the feedback was written: the test sees it
-    return [filled] + moodle.summary_lines(summary, 'ws-filled.csv')
+    return [filled] + moodle.summary_lines(summary, moodle.UPLOAD)
 
 
 def out_gradescope(tmp_path, record, monkeypatch, capsys):
@@ -261,6 +276,7 @@ def class_desk(tmp_path):
     worksheet.write_text('\ufeffIdentifier,Full name,Grade,Maximum grade,Last modified (grade),Feedback comments\n'
                          + ''.join('"Participant %d","%s",,17.00,-,\n' % (r['participant'], r['student'])
                                    for r in records), encoding='utf-8')
+    give_hand_points(out, records)
     return out, records, str(worksheet)
 
 
@@ -286,7 +302,7 @@ def test_the_desk_survives_one_student_whose_part_fails(part, tmp_path, monkeypa
     for student in ('Ada', 'Eve'):
         assert os.path.isfile(str(out / student / 'flight.png'))
         assert os.path.isfile(str(out / student / 'results.json'))
-    assert os.path.isfile(str(out / 'ws-filled.csv')) and any('3 grade(s) written' in l for l in lines)
+    assert os.path.isfile(str(out / moodle.UPLOAD)) and any('3 whole grade(s)' in l for l in lines)
     html = _read(str(out / 'index.html'))
     assert html.count('class="student"') == 3
     assert 'src="Ada/flight.png"' in html and 'src="Eve/flight.png"' in html
@@ -309,7 +325,7 @@ def test_a_page_that_cannot_be_made_is_replaced_by_a_plain_one(tmp_path, monkeyp
     html = _read(str(out / 'index.html'))
     assert 'the page could not be made' in html and 'ValueError: no page' in html and CONTROL.search(html) is None
     assert all('<a href="%s/grade.md">' % r['student'] in html for r in records)
-    assert any('the page could not be made' in l for l in lines) and os.path.isfile(str(out / 'ws-filled.csv'))
+    assert any('the page could not be made' in l for l in lines) and os.path.isfile(str(out / moodle.UPLOAD))
 
 
 #: A name in bytes that are not UTF-8, as Python reads it from a student's tar (surrogate escapes).
@@ -388,8 +404,9 @@ def test_the_publishers_take_records_only_the_desk_makes_them(tmp_path):
     os.makedirs(str(out / 'Eve'))
     worksheet = tmp_path / 'ws.csv'
     worksheet.write_text(WORKSHEET, encoding='utf-8')
+    give_hand_points(out, [GradeRecord.make(raw).value])
     lines = desk.finish(str(out), [raw], worksheet=str(worksheet), show='evidence')
-    written = [_read(str(out / 'index.html')), _read(str(out / 'Eve' / 'results.json')), _read(str(out / 'ws-filled.csv'))]
+    written = [_read(str(out / 'index.html')), _read(str(out / 'Eve' / 'results.json')), _read(str(out / moodle.UPLOAD))]
     with zipfile.ZipFile(str(out / 'moodle-feedback.zip')) as zf:
         written += [zf.read(name).decode('utf-8') for name in zf.namelist()]
     assert len(written) == 4 and all('most recent call last' in text for text in written), lines

@@ -2,6 +2,7 @@
 the ones needing the teacher first, every plot it names written), the flight plot, PDF page counts,
 progress lines and time estimates, the probe's trace. No master, no browser (the browser test is
 lab/test/grader/test_page_browser.py)."""
+import csv
 import io
 import json
 import os
@@ -12,9 +13,9 @@ import pytest
 
 from exam_lab.grader.boxed import documents
 
-from exam_lab.grader.publish import desk, flightplot, gradescope, hand, page, progress, report
+from exam_lab.grader.publish import desk, flightplot, gradescope, hand, moodle, page, progress, report
 from exam_lab.grader.score.records import SimilarityRecord
-from exam_lab.grader.score.sheets import ITEMS
+from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 from test_grader_probe_record import keep_runs
 
 T0 = 1000.0
@@ -161,7 +162,9 @@ def test_finish_writes_the_desk_for_a_class(tmp_path):
     worksheet.write_text('\ufeffIdentifier,Full name,Grade,Maximum grade,Last modified (grade),Feedback comments\n'
                          '"Participant 101","Jane Doe",,17.00,-,\n', encoding='utf-8')
     lines = desk.finish(out, records, similar=SimilarityRecord.make({'pairs': [], 'students': 2, 'notes': []}), worksheet=str(worksheet))
-    assert any('1 grade(s) written' in l for l in lines)
+    # No hand point given yet: no file to upload (the machine's points alone are no grade).
+    assert any("no whole grade yet, so no moodle-worksheet.csv to upload" in l for l in lines), lines
+    assert not os.path.exists(os.path.join(out, moodle.UPLOAD))
     assert any('NOT MATCHED: Paul' in l for l in lines)
     for r in records:
         assert os.path.isfile(os.path.join(out, r['student'], 'flight.png'))
@@ -170,11 +173,24 @@ def test_finish_writes_the_desk_for_a_class(tmp_path):
     with open(os.path.join(out, 'index.html')) as f:
         got = parsed(f.read())
     assert got.images == ['Jane Doe/flight.png', 'Paul/flight.png']
-    assert os.path.isfile(os.path.join(out, 'ws-filled.csv'))
     # hand.csv beside grades.csv, one empty row per student for the teacher's 13 points.
     assert any(l.startswith('hand points: %s' % os.path.join(out, 'hand.csv')) for l in lines)
     assert sorted((h.student, h.participant) for h in hand.read(os.path.join(out, 'hand.csv')).values()) == \
         [('Jane Doe', 101), ('Paul', 102)]
+    assert '  none given yet: Jane Doe, Paul' in lines
+    # The teacher gives Jane's points: a rescore (the desk again, no WORKSHEET=) fills the kept worksheet,
+    # asks for no point already given, and ends with the commands to paste, OUT quoted.
+    from test_grader_hand import fill
+    fill(os.path.join(out, hand.FILE), {('Jane Doe', item): str(top) for item, (top, _) in HAND_ITEMS.items()})
+    lines = desk.finish(out, records)
+    assert any('1 whole grade(s)' in l and moodle.UPLOAD in l for l in lines), lines
+    assert '  none given yet: Paul' in lines and not any('Jane Doe' in l and 'not given' in l for l in lines)
+    with open(os.path.join(out, moodle.UPLOAD), encoding='utf-8-sig') as f:
+        assert '"Participant 101","Jane Doe",17,17.00' in f.read()  # 30 of 30 on a worksheet out of 17
+    with open(os.path.join(out, 'index.html')) as f:
+        assert 'none given yet: Paul' in f.read()  # the page says whose hand points are missing
+    commands = desk.next_commands(out, records)
+    assert '  make worksheet OUT="%s"' % out in commands and any('make rescore OUT="%s"' % out in c for c in commands)
 
 
 def test_the_plot_draws_the_kept_measurements_never_a_file_in_the_logs(tmp_path):
@@ -241,8 +257,32 @@ class Clock(object):
 def test_time_left_estimate():
     assert progress.estimate_left([], [], 4, 2) == pytest.approx(2 * 45.0)
     assert progress.estimate_left([40.0, 60.0], [10.0], 2, 2) == pytest.approx((2 * 50 + 40) / 2)
-    assert progress.estimate_left([50.0], [70.0], 0, 2) == pytest.approx(5.0)  # overdue: a tenth
+    # overdue: each student takes as long as the longest seen, a running one a tenth of that at least
+    assert progress.estimate_left([50.0], [70.0], 0, 2) == pytest.approx(7.0)
     assert progress.estimate_left([50.0], [], 0, 2) == 0.0
+
+
+def test_time_left_is_never_stuck_then_rising():
+    """Issue 49: 5 students, 4 at a time, each 100 s: the estimate stayed at "about 16 s" while the
+    first four outlasted the 45 s prior, then jumped up. Now, past the prior and before any is done,
+    it is not given; once one is done it only falls as the class goes on."""
+    shown = []
+    for t in range(0, 300, 5):
+        first = [min(t, 100.0)] * 4 if t < 100 else []
+        done = [100.0] * 4 if t >= 100 else []
+        running = first if t < 100 else [t - 100.0]
+        if t >= 200:
+            done, running = done + [100.0], []
+        waiting = 1 if t < 100 else 0
+        shown.append((t, progress.estimate_left(done, running, waiting, 4)))
+    before = [left for t, left in shown if t <= 45]
+    assert before == sorted(before, reverse=True) and before[0] == pytest.approx(45 + 45 / 4.0)
+    assert all(left is None for t, left in shown if 45 < t < 100)
+    after = [left for t, left in shown if t >= 100]
+    assert after == sorted(after, reverse=True) and after[0] == pytest.approx(100.0) and after[-1] == 0.0
+    line = progress.ClassProgress(4, io.StringIO(), live=False, clock=lambda: 60.0)
+    line.total, line.running = 5, {'Jane': [0.0, 'main flight']}
+    assert line.line().endswith('time left known when the first student is done')
 
 
 def test_class_progress_on_a_terminal_and_off():
@@ -323,3 +363,66 @@ def test_pdf_pages_in_linear_time(tmp_path):
         pytest.fail('pdf_pages took over 60 s on a 4 MB PDF')
     pages, seconds = out.stdout.decode().split()
     assert pages == '7' and float(seconds) < 0.5, out.stdout
+
+
+def test_the_default_out_is_pasted_as_it_is():
+    """Issue 49: Moodle's zip name gave a folder ending in .zip with spaces and parentheses, which every
+    later OUT= needed quoted. The default has neither; any OUT is printed quoted as bash reads it back."""
+    import subprocess
+    name = moodle.out_name('/home/t/ROS-2026-Exam submarinedrone (groupe D)-915302.zip')
+    assert name == 'ROS-2026-Exam_submarinedrone_groupe_D-915302'
+    assert moodle.out_name('/x/Cours d\'été "ROS".tar.gz') == 'Cours_d_été_ROS'
+    assert moodle.out_name('/x/class/') == 'class'
+    for out in ('/tmp/a b (c)', '/tmp/x"y$z`w\\v', '/tmp/plain'):
+        said = subprocess.run(['bash', '-c', 'printf %s ' + moodle.shell_quoted(out)], stdout=subprocess.PIPE)
+        assert said.stdout.decode() == out
+
+
+def test_a_report_only_student_has_the_class_sheet_and_counts_in_no_statistic(tmp_path):
+    """Issue 49 point 3: a student who handed in only a report (not graded: no package; the runner's
+    default sheet, altitude) is listed with the class's sheet, counted in neither the mean nor the
+    histogram, and her hand points make her grade in the worksheet."""
+    out = str(tmp_path)
+    depth = [dict(record(name, participant=number), sheet='depth') for name, number in (('Ann', 1), ('Bob', 2))]
+    report_only = record('Cleo', status='not graded', participant=3,
+                         reason='submission refused: no catkin package (package.xml) in Cleo_3 (seen: report.pdf)')
+    report_only['items'] = [dict(e, points=0.0) for e in report_only['items']]
+    report_only['total'] = 0.0
+    records = depth + [report_only]
+    for r in records:
+        report.write_grade(os.path.join(out, r['student']), r)
+    report.write_csv(os.path.join(out, 'grades.csv'), records)
+    worksheet = tmp_path / 'ws.csv'
+    worksheet.write_text('\ufeffIdentifier,Full name,Grade,Maximum grade,Last modified (grade),Feedback comments\n'
+                         + ''.join('"Participant %d",%s,,20.00,-,\n' % (n, s) for s, n in (('Ann', 1), ('Bob', 2), ('Cleo', 3))),
+                         encoding='utf-8')
+    desk.finish(out, records, worksheet=str(worksheet))
+    assert {h.student: h for h in hand.read(os.path.join(out, hand.FILE)).values()}
+    with open(os.path.join(out, hand.FILE), encoding='utf-8') as f:
+        assert [row['sheet'] for row in csv.DictReader(f) if row['student'] == 'Cleo'] == ['depth']
+    with open(os.path.join(out, 'grades.csv'), encoding='utf-8') as f:
+        assert [row['sheet'] for row in csv.DictReader(f) if row['student'] == 'Cleo'] == ['depth']
+    with open(os.path.join(out, 'index.html')) as f:
+        text = f.read()
+    assert 'mean 17.0 / 17 over the 2 whose package ran; 1 not graded' in text
+    histogram = text[text.index('<svg'):text.index('</svg>')]
+    assert '<title>0 point(s): 0 student(s)</title>' in histogram and '<title>17 point(s): 2 student(s)</title>' in histogram
+    from test_grader_hand import fill
+    fill(os.path.join(out, hand.FILE), {('Cleo', item): str(top) for item, (top, _) in HAND_ITEMS.items()})
+    lines = desk.finish(out, records)
+    assert any('1 whole grade(s)' in l for l in lines), lines
+    with open(os.path.join(out, moodle.UPLOAD), encoding='utf-8-sig') as f:
+        cleo = [row for row in csv.DictReader(f) if row['Full name'] == 'Cleo'][0]
+    assert cleo['Grade'] == '8.67'  # 0 + 13 of 30, out of 20
+    assert 'nothing of the package ran: submission refused' in cleo['Feedback comments']
+
+
+def test_a_status_reason_is_said_once():
+    """A doubt that is the status reason itself (several uploads) is not printed twice on its line."""
+    twice = dict(record('Jane', status='needs a hand grade', reason='several uploads: a.zip and b.zip'),
+                 doubts=['several uploads: a.zip and b.zip', 'a launch file warning'])
+    line, = report.needing_the_teacher([twice])
+    assert line.count('several uploads') == 1 and 'a launch file warning' in line
+    text = page.render([twice], 'Class', {})
+    first = re.sub(r' title="[^"]*"', '', text[text.index('id="first"'):text.index('id="histogram"')])
+    assert first.count('several uploads') == 1  # (the status's tooltip aside)

@@ -322,7 +322,7 @@ def test_a_students_text_is_escaped(tmp_path):
     shown = ''.join(parsed.text)
     assert topic in shown and '\'single\' "double" </td></tr><img src=x onerror=alert(1)> end' in shown
     assert '&lt;script&gt;alert(&quot;x&quot;)' in text
-    assert 'REFUSED ""WARNING"<b>" call (1)' in shown  # the plot's label, a student's request, as text: its first 12 characters once the bell was gone (the probe's record made it safe)
+    assert 'REFUSED ""WARNING"<b>" calls (1 in the flight)' in shown  # the plot's label, a student's request, as text: its first 12 characters once the bell was gone (the probe's record made it safe)
 
 
 def test_hand_points_merged_or_left_out(tmp_path):

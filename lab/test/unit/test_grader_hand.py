@@ -4,7 +4,7 @@ import csv
 
 import pytest
 
-from exam_lab.grader.publish import hand, report
+from exam_lab.grader.publish import hand, moodle, report
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 
 
@@ -149,7 +149,7 @@ def test_the_whole_grade_on_the_worksheets_scale_and_nothing_missing_taken_as_ze
     (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8', newline='')
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 0
     printed = capsys.readouterr().out
-    filled = (out / 'ws-whole.csv').read_text(encoding='utf-8-sig')
+    filled = (out / moodle.UPLOAD).read_text(encoding='utf-8-sig')
     rows = {r['Full name']: r for r in csv.DictReader(filled.splitlines())}
     # Jane: 17 + 12 = 29 of 30 on a worksheet out of 20.
     assert rows['Jane Doe']['Grade'] == '19.33'
@@ -157,7 +157,7 @@ def test_the_whole_grade_on_the_worksheets_scale_and_nothing_missing_taken_as_ze
     assert '29 / 30 points: 17 of 17 by the machine' in comment and 'quality 1/2 (by hand)' in comment
     # Paul's hand points are not all given: no grade, and he is named with what is missing.
     assert rows['Paul Martin']['Grade'] == '' and rows['Paul Martin']['Feedback comments'] == ''
-    assert 'Paul Martin: Q5, Q6, Q7, Q8, Q9, comments, quality' in printed
+    assert 'Paul Martin (hand points not given yet in hand.csv: Q5, Q6, Q7, Q8, Q9, comments, quality)' in printed
     assert 'hand points not given yet' in printed
 
 
@@ -172,7 +172,7 @@ def test_a_badly_filled_hand_csv_stops_the_worksheet_with_every_problem(tmp_path
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
     err = capsys.readouterr().err
     assert "column Q5: 'two'" in err and "column comments: '9'" in err
-    assert not (out / 'ws-whole.csv').exists()
+    assert not (out / moodle.UPLOAD).exists()
 
 
 def test_a_grade_json_that_is_no_grade_stops_the_worksheet_naming_it(tmp_path, capsys):
@@ -187,7 +187,7 @@ def test_a_grade_json_that_is_no_grade_stops_the_worksheet_naming_it(tmp_path, c
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
     err = capsys.readouterr().err
     assert 'NOT filled: Paul Martin/grade.json: grade.json.total' in err, err
-    assert not (out / 'ws-whole.csv').exists()
+    assert not (out / moodle.UPLOAD).exists()
     (out / 'Paul Martin' / 'grade.json').write_text(json.dumps(paul)[:40])
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
     assert 'NOT filled: Paul Martin/grade.json' in capsys.readouterr().err
@@ -248,12 +248,12 @@ def test_a_name_differing_by_a_trailing_dot_never_takes_a_classmates_hand_points
     assert hands[1002].student == 'Jane Doe_2' and all(v is None for v in hands[1001].points.values())
     (tmp_path / 'ws.csv').write_text(WORKSHEET_TWO_JANES, encoding='utf-8', newline='')
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 0
-    filled = (out / 'ws-whole.csv').read_text(encoding='utf-8-sig')
+    filled = (out / moodle.UPLOAD).read_text(encoding='utf-8-sig')
     rows = {r['Identifier']: r for r in csv.DictReader(filled.splitlines())}
     assert rows['Participant 1002']['Grade'] == '28'  # 15 + 13 of 30
     assert 'a clear report' in rows['Participant 1002']['Feedback comments']
     assert rows['Participant 1001']['Grade'] == '' and rows['Participant 1001']['Feedback comments'] == ''
-    assert 'Jane Doe: Q4, Q5' in capsys.readouterr().out  # 1001's hand points: none given yet
+    assert 'Jane Doe (hand points not given yet in hand.csv: Q4, Q5' in capsys.readouterr().out  # 1001's: none yet
 
 
 def test_a_kept_row_whose_participant_no_longer_matches_stops_the_worksheet(tmp_path, capsys):
@@ -270,7 +270,7 @@ def test_a_kept_row_whose_participant_no_longer_matches_stops_the_worksheet(tmp_
     err = capsys.readouterr().err
     assert 'hand.csv line 3 (Jane Doe, participant 1002)' in err
     assert 'Jane Doe (participant 1001, folder Jane Doe._1001_assignsubmission_file_)' in err
-    assert not (out / 'ws-whole.csv').exists()
+    assert not (out / moodle.UPLOAD).exists()
 
 
 def test_a_row_without_a_number_is_not_given_to_a_student_who_has_one(tmp_path, capsys):

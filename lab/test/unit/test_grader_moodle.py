@@ -6,9 +6,9 @@ import io
 
 import pytest
 
-from exam_lab.grader.publish import cells, moodle
+from exam_lab.grader.publish import cells, hand, moodle
 from exam_lab.grader.score import identity
-from exam_lab.grader.score.sheets import ITEMS
+from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 
 #: The header line of a real worksheet, exactly as Moodle wrote it in English (quoting included):
 #: copied from a public grading script that quotes a downloaded worksheet's first line in a comment
@@ -20,22 +20,23 @@ from exam_lab.grader.score.sheets import ITEMS
 HEADER_LINE = ('Identifier,"Full name","Email address",Status,Group,Grade,"Maximum Grade","Grade can be changed",'
                '"Last modified (submission)","Last modified (grade)","Feedback comments"')
 HEADER = next(csv.reader([HEADER_LINE]))
-#: Rows as Moodle's writer quotes them (spaces, commas, line breaks, quotes), CRLF line ends.
+#: Rows as Moodle's writer quotes them (spaces, commas, line breaks, quotes), CRLF line ends; the
+#: assignment's maximum grade 30, the sheets' points (the grades written are the whole grades as they are).
 WORKSHEET = '\ufeff' + '\r\n'.join([
     HEADER_LINE,
-    '"Participant 101","Jane Doe",jane@example.org,"Submitted for grading","Team ""A"", the\nmorning",,17.00,Yes,'
+    '"Participant 101","Jane Doe",jane@example.org,"Submitted for grading","Team ""A"", the\nmorning",,30.00,Yes,'
     '"Monday, 3 March 2025, 10:12 AM",-,',
-    '"Participant 102","Paul Martin",paul@example.org,"Submitted for grading","Default group",,17.00,Yes,'
+    '"Participant 102","Paul Martin",paul@example.org,"Submitted for grading","Default group",,30.00,Yes,'
     '"Monday, 3 March 2025, 10:13 AM",-,',
-    '"Participant 103","Ada Lovelace",ada@example.org,"Submitted for grading","Default group",12.00,17.00,Yes,'
+    '"Participant 103","Ada Lovelace",ada@example.org,"Submitted for grading","Default group",12.00,30.00,Yes,'
     '"Monday, 3 March 2025, 10:14 AM","Monday, 3 March 2025, 11:00 AM","<p>seen by hand</p>"',
-    '"Participant 104","Alan Turing",alan@example.org,"No submission","Default group",,17.00,Yes,-,-,',
-    '"Participant 105","Grace Hopper",grace@example.org,"Submitted for grading","Default group",,17.00,Yes,'
+    '"Participant 104","Alan Turing",alan@example.org,"No submission","Default group",,30.00,Yes,-,-,',
+    '"Participant 105","Grace Hopper",grace@example.org,"Submitted for grading","Default group",,30.00,Yes,'
     '"Monday, 3 March 2025, 10:15 AM",-,',
 ]) + '\r\n'
 
 
-def record(student, participant, points, status='graded'):
+def machine_record(student, participant, points, status='graded'):
     items = []
     for item, (top, _) in ITEMS.items():
         got = top if item != 'Q11' else points - (sum(t for t, _ in ITEMS.values()) - top)
@@ -43,6 +44,12 @@ def record(student, participant, points, status='graded'):
                       'evidence': 'values: 3 of 3 disagree, "in degC"\nmore' if got < top else 'ok'})
     return {'student': student, 'participant': participant, 'total': points, 'max': 17.0, 'items': items,
             'status': status, 'status_reason': 'the node crashed' if status != 'graded' else ''}
+
+
+def record(student, participant, points, status='graded'):
+    """The whole grade make worksheet fills with: the machine's ``points`` and every hand point given."""
+    return hand.combine(machine_record(student, participant, points, status),
+                        hand.Hand(student, {item: top for item, (top, _) in HAND_ITEMS.items()}, '', participant))
 
 
 RECORDS = [record('Jane Doe', 101, 17.0), record('Paul Martin', 102, 15.5), record('Ada Lovelace', 103, 17.0),
@@ -93,8 +100,8 @@ def test_filled_worksheet_reads_back_row_by_row():
             if column not in (grade, comments):
                 assert cell == old, (number, header[column])
     jane, paul = by_id['101'][0], by_id['102'][0]
-    assert jane[grade] == '17' and paul[grade] == '15.5'
-    assert paul[comments].startswith('<p>Machine-graded by running the package: 15.5 / 17 points')
+    assert jane[grade] == '30' and paul[grade] == '28.5'
+    assert paul[comments].startswith('<p>28.5 / 30 points: 15.5 of 17 by the machine')
     for item in ITEMS:
         assert '<li>%s ' % item in paul[comments]
     assert '<li>Q11 2.5/4: values: 3 of 3 disagree, &quot;in degC&quot;</li>' in paul[comments]
@@ -115,15 +122,15 @@ def test_every_byte_outside_the_filled_cells_is_kept():
     for line in (3, 4, 5):  # Ada (graded by hand), Alan (no submission), Grace (needs a hand grade)
         assert before[line] == after[line]
     assert after[1].startswith('"Participant 101","Jane Doe",jane@example.org,"Submitted for grading","Team ""A"", '
-                               'the\nmorning",17,17.00,')
+                               'the\nmorning",30,30.00,')
     assert filled.endswith('\r\n')
 
 
 def test_decimal_comma_follows_the_worksheet():
-    text = WORKSHEET.replace('17.00', '"17,00"').replace('12.00', '"12,00"')
+    text = WORKSHEET.replace('30.00', '"30,00"').replace('12.00', '"12,00"')
     filled, _ = moodle.fill(text, RECORDS)
     header, rows = moodle_read(filled)
-    assert rows[1][header.index('Grade')] == '15,5'
+    assert rows[1][header.index('Grade')] == '28,5'
 
 
 def test_a_malformed_worksheet_is_refused():
@@ -144,10 +151,42 @@ def test_the_identifier_column_in_another_language_is_found_by_its_cells():
 
 
 def test_points_above_the_maximum_are_not_written():
-    text = WORKSHEET.replace('17.00', '10.00')
-    _, summary = moodle.fill(text, RECORDS)
+    """Scaled, a grade exceeds the maximum only when its points exceed their own maximum: never written."""
+    _, summary = moodle.fill(WORKSHEET, [dict(RECORDS[0], total=31.0)])
     assert summary['graded'] == []
     assert any('exceed the maximum' in why for _, why in summary['kept'])
+
+
+def test_only_whole_grades_are_written():
+    """The machine's 17 points alone, or a whole grade with a hand point missing, are no grade: the
+    row stays as downloaded, its feedback cell too (Moodle imports a feedback cell even with no grade:
+    process_import_grades in mod/assign/feedback/offline/locallib.php), and the summary says why."""
+    missing = hand.combine(machine_record('Paul Martin', 102, 15.5), hand.Hand('Paul Martin', {'Q4': 1.0}, '', 102))
+    filled, summary = moodle.fill(WORKSHEET, [machine_record('Jane Doe', 101, 17.0), missing])
+    assert filled == WORKSHEET and summary['graded'] == []
+    why = dict(summary['kept'])
+    assert why['Jane Doe'].startswith("only the machine's 17 points, not a grade") and \
+        why['Paul Martin'].startswith('hand points not given yet in hand.csv: Q5, Q6')
+
+
+def test_a_report_only_student_is_hand_gradable():
+    """A student who handed in a report only (refused before anything ran: 0 by the machine) gets her
+    hand points as her grade; a student the grader failed on does not (0 would not be measured)."""
+    refused = record('Paul Martin', 102, 0.0, status='not graded')
+    refused['status_reason'] = 'submission refused: no catkin package (package.xml) in report.pdf'
+    failed = dict(record('Jane Doe', 101, 0.0, status='not graded'), status_reason='the grader failed on this submission')
+    filled, summary = moodle.fill(WORKSHEET, [refused, failed])
+    assert summary['graded'] == [('Paul Martin', 102, '13')]
+    assert 'nothing of the package ran: submission refused: no catkin package' in filled
+    assert dict(summary['kept'])['Jane Doe'].startswith('status "not graded"')
+
+
+def test_the_teachers_remark_is_a_paragraph_of_its_own():
+    """Never spliced into the grade's sentence (issue 49: "...code quality). relu le 1 The grade is")."""
+    whole = dict(record('Jane Doe', 101, 17.0), remark='relu le 1')
+    text = moodle.feedback(whole, maximum=20.0)
+    assert "code quality). The grade is these points scaled to 20 (x 20/30).</p><p>The teacher&#x27;s remark: " \
+        "relu le 1</p><ul>" in text
 
 
 def test_fill_file_and_summary(tmp_path):
@@ -156,7 +195,7 @@ def test_fill_file_and_summary(tmp_path):
     summary = moodle.fill_file(str(source), str(target), RECORDS)
     assert target.read_bytes().startswith(b'\xef\xbb\xbf')
     lines = moodle.summary_lines(summary, str(target))
-    assert '2 grade(s) written' in lines[0]
+    assert '2 whole grade(s)' in lines[0] and 'upload it in Moodle' in lines[0]
     assert any('NOT MATCHED: Eve Elsewhere' in line for line in lines)
 
 
@@ -184,19 +223,18 @@ WORD = {'en': 'Participant', 'en AMOS': 'Participant', 'fr': 'Participant', 'de'
 
 
 @pytest.mark.parametrize('language', sorted(LANGUAGES))
-@pytest.mark.parametrize('scale', [False, True])
-def test_moodles_own_headers_in_each_language_and_any_case(language, scale):
+def test_moodles_own_headers_in_each_language_and_any_case(language):
     """The maximum grade column is found whatever its language or case: with the worksheet out of 20,
-    15.5 of 17 is written as it is (the summary says NOT SCALED) or scaled to 18.24."""
+    the whole grade 28.5 of 30 is scaled to 19."""
     text = '\ufeff' + '\r\n'.join([
         LANGUAGES[language],
         '"%s 102","Paul Martin",paul@example.org,"-",,20.00,Yes,-,-,' % WORD[language],
     ]) + '\r\n'
-    filled, summary = moodle.fill(text, [record('Paul Martin', 102, 15.5)], scale=scale)
-    assert summary['graded'] == [('Paul Martin', 102, '18.24' if scale else '15.5')]
+    filled, summary = moodle.fill(text, [record('Paul Martin', 102, 15.5)])
+    assert summary['graded'] == [('Paul Martin', 102, '19')]
     assert summary['maxima'] == [20.0]
     header, rows = moodle_read(filled)
-    assert rows[0][4] == ('18.24' if scale else '15.5') and rows[0][9].startswith('<p>')
+    assert rows[0][4] == '19' and rows[0][9].startswith('<p>')
 
 
 def test_a_worksheet_whose_maximum_grade_is_not_recognised_stops():
@@ -204,9 +242,8 @@ def test_a_worksheet_whose_maximum_grade_is_not_recognised_stops():
     not recognised stops the filling, naming what was looked for; a scale says so."""
     for other in ('Max. grade', 'Maximum points'):
         text = WORKSHEET.replace('"Maximum Grade"', '"%s"' % other, 1)
-        for scale in (False, True):
-            with pytest.raises(moodle.WorksheetError, match="no maximum grade column .*'Maximum Grade'"):
-                moodle.fill(text, RECORDS, scale=scale)
+        with pytest.raises(moodle.WorksheetError, match="no maximum grade column .*'Maximum Grade'"):
+            moodle.fill(text, RECORDS)
     with pytest.raises(moodle.WorksheetError, match='graded on a scale'):
         moodle.fill(WORKSHEET.replace('"Maximum Grade"', 'Scale', 1), RECORDS)
     with pytest.raises(moodle.WorksheetError, match='no last modified'):
@@ -214,8 +251,8 @@ def test_a_worksheet_whose_maximum_grade_is_not_recognised_stops():
 
 
 def test_a_row_whose_maximum_is_no_number_is_left_with_why():
-    text = WORKSHEET.replace('"Default group",,17.00', '"Default group",,', 1)  # Paul's row
-    _, summary = moodle.fill(text, RECORDS, scale=True)
+    text = WORKSHEET.replace('"Default group",,30.00', '"Default group",,', 1)  # Paul's row
+    _, summary = moodle.fill(text, RECORDS)
     assert ('Paul Martin', "its maximum grade '' is not a number above 0") in summary['kept']
     assert [g[0] for g in summary['graded']] == ['Jane Doe']
 
@@ -234,7 +271,7 @@ def test_cells_a_student_chose_cannot_run_in_a_spreadsheet():
         assert jane[header.index(column)] == "'" + value
         assert cells.read_cell(jane[header.index(column)]) == value
     assert rows[1][1] == "'\tPaul" and rows[2][1] == "''t Hooft"
-    assert jane[header.index('Grade')] == '17' and jane[header.index('Last modified (grade)')] == '-'
+    assert jane[header.index('Grade')] == '30' and jane[header.index('Last modified (grade)')] == '-'
     assert rows[3][header.index('Last modified (submission)')] == '-'
     assert [g[1] for g in summary['graded']] == [101, 102]
 

@@ -174,16 +174,20 @@ WORKSHEET = ('\ufeffIdentifier,"Full name",Status,Grade,"Maximum grade","Grade c
 
 
 def test_the_worksheet_scale_is_never_silent():
+    """The machine's 17 points are never written into a column out of 20; the whole grade is, scaled,
+    and both the comment and the terminal say so."""
+    from exam_lab.grader.publish import hand
+    from exam_lab.grader.score.sheets import HAND_ITEMS
     record = {'student': 'Jane Doe', 'participant': 12, 'total': 17.0, 'max': 17.0, 'status': 'graded',
               'items': [{'id': 'runs', 'points': 2.0, 'max': 2.0, 'evidence': ''}]}
     text, summary = moodle.fill(WORKSHEET, [record])
-    assert summary['graded'] == [('Jane Doe', 12, '17')]
-    assert 'not out of the maximum grade 20' in text
-    assert any('NOT SCALED' in l and 'out of 17' in l for l in moodle.summary_lines(summary, 'x.csv'))
-    text, summary = moodle.fill(WORKSHEET, [record], scale=True)
+    assert summary['graded'] == [] and text == WORKSHEET
+    assert any("no whole grade yet" in l for l in moodle.summary_lines(summary, 'x.csv'))
+    whole = hand.combine(record, hand.Hand('Jane Doe', {i: top for i, (top, _) in HAND_ITEMS.items()}, '', 12))
+    text, summary = moodle.fill(WORKSHEET, [whole])
     assert summary['graded'] == [('Jane Doe', 12, '20')]
-    assert 'scaled to 20' in text
-    assert any('SCALED' in l and 'x 20/17' in l for l in moodle.summary_lines(summary, 'x.csv'))
+    assert 'scaled to 20 (x 20/30)' in text
+    assert any('scaled to the maximum grade 20' in l for l in moodle.summary_lines(summary, 'x.csv'))
 
 
 def test_the_class_name_for_the_title():
@@ -215,7 +219,7 @@ def test_refused_calls_on_the_plot(tmp_path, monkeypatch):
         return original(self, *args, **kwargs)
     monkeypatch.setattr(Axes, 'plot', plot)
     assert flightplot.draw([('main', probe)], str(tmp_path / 'flight.png'))
-    assert 'REFUSED "warning" call (1)' in labels and 'REFUSED "normal" call (1)' in labels, labels
+    assert 'REFUSED "warning" calls (1 in the flight)' in labels and 'REFUSED "normal" calls (1 in the flight)' in labels, labels
 
 
 def test_grade_md_says_what_to_look_at():

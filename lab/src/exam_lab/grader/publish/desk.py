@@ -2,7 +2,8 @@
 
 After grading, :func:`finish` writes, in ``OUT``: each student's Gradescope ``results.json`` and
 flight plot, the hand points proposed (``proposals.csv``, :mod:`exam_lab.grader.publish.proposals`),
-the similarity check across the class, the Moodle worksheet filled (when one is given),
+the similarity check across the class, hand.csv (the teacher's points), the Moodle worksheet
+with the whole grades (``moodle-worksheet.csv``, when a worksheet is given or kept: :func:`worksheet_lines`),
 each released student's feedback page in ``moodle-feedback.zip`` (:mod:`exam_lab.grader.publish.feedback`)
 and ``index.html`` (:mod:`exam_lab.grader.publish.page`).
 
@@ -12,6 +13,7 @@ student's section, on the page's top and on the terminal; the rest is written. T
 already written by then (grade.json, grades.csv): nothing here may lose them.
 """
 import html
+import importlib.util
 import json
 import os
 
@@ -113,15 +115,15 @@ def _student(out, record, single):
     return entry
 
 
-def finish(out, records, single=False, similar=None, worksheet=None, scale=False, title=None, show=None):
+def finish(out, records, single=False, similar=None, worksheet=None, title=None, show=None):
     """Write the desk's files for ``records`` graded into ``out``; return lines for the terminal.
 
     :param single: one submission (its results are in ``out`` itself, not ``out/<student>``).
     :param similar: the similarity check's record (a :class:`~exam_lab.grader.score.records.SimilarityRecord`:
         :func:`exam_lab.grader.class_run.class_similarity`, :func:`read_similarity`) or None; a plain
         dict is refused (TypeError): its text would reach the page uncleaned.
-    :param worksheet: the Moodle worksheet to fill, or None.
-    :param scale: scale the grades to the worksheet's maximum grade (:func:`moodle.fill`).
+    :param worksheet: the Moodle worksheet the teacher downloaded, or None (the one kept in OUT, if
+        any: :func:`worksheet_lines`).
     :param title: the class's name (:func:`moodle.class_name`); the output folder's name when None.
     :param show: what the students' feedback pages show (:func:`feedback.write`); None: lab/check_visibility.ini.
     """
@@ -130,6 +132,11 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
                         % type(similar).__name__)
     lines, notes, entries = [], [], {}
     records, refused = _grade_records(records)
+    sheeted = report.with_class_sheet(records)
+    if not single and any(a is not b for a, b in zip(records, sheeted)) and \
+            os.path.isfile(os.path.join(out, 'grades.csv')):
+        report.write_csv(os.path.join(out, 'grades.csv'), sheeted)
+    records = sheeted
     for record in records:
         entry = entries[record['student']] = _student(out, record, single)
         entry['problems'][:0] = refused.get(id(record), [])
@@ -140,26 +147,19 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
     lines += twice
     try:
         added = hand.write(os.path.join(out, hand.FILE), records)
-        lines.append('hand points: %s (%d new row(s)): fill in the %d points the machine does not judge, '
-                     'then make worksheet OUT=%s WORKSHEET=<Moodle worksheet>' % (
-                         os.path.join(out, hand.FILE), added, hand.HAND_MAX, out))
+        lines += hand_lines(out, records, added)
     except (hand.HandError, OSError) as err:  # the teacher's file as it is: never overwritten blindly
         lines.append('hand.csv NOT written: %s' % err)
     try:
         lines += proposals.write(out, records, single)
     except OSError as err:
         lines.append('proposals.csv NOT written: %s' % err)
-    if worksheet:
-        base = os.path.splitext(os.path.basename(worksheet))[0]
-        target = os.path.join(out, '%s-filled.csv' % base)
-        try:
-            summary = moodle.fill_file(worksheet, target, newest, scale)
-            lines += moodle.summary_lines(summary, target)
-            contract.write_text(os.path.join(out, 'worksheet.json'), json.dumps(summary, indent=1, sort_keys=True))
-        except (moodle.WorksheetError, OSError) as err:
-            lines.append('worksheet NOT filled: %s' % err)
-        except Exception as err:  # a bug on one record's text: the page must still say so
-            lines.append('worksheet NOT filled (a grader bug, please report): %s' % _failure(err))
+    try:
+        lines += worksheet_lines(out, records, worksheet)
+    except (hand.HandError, moodle.WorksheetError, OSError) as err:
+        lines.append('worksheet: %s NOT written: %s' % (moodle.UPLOAD, err))
+    except Exception as err:  # a bug on one record's text: the page must still say so
+        lines.append('worksheet: %s NOT written (a grader bug, please report): %s' % (moodle.UPLOAD, _failure(err)))
     try:
         lines += feedback.write(out, newest, single, show)
     except Exception as err:  # the grades are written; the page must still say why the zip is not
@@ -186,6 +186,83 @@ def finish(out, records, single=False, similar=None, worksheet=None, scale=False
     contract.write_text(os.path.join(out, 'index.html'), content)
     lines.append('page: %s' % os.path.join(out, 'index.html'))
     return [safe_text.one_line(line) for line in lines]
+
+
+def hand_lines(out, records, added=0):
+    """What the teacher reads of hand.csv: where it is, and whose hand points are still missing (all of
+    them, or the items), so that a run after the teacher gave them never asks for them again."""
+    path = os.path.join(out, hand.FILE)
+    try:
+        rows, _ = hand.match(hand.read(path), records)
+    except hand.HandError as err:
+        return ['hand points: %s written, but cannot be matched to the students: %s' % (path, err)]
+    missing = [(r['student'], hand.combine(r, row)['missing']) for r, row in zip(records, rows)]
+    none_given = [s for s, items in missing if len(items) == len(hand.HAND_ITEMS)]
+    some = [(s, items) for s, items in missing if items and len(items) < len(hand.HAND_ITEMS)]
+    head = 'hand points: %s (%d new row(s)): ' % (path, added)
+    if not none_given and not some:
+        return [head + 'all %d given for each of the %d student(s)' % (hand.HAND_MAX, len(records))]
+    lines = [head + 'the %d points the machine does not judge are missing for %d of %d student(s)'
+             % (hand.HAND_MAX, len(none_given) + len(some), len(records))]
+    if none_given:
+        lines.append('  none given yet: %s' % ', '.join(none_given))
+    for student, items in some:
+        lines.append('  %s: %s not given yet' % (student, ', '.join(items)))
+    return lines
+
+
+def worksheet_lines(out, records, worksheet=None):
+    """Fill Moodle's worksheet with the whole grades: ``records`` (the machine's) with their hand points
+    of ``out/hand.csv``, scaled, into ``out/moodle-worksheet.csv`` (:data:`moodle.UPLOAD`), the one file
+    to upload; return the lines for the terminal and the page. ``worksheet`` (the file the teacher
+    downloaded) is kept in OUT as :data:`moodle.DOWNLOADED`, which a later run fills again when none is
+    given; with neither, nothing is done ([]). make grade, make rescore and make worksheet all fill it
+    here, so the file, its name and its lines are the same whichever ran last.
+
+    :raises hand.HandError: hand.csv unreadable, or a row that could be another student's.
+    :raises moodle.WorksheetError: the worksheet lacks what Moodle's importer needs.
+    """
+    kept = os.path.join(out, moodle.DOWNLOADED)
+    if not worksheet and not contract.exists(kept):
+        return []
+    records, _ = hand.newest(records)  # one participant graded twice: its newest (said by the caller)
+    path = os.path.join(out, hand.FILE)
+    hands = hand.read(path) if contract.exists(path) else {}
+    if worksheet and (not contract.exists(kept) or not os.path.samefile(worksheet, kept)):
+        with open(worksheet, 'rb') as f:  # the teacher's own file, named on the command line
+            contract.write_bytes(kept, f.read(moodle.MAX_WORKSHEET_BYTES + 1))
+    rows, notes = hand.match(hands, records)
+    whole = [hand.combine(record, row) for record, row in zip(records, rows)]
+    target = os.path.join(out, moodle.UPLOAD)
+    summary = moodle.fill_file(kept, target, whole)
+    contract.write_text(os.path.join(out, 'worksheet.json'), json.dumps(summary, indent=1, sort_keys=True))
+    return [safe_text.one_line(n) for n in notes] + moodle.summary_lines(summary, target)
+
+
+def next_commands(out, records):
+    """The commands that come next, for the terminal, ready to paste (OUT quoted): review and confirm
+    the hand points, fill the worksheet, what to upload; and for later, a rescore."""
+    where = moodle.shell_quoted(out)
+    lines = ['next (each command ready to paste; docs/grading.md, "Quick start"):']
+    path = os.path.join(out, hand.FILE)
+    try:
+        rows, _ = hand.match(hand.read(path), records)
+        missing = any(hand.combine(r, row)['missing'] for r, row in zip(records, rows))
+    except (hand.HandError, OSError):
+        missing = True
+    if missing:
+        if importlib.util.find_spec('exam_lab.grader.publish.review') is not None:
+            lines.append('  make review OUT=%s    # the hand points, reviewed and confirmed' % where)
+        else:
+            lines.append('  # give the hand points in %s (any spreadsheet, saved as CSV)' % path)
+    if os.path.isfile(os.path.join(out, moodle.DOWNLOADED)):
+        lines.append('  make worksheet OUT=%s' % where)
+    else:
+        lines.append('  make worksheet OUT=%s WORKSHEET="<the grading worksheet downloaded from Moodle>"' % where)
+    lines.append('  # then upload %s (Grading action: Upload grading worksheet) and %s (Upload multiple '
+                 'feedback files in a zip)' % (os.path.join(out, moodle.UPLOAD), os.path.join(out, 'moodle-feedback.zip')))
+    lines.append('  make rescore OUT=%s    # later: today\'s rubric on the kept measurements' % where)
+    return lines
 
 
 def _plain_page(title, records, problem):

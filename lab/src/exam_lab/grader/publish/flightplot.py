@@ -18,6 +18,10 @@ from exam_lab.grader.score.safe_text import one_line
 #: Legs of each run, in order, and the side of the threshold each is flown on.
 LEGS = {'rest': 'below', 'short_up': 'above', 'short_down': 'below', 'long_up': 'above', 'long_down': 'below', 'deep_down': 'below',
         'start': 'below', 'step': 'above'}
+#: Each leg's name on the plot: the manual's (docs/grading.md, "The legs of the flight"; a docs test
+#: holds the two together); the threshold run's first two its own.
+LEG_NAMES = {'rest': 'rest', 'short_up': 'short excursion', 'short_down': 'just below', 'long_up': 'long excursion',
+             'long_down': 'return just below', 'deep_down': 'further below', 'start': 'start', 'step': 'step'}
 _SIDE_COLOUR = {'above': '#f4cccc', 'below': '#d9e8f5'}
 #: Up to this many calls of a kind, each is also a vertical line across the panel.
 FEW_CALLS = 10
@@ -165,9 +169,10 @@ def _panel(ax, tag, probe):
     schedule = {k: clamp.time(v, t0) for k, v in (probe.get('schedule') or {}).items()}
     schedule = {k: v for k, v in schedule.items() if v is not None}  # seconds from the probe's start
     end = max([t for t, _ in published + beyond] + [t for t, _ in oracle] + [schedule.get('end', 0.0)])
-    for name, start, stop, side in legs(schedule):
+    for row, (name, start, stop, side) in enumerate(legs(schedule)):
         ax.axvspan(start, stop, color=_SIDE_COLOUR[side], alpha=0.6, lw=0)
-        ax.text((start + stop) / 2, 1.0, name.replace('_', ' '), transform=ax.get_xaxis_transform(),
+        # Two rows, one leg in two on each: the short legs' names (2 s wide) never overlap.
+        ax.text((start + stop) / 2, 1.0 + 0.08 * (row % 2), LEG_NAMES[name], transform=ax.get_xaxis_transform(),
                 ha='center', va='bottom', fontsize=7, color='#555555')
     if oracle:
         xs = [t for t, _ in oracle] + [end]
@@ -190,6 +195,15 @@ def _panel(ax, tag, probe):
     if threshold is not None:
         ax.axhline(threshold, color='#cc0000', ls='--', lw=1, label='threshold %g' % threshold)
     made = calls(probe)
+    # grade.md counts the calls of the flight (rest to end, question 13): so does the legend; those of the
+    # calibration before it are drawn and counted apart.
+    flown = (schedule.get('rest'), schedule.get('end')) if 'rest' in schedule and 'end' in schedule else None
+
+    def counted(times):
+        inside = [t for t in times if flown is None or flown[0] <= t <= flown[1]]
+        return '%d in the flight%s' % (len(inside), ', %d before' % (len(times) - len(inside))
+                                         if len(inside) < len(times) else '') if flown else '%d' % len(times)
+
     for kind in ('WARNING', 'NORMAL'):
         for accepted in (True, False):
             times = [clamp.time(t, t0) for t, meaning, _, ok in made if meaning == kind and ok == accepted]
@@ -201,19 +215,19 @@ def _panel(ax, tag, probe):
             if times:
                 ax.plot(times, [0.96] * len(times), 'v', color=_CALL_COLOUR[kind], ms=6, clip_on=False,
                         mfc=_CALL_COLOUR[kind] if accepted else 'white', transform=ax.get_xaxis_transform(),
-                        label='%s call (%d)' % (kind, len(times)) if accepted else
-                        'REFUSED %s call (%d)' % (' / '.join('"%s"' % r[:12] for r in requests[:2]), len(times)))
+                        label='%s calls (%s)' % (kind, counted(times)) if accepted else
+                        'REFUSED %s calls (%s)' % (' / '.join('"%s"' % r[:12] for r in requests[:2]), counted(times)))
     other = [(clamp.time(t, t0), r) for t, meaning, r, _ in made if meaning not in _CALL_COLOUR]
     other = [(t, r) for t, r in other if t is not None]
     if other:
         ax.plot([t for t, _ in other], [0.96] * len(other), 'x', color='#7a4a00', ms=6, clip_on=False,
-                transform=ax.get_xaxis_transform(), label='REFUSED other call (%d)' % len(other))
+                transform=ax.get_xaxis_transform(), label='REFUSED other calls (%s)' % counted([t for t, _ in other]))
     _limits(ax, [v for _, v in published], [v for _, v in oracle], threshold)
     if clamp.note():
         ax.text(0.99, 0.04, clamp.note(), transform=ax.transAxes, fontsize=8, color='#b00000', ha='right',
                 va='bottom', bbox=dict(facecolor='white', alpha=0.85, lw=0))
     run = 'main run' if tag == 'main' else 'threshold run (lowered threshold, question 14a)'
-    ax.set_title(run, fontsize=9, loc='left', pad=12)
+    ax.set_title(run, fontsize=9, loc='left', pad=22)
     ax.set_xlabel('s from the probe\'s start')
     ax.set_ylabel(probe.get('sheet') or 'value')
     ax.set_xlim(0, max(end, 1.0))

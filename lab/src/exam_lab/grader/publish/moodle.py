@@ -17,8 +17,16 @@ The layout is Moodle's own (``mod/assign/gradingtable.php`` in download mode, wr
 So the filled copy changes only the grade and the feedback cells of the rows it matched, byte for byte
 everything else (the mark, the quoting of every other cell, the line ends), and leaves a grade or a
 feedback already in the worksheet as it was (a teacher's grade wins over the machine's).
+
+One file is for Moodle: :data:`UPLOAD` in OUT, written only with whole grades (the machine's points
+and the teacher's hand points of ``hand.csv``, scaled to the worksheet's maximum grade). A student
+whose hand points are not all given is left blank there: the importer skips an empty grade
+(``process_import_grades`` in ``mod/assign/feedback/offline/locallib.php``), and since it imports a
+feedback cell even then, that cell is left as downloaded too. The machine's 17 points alone are never
+written into a grade column.
 """
 import html
+import os
 import re
 
 from exam_lab.grader import contract
@@ -57,6 +65,15 @@ HEADERS = {
 }
 #: Statuses whose points go into the grade column (the others wait for the teacher).
 GRADED = ('graded', 'graded with fixes')
+#: The start of the status reason of a submission refused before anything ran (no package in it, a
+#: report only, an archive refused): the machine's points are 0, measured as such, and the teacher's
+#: hand points (the report's questions) make its grade all the same.
+REFUSED = 'submission refused'
+#: The file to upload into Moodle (Grading action: Upload grading worksheet), in OUT.
+UPLOAD = 'moodle-worksheet.csv'
+#: Moodle's worksheet as the teacher downloaded it, kept in OUT: what make worksheet and make rescore
+#: fill again without WORKSHEET= (blank: importing it changes nothing).
+DOWNLOADED = 'worksheet-as-downloaded.csv'
 _BOM = '\ufeff'
 
 
@@ -67,18 +84,39 @@ class WorksheetError(Exception):
 #: Moodle's "download all submissions" zip: ``<course short name>-<assignment name>-<module id>.zip``
 #: (``download_submissions()`` in ``mod/assign/locallib.php``).
 _CLASS_ZIP = re.compile(r'^(.+?)-\d+$')
+_ENDINGS = ('.zip', '.tar.gz', '.tgz', '.tar')
+
+
+def _stem(path):
+    """``(file name without its archive ending, whether it had one)``."""
+    name = path.rstrip('/\\').replace('\\', '/').split('/')[-1]
+    for ending in _ENDINGS:
+        if name.lower().endswith(ending):
+            return name[:-len(ending)], True
+    return name, False
 
 
 def class_name(path):
     """The class's name for the page's title: Moodle's zip gives the course and the assignment
     (``ROS-Exam altitude-1234.zip`` gives ``ROS-Exam altitude``), a folder its own name."""
-    name = path.rstrip('/\\').replace('\\', '/').split('/')[-1]
-    for ending in ('.zip', '.tar.gz', '.tgz', '.tar'):
-        if name.lower().endswith(ending):
-            name = name[:-len(ending)]
-            match = _CLASS_ZIP.match(name)
-            return match.group(1) if match else name
-    return name
+    name, archive = _stem(path)
+    match = _CLASS_ZIP.match(name) if archive else None
+    return match.group(1) if match else name
+
+
+def out_name(path):
+    """The default output folder's name for a class or a submission at ``path``: its name without the
+    archive ending, each run of characters a shell would need quoted (spaces, parentheses, quotes;
+    letters of any language stay) one ``_``: ``ROS-2026-Exam submarinedrone (groupe D)-915302.zip`` gives
+    ``ROS-2026-Exam_submarinedrone_groupe_D-915302``, pasted as it is in any later ``OUT=``."""
+    name = re.sub(r'[^\w.-]+', '_', _stem(path)[0]).strip('_.')
+    return re.sub(r'_?-_?', '-', name) or 'grades'
+
+
+def shell_quoted(value):
+    """``value`` in double quotes as bash reads it back (``OUT="..."``): ``"``, ``$``, `````, ``\\``
+    escaped."""
+    return '"%s"' % re.sub(r'(["$`\\])', r'\\\1', value)
 
 
 def parse(text):
@@ -205,14 +243,14 @@ def _points(x, comma=False):
     return text.replace('.', ',') if comma else text
 
 
-def feedback(record, maximum=None, scaled=None):
+def feedback(record, maximum=None):
     """The feedback comment of one student (HTML, as Moodle's feedback comments are): the total, then
     one line per item with its points, and why for each point lost. With the worksheet's ``maximum``
-    grade (a number) other than the machine's, it says on which scale the grade column is: ``scaled``
-    (the grade written) or the machine's points as they are. ``record`` is a
-    :class:`~exam_lab.grader.score.kept.GradeRecord`'s value (the desk's, or make worksheet's read from
-    grade.json, with :func:`~exam_lab.grader.publish.hand.combine`'s hand items): its text is clean
-    where the record was made; the teacher's remark from hand.csv is put on one line here."""
+    grade (a number) other than the record's, it says the grade is the points scaled to it.
+    ``record`` is a :class:`~exam_lab.grader.score.kept.GradeRecord`'s value (the desk's, or make
+    worksheet's read from grade.json), whole when :func:`~exam_lab.grader.publish.hand.combine` added
+    its hand items: its text is clean where the record was made; the teacher's remark from hand.csv
+    is a paragraph of its own, after the sentences about the grade."""
     lines = []
     for entry in record['items']:
         line = '%s %s/%s' % (entry['id'], _points(entry['points']), _points(entry['max']))
@@ -222,28 +260,43 @@ def feedback(record, maximum=None, scaled=None):
             why = student_view.item_words(entry, record).split('\n', 1)[0]  # never the threshold run
             line += ': ' + (why if len(why) <= 200 else why[:197] + '...')
         lines.append(line)
+    paragraphs = []
     if 'machine_total' in record:  # the whole grade (exam_lab.grader.publish.hand.combine)
-        head = ('%s / %s points: %s of %s by the machine, running the package (%s), and %s of %s by the '
+        ran = '' if record.get('status') in GRADED else ' (nothing of the package ran: %s)' % safe_text.one_line(
+            record.get('status_reason', ''))
+        head = ('%s / %s points: %s of %s by the machine, running the package (%s)%s, and %s of %s by the '
                 'teacher (the report\'s questions, comments, code quality).' % (
                     _points(record['total']), _points(record['max']), _points(record['machine_total']),
                     _points(sum(e['max'] for e in record['items'] if e.get('by') != 'hand')), ', '.join(ITEMS),
-                    _points(record['total'] - record['machine_total']),
+                    ran, _points(record['total'] - record['machine_total']),
                     _points(sum(e['max'] for e in record['items'] if e.get('by') == 'hand'))))
-        if record.get('remark'):
-            head += ' ' + safe_text.one_line(record['remark'])
     else:
         head = ('Machine-graded by running the package: %s / %s points (%s). Not scored by the machine: '
                 'comments, code quality and the report.' % (_points(record['total']), _points(record['max']),
                                                             ', '.join(ITEMS)))
     if maximum is not None and abs(maximum - record['max']) > 1e-9:
-        head += (' The grade is these points scaled to %s (x %s/%s).' % (_points(maximum), _points(maximum),
+        head += ' The grade is these points scaled to %s (x %s/%s).' % (_points(maximum), _points(maximum),
                                                                         _points(record['max']))
-                 if scaled is not None else
-                 ' The grade is out of %s (the machine\'s items), not out of the maximum grade %s: the '
-                 'comments, code quality and report are added by the teacher.' % (_points(record['max']),
-                                                                                  _points(maximum)))
-    text = '<p>%s</p><ul>%s</ul>' % (_escape(head), ''.join('<li>%s</li>' % _escape(l) for l in lines))
-    return text
+    paragraphs.append(head)
+    if record.get('remark'):
+        paragraphs.append('The teacher\'s remark: %s' % safe_text.one_line(record['remark']))
+    return '%s<ul>%s</ul>' % (''.join('<p>%s</p>' % _escape(p) for p in paragraphs),
+                              ''.join('<li>%s</li>' % _escape(l) for l in lines))
+
+
+def whole_grade(record):
+    """Whether ``record``'s points are a grade for Moodle: a whole grade (machine + hand) with every
+    hand point given, of a student the machine graded or whose submission was refused before anything
+    ran (a report only: 0 by the machine, measured as such). Else the reason it is not, one line."""
+    if 'machine_total' not in record:
+        return 'only the machine\'s %s points, not a grade: make worksheet adds the hand points of hand.csv' % (
+            _points(record['max']))
+    if record.get('missing'):
+        return 'hand points not given yet in hand.csv: %s' % ', '.join(record['missing'])
+    status = record.get('status', 'graded')
+    if status in GRADED or record.get('status_reason', '').startswith(REFUSED):
+        return None
+    return 'status "%s": %s' % (status, record.get('status_reason', ''))
 
 
 def _escape(text):
@@ -251,12 +304,12 @@ def _escape(text):
     return html.escape(text, quote=True).replace('\\', '&#92;')
 
 
-def fill(text, records, scale=False):
+def fill(text, records):
     """Fill the worksheet ``text`` with the grades of ``records`` (each with ``participant``).
 
-    The grade column gets the machine's points out of its 17, as they are, and the summary and each
-    comment say so when the worksheet's "Maximum grade" is another (20, Moodle's default 100); with
-    ``scale`` they are scaled to that maximum instead (the teacher's choice, never silent either).
+    Only a whole grade (:func:`whole_grade`) is written, scaled to the row's "Maximum grade" (20,
+    Moodle's default 100), and its comment says so; any other record leaves its row as it was, with
+    why in the summary.
 
     A row is the participant's: a record is matched by its participant number only (never by name),
     and a number two records claim (two folders of one participant in OUT) fills neither row. Every
@@ -294,8 +347,7 @@ def fill(text, records, scale=False):
         match = _IDENTIFIER.match(fields[ident][1].strip())
         if match:
             by_number[int(match.group(1))] = fields
-    summary = {'graded': [], 'kept': [], 'unmatched': [], 'no_submission': [], 'maxima': [], 'scaled': scale,
-               'machine_max': []}
+    summary = {'graded': [], 'kept': [], 'unmatched': [], 'no_submission': [], 'maxima': [], 'whole_max': []}
     matched = set()
     claims = {}
     for record in records:
@@ -318,12 +370,9 @@ def fill(text, records, scale=False):
             summary['unmatched'].append((student, 'participant %d is not in the worksheet' % number))
             continue
         matched.add(number)
-        status = record.get('status', 'graded')
-        if status not in GRADED:
-            summary['kept'].append((student, 'status "%s": %s' % (status, record.get('status_reason', ''))))
-            continue
-        if record.get('missing'):
-            summary['kept'].append((student, 'hand points not given yet in hand.csv: %s' % ', '.join(record['missing'])))
+        why = whole_grade(record)
+        if why:
+            summary['kept'].append((student, why))
             continue
         if fields[grade][1].strip() or fields[comments][1].strip():
             summary['kept'].append((student, 'the worksheet already has a grade or a feedback for it'))
@@ -336,17 +385,17 @@ def fill(text, records, scale=False):
             continue
         if top_value not in summary['maxima']:
             summary['maxima'].append(top_value)
-        total = record['total'] * top_value / record['max'] if scale else record['total']
+        total = record['total'] * top_value / record['max']
         if total > top_value + 1e-9:
             summary['kept'].append((student, '%s points exceed the maximum grade %s' % (record['total'], top)))
             continue
         points = _points(round(total, 2), comma)
         fields[grade][:] = [quoted(points), points]
-        note = cells.cell(feedback(record, top_value, points if scale else None))
+        note = cells.cell(feedback(record, top_value))
         fields[comments][:] = [quoted(note), note]
         summary['graded'].append((student, number, points))
-        if record['max'] not in summary['machine_max']:
-            summary['machine_max'].append(record['max'])
+        if record['max'] not in summary['whole_max']:
+            summary['whole_max'].append(record['max'])
     for number, fields in sorted(by_number.items()):
         if number not in matched:
             summary['no_submission'].append(fields[names][1] if names is not None else 'Participant %d' % number)
@@ -360,38 +409,43 @@ def _number(text):
         return None
 
 
-def fill_file(source, target, records, scale=False):
-    """Read the worksheet at ``source``, write the filled copy at ``target``; return the summary
-    (``scale``: see :func:`fill`)."""
-    with open(source, 'rb') as f:
-        raw = f.read()
+#: The most a worksheet may hold (Moodle's for a class of thousands is a few MB).
+MAX_WORKSHEET_BYTES = 32 << 20
+
+
+def fill_file(source, target, records):
+    """Read the worksheet at ``source`` (kept in OUT: through the contract); write the filled copy at
+    ``target`` when it holds a grade, else remove an older one (never a file to upload without a grade
+    in it); return the summary."""
+    try:
+        raw = contract.read_bytes(source, MAX_WORKSHEET_BYTES)
+    except contract.ContractError as err:
+        raise WorksheetError(str(err))
     try:
         text = raw.decode('utf-8')
     except UnicodeDecodeError as err:
         raise WorksheetError('not UTF-8 (download the worksheet again from Moodle): %s' % err)
-    filled, summary = fill(text, records, scale)
-    contract.write_bytes(target, filled.encode('utf-8'))
+    filled, summary = fill(text, records)
+    if summary['graded']:
+        contract.write_bytes(target, filled.encode('utf-8'))
+    elif contract.exists(target):
+        os.remove(target)
     return summary
 
 
 def summary_lines(summary, target):
-    """What the teacher reads after the run: where the file is, and every row not graded."""
-    lines = ['worksheet: %d grade(s) written into %s; import it in Moodle (Assignment > View all '
-             'submissions > Grading action: Upload grading worksheet)' % (len(summary['graded']), target)]
-    machine = sorted(set(r for r in summary.get('machine_max', []))) or [17.0]
-    for top in summary.get('maxima', []):
-        if abs(top - machine[0]) < 1e-9:
-            continue
-        if summary.get('scaled'):
-            lines.append('  SCALED: the worksheet\'s maximum grade is %s: each grade written is the points out of '
-                         '%s x %s/%s' % (_points(top), _points(machine[0]), _points(top), _points(machine[0])))
-        else:
-            lines.append('  NOT SCALED: the worksheet\'s maximum grade is %s, the grades written are the machine\'s '
-                         'points out of %s (comments, code quality and the report are yours to add); '
-                         'WORKSHEET_SCALE=1 (--worksheet-scale) writes them scaled to %s instead'
-                         % (_points(top), _points(machine[0]), _points(top)))
+    """What the teacher reads after the run: the file to upload (or why there is none yet), and every
+    row not graded, each student without all hand points with the items missing."""
+    name = os.path.basename(target)
+    if summary['graded']:
+        lines = ['worksheet: %d whole grade(s) (machine + hand points, scaled to the maximum grade %s) in %s: '
+                 'upload it in Moodle (Assignment > View all submissions > Grading action: Upload grading '
+                 'worksheet)' % (len(summary['graded']), ', '.join(_points(m) for m in summary['maxima']), target)]
+    else:
+        lines = ['worksheet: no whole grade yet, so no %s to upload (the machine\'s points alone are no grade): '
+                 'give the hand points, then make worksheet' % name]
     for student, why in summary['kept']:
-        lines.append('  left as it was: %s (%s)' % (student, why))
+        lines.append('  left blank in %s: %s (%s)' % (name, student, why))
     for student, why in summary['unmatched']:
         lines.append('  NOT MATCHED: %s (%s)' % (student, why))
     if summary['no_submission']:

@@ -177,11 +177,17 @@ def render(records, title, entries, similar=None, notes=None):
     parts = ['<!DOCTYPE html>', '<html lang="en"><head><meta charset="utf-8">',
              '<title>%s</title>' % _e(title), '<style>%s</style></head><body>' % _STYLE,
              '<h1>%s</h1>' % _e(title)]
-    totals = [r['total'] for r in records]
+    # The machine's statistics count only what it measured: a student nothing of whose package ran
+    # (a report only, an upload refused) is listed, never a 0 in the mean or the histogram.
+    counted = [r for r in records if not report.ran_nothing(r)]
+    totals = [r['total'] for r in counted]
     maximum = max([r['max'] for r in records] + [sum(p for p, _ in ITEMS.values())])
-    parts.append('<p>%d student(s); mean %.1f / %s; machine-scored items only (not the comments, the '
-                 'code quality, the report).</p>' % (len(records), sum(totals) / max(len(totals), 1),
-                                                      report._points(maximum)))
+    left_out = len(records) - len(counted)
+    parts.append('<p>%d student(s); mean %s / %s over the %d whose package ran%s; machine-scored items only '
+                 '(not the comments, the code quality, the report).</p>' % (
+                     len(records), '%.1f' % (sum(totals) / len(totals)) if totals else '-', report._points(maximum),
+                     len(counted), '; %d not graded (nothing of theirs ran) counted in neither the mean nor the '
+                     'histogram' % left_out if left_out else ''))
     first = [r for r in records if _status(r) not in GRADED or r.get('doubts')]
     parts.append('<h2 id="first">Needs the teacher first</h2>')
     if first:
@@ -189,12 +195,12 @@ def render(records, title, entries, similar=None, notes=None):
             '<li><a href="#%s">%s</a>: %s%s%s</li>' % (
                 anchor(r['student']), _e(r['student']), _status_cell(r),
                 ' - %s' % _e(r['status_reason']) if r.get('status_reason') else '',
-                '<ul>%s</ul>' % ''.join('<li>%s</li>' % _e(d) for d in r.get('doubts') or [])
-                if r.get('doubts') else '') for r in first))
+                '<ul>%s</ul>' % ''.join('<li>%s</li>' % _e(d) for d in report.doubts_beyond_reason(r))
+                if report.doubts_beyond_reason(r) else '') for r in first))
     else:
         parts.append('<p>Nobody: every submission was graded by the machine.</p>')
     if notes:
-        parts.append('<h2 id="notes">Moodle worksheet and checks</h2>')
+        parts.append('<h2 id="notes">Hand points, Moodle worksheet and checks</h2>')
         parts.append('<ul>%s</ul>' % ''.join('<li>%s</li>' % _e(n) for n in notes))
     parts.append('<h2 id="histogram">Totals</h2>')
     parts.append(histogram_svg(totals, maximum))

@@ -65,13 +65,21 @@ def watching(log_dir, on_step):
 
 
 def estimate_left(durations, running, waiting, jobs, prior=PRIOR_S):
-    """Seconds left: each waiting student takes the mean duration so far (``prior`` before any), each
-    running one what it still lacks of that mean (a tenth of it at least), ``jobs`` at a time.
+    """Seconds left, or None while nothing says it: each student takes the mean duration of those done
+    (``prior`` before any is done), or as long as the longest running one has taken when that is
+    longer (a student known to take more than the mean makes the mean wrong: the estimate grows with
+    what is seen, never stuck at a floor); each running one takes what it still lacks of that (a tenth
+    of it at least), and
+    ``jobs`` run at a time. None before the first student is done once a running one outlasts the
+    prior: the prior was wrong and no duration is known yet.
 
     :param durations: seconds of the students done; :param running: seconds each running one has taken.
     """
-    mean = sum(durations) / len(durations) if durations else prior
-    work = waiting * mean + sum(max(mean - spent, 0.1 * mean) for spent in running)
+    longest = max(running) if running else 0.0
+    if not durations and longest > prior:
+        return None
+    each = max(sum(durations) / len(durations) if durations else prior, longest)
+    work = waiting * each + sum(max(each - spent, 0.1 * each) for spent in running)
     return work / max(1, min(jobs, waiting + len(running)))
 
 
@@ -144,8 +152,9 @@ class ClassProgress(object):
         left = estimate_left(self.done, [now - start for start, _ in self.running.values()], waiting, self.jobs)
         now_on = ', '.join('%s (%s, %s)' % (name, step, duration(now - start))
                            for name, (start, step) in sorted(self.running.items()))
-        return safe_text.one_line('[%d of %d graded] now: %s; about %s left' % (
-            len(self.done), self.total, now_on or '-', duration(left)))
+        return safe_text.one_line('[%d of %d graded] now: %s; %s' % (
+            len(self.done), self.total, now_on or '-', 'about %s left' % duration(left) if left is not None else
+            'time left known when the first student is done'))
 
     def _tick(self):
         while not self.stop.wait(REDRAW_S):

@@ -7,6 +7,7 @@ where it is made; grade.json is written and read back through that type too, so 
 clean text as it is. A line for the terminal or a cell of grades.csv is put on one line
 (:func:`~exam_lab.grader.score.safe_text.one_line`), which cleans it on the way for any caller.
 """
+import collections
 import csv
 import io
 import os
@@ -128,14 +129,38 @@ def table(records):
     return '\n'.join('  '.join(str(cell).ljust(w) for cell, w in zip(r, widths)).rstrip() for r in rows)
 
 
+def doubts_beyond_reason(record):
+    """The record's doubts that its status reason does not already say (a doubt is often the reason
+    itself: several uploads, a launch file refused), so that no line says one thing twice."""
+    reason = record.get('status_reason') or ''
+    return [d for d in record.get('doubts') or [] if d not in reason and reason not in d or not reason]
+
+
 def needing_the_teacher(records):
     """Lines for the terminal: each student whose grade the teacher must look at, and why (all but
     'graded' and 'graded with fixes', and any grade with a doubt: refused calls, a launch file roslaunch
-    refuses, several uploads...)."""
+    refuses, several uploads...), each reason once."""
     return [safe_text.one_line('%s: %s%s%s' % (r['student'], r.get('status'),
                                                 ' - %s' % r['status_reason'] if r.get('status_reason') else '',
-                                                ''.join('; %s' % d for d in r.get('doubts') or [])))
+                                                ''.join('; %s' % d for d in doubts_beyond_reason(r))))
             for r in records if r.get('status') not in ('graded', 'graded with fixes') or r.get('doubts')]
+
+
+def ran_nothing(record):
+    """Whether nothing of the student's package ran (not graded: refused, no package, a report only):
+    its sheet was not detected, its points measure nothing of the machine's statistics."""
+    return record.get('status') == 'not graded'
+
+
+def with_class_sheet(records):
+    """``records``, each one that ran nothing (:func:`ran_nothing`: its sheet is the runner's default,
+    not detected) given the class's sheet: the one most of the others were detected on (when any ran),
+    so that hand.csv, the page and the worksheet show the sheet her report answers."""
+    counts = collections.Counter(r['sheet'] for r in records if not ran_nothing(r) and r.get('sheet'))
+    if not counts:
+        return list(records)
+    sheet = counts.most_common(1)[0][0]
+    return [dict(r, sheet=sheet) if ran_nothing(r) and r.get('sheet') != sheet else r for r in records]
 
 
 def evidence_lines(record):
