@@ -327,3 +327,80 @@ def test_a_node_slower_than_one_input_period_is_timed_from_the_readings():
 def test_a_warning_in_the_short_excursion_is_judged_on_its_own_length():
     calls = [[2.1 + 2.0, 'WARNING'], [5.2, 'NORMAL'], [7.6 + 5.0, 'WARNING'], [14.6, 'NORMAL']]
     assert lost(flown(calls)) == {'Q14b': 1.0}
+
+
+REFUSED = {'file': 'launch/exam.launch', 'status': 1, 'warnings': [], 'nodes': [],
+           'refused': 'RLException: Invalid roslaunch XML syntax: junk after document element: line 3, column 0'}
+REPAIR = ('launch/exam.launch: roslaunch refuses it (no root <launch> tag: its elements are not inside one '
+          '<launch>); the grader read and ran its elements inside a <launch>')
+
+
+def test_a_launch_file_roslaunch_refuses_loses_q12_only_its_threshold_judged_as_written():
+    """Issue 45: one mistake, one loss. The inspection read its threshold and nodes through the repair;
+    the runs flew the repaired copy: Q12 is the loss, Q14a judged as written, said as a fix."""
+    session = dict(measured(threshold_shape='main'), launch_check=REFUSED)
+    static = dict(STATIC, launch=dict(STATIC['launch'], repairs=[REPAIR]))
+    assert lost(session, static) == {'Q12': 1.0}
+    q12 = _item(rubric.score('altitude', static, session), 'Q12')['evidence']
+    assert 'roslaunch refuses launch/exam.launch as handed in' in q12 and 'junk after document element' in q12, q12
+    assert 'ran it repaired and without the drone\'s node' in q12, q12
+    status, reason = rubric.status(static, session, [REPAIR])
+    assert status == rubric.GRADED_WITH_FIXES and reason.startswith(REPAIR), reason
+    reason = rubric.status(static, session)[1]
+    assert 'ran it repaired and without' in reason and 'the rest on what it starts and sets as written' in reason, reason
+
+
+def test_a_launch_file_the_grader_cannot_read_either_is_a_hand_grade_never_a_second_loss():
+    unread = ('launch/exam.launch cannot be read, by roslaunch nor by the grader (mismatched tag: line 9, column 2): '
+              'the nodes it starts and the threshold it sets are not judged by a run; read it by hand')
+    session = dict(measured(threshold_run=False), launch_check=dict(REFUSED, refused='RLException: mismatched tag'))
+    static = dict(STATIC, launch=None, threshold=None, launch_unread=unread, threshold_reason=unread)
+    status, reason = rubric.status(static, session)
+    assert status == rubric.HAND_GRADE and reason == unread, reason
+    q12 = _item(rubric.score('altitude', static, session), 'Q12')['evidence']
+    assert q12.startswith(unread) and 'RLException: mismatched tag' in q12, q12
+
+
+def silent_flight(calls, lag=1.0):
+    """A main run whose output the probe read and received nothing on (issue 45: a publisher made with
+    ``rospy.Publisher(topic, Float32, 10)``): every leg flown from the input's change at the oracle's
+    values, the legs' checks empty; the calls as given (``lag`` s after each reading, as its own value)."""
+    session = flown(calls)
+    probe = session['runs'][0]['probe']
+    probe.update(silent=True, rate={'samples': 0, 'hz': None, 'max_gap': None},
+                 calibration={'by': 'oracle', 'reason': 'no readable output: flying by the oracle\'s values',
+                              'lo': {'x': 1170.0, 'target': 1170.0, 'value': None},
+                              'hi': {'x': 1430.0, 'target': 1430.0, 'value': None},
+                              'near': {'x': 1299.9, 'target': 1299.9, 'value': None}})
+    probe['formula'] = [dict(row, published=None, samples=0) for row in probe['formula']]
+    for leg in probe['legs'].values():
+        leg.update(reached=None, stays=None, first=None, last=None, samples=0)
+    return session
+
+
+def test_a_silent_output_with_right_calls_is_judged_from_its_calls_against_the_judges_value():
+    """Q11's rate and values are lost; Q13, Q14a, Q14b judged from the calls, timed from the readings
+    (the judge's own value of the flight); a hand grade saying how, and why when rospy said it."""
+    calls = [[7.5 + 0.4 + 5.1, 'WARNING'], [14.5 + 0.3, 'NORMAL']]
+    session = silent_flight(calls)
+    static = dict(STATIC, code=CODE)
+    assert lost(session, static) == {'Q11': 2.5}
+    q14b = _item(rubric.score('altitude', static, session), 'Q14b')['evidence']
+    assert 'WARNING 5.50 s after the first reading went above the threshold' in q14b, q14b
+    status, reason = rubric.status(static, session)
+    assert status == rubric.HAND_GRADE, reason
+    assert 'the judge received nothing on /altitude, yet its code publishes at scripts/exam_node.py:62' in reason
+    assert 'Q13, Q14a, Q14b judged from its calls against the judge\'s own value of the flight' in reason, reason
+    session['runs'][0]['launch']['tail'] = ("[WARN] [1796157933.186073]: Inbound TCP/IP connection failed: 'int' "
+                                            "object has no attribute 'peer_subscribe'")
+    reason = rubric.status(static, session)[1]
+    assert "rospy.Publisher's third positional argument is subscriber_listener" in reason, reason
+    late = silent_flight([[7.5 + 0.4 + 3.0, 'WARNING'], [14.5 + 0.3, 'NORMAL']])
+    assert lost(late, static) == {'Q11': 2.5, 'Q14b': 1.5}, 'the calls are judged, not given: a WARNING 3.4 s after'
+
+
+def test_a_silent_output_of_a_probe_before_issue_45_is_not_judged_from_the_readings():
+    """Such a probe held each leg for a value that never came: its legs say nothing was reached."""
+    session = silent_flight([[7.5 + 0.4 + 5.1, 'WARNING'], [14.5 + 0.3, 'NORMAL']])
+    del session['runs'][0]['probe']['silent']
+    assert lost(session)['Q13'] == 4.0

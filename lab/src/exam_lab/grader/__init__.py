@@ -10,6 +10,7 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   copied), :mod:`~.boxed.uploads` (which of several uploads is the last), :mod:`~.boxed.classlist` (a
   class's students, from a folder or an archive), :mod:`~.boxed.source` (what the sources say;
   the teacher's fixes before running), :mod:`~.boxed.launch` (the launch file read without running it),
+  :mod:`~.boxed.repair` (a launch file roslaunch refuses for its form, read and run repaired),
   :mod:`~.boxed.derive` (which launch file and threshold are run; the derived launch files the grader
   runs), :mod:`~.boxed.documents` (participant number, PDF
   reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own),

@@ -141,10 +141,10 @@ def score_q14a(sheet, static, session):
         side = calibration.lo if calibration else None
     flown = otherwise(side.target if side else None, float('nan'))
     if warned:
-        return item('Q14a', 1, 'launch file %s = %s; set to %g, the node warned %.2f s after its own value went '
+        return item('Q14a', 1, 'launch file %s = %s; set to %g, the node warned %.2f s after %s went '
                     'above it, flown at %.1f, a value it kept NORMAL with %s' % (
-                        what, threshold.value, probe2.threshold, warned[0][0] - flight.reached(probe2, leg), flown,
-                        threshold.value))
+                        what, threshold.value, probe2.threshold, warned[0][0] - flight.reached(probe2, leg),
+                        'the first reading' if flight.silent(probe2) else 'its own value', flown, threshold.value))
     return item('Q14a', 0, 'launch file %s = %s; set to %g, the node stayed NORMAL for %.1f s at %.1f, above the new '
                 'threshold: it does not obey the %s (%s)' % (
                     what, threshold.value, probe2.threshold, end - flight.reached(probe2, leg), flown,
