@@ -518,3 +518,20 @@ def test_each_package_is_a_catkin_package_named_exam(answer):
         assert files[script].startswith('#!/usr/bin/env python3\n')
         assert script in files['CMakeLists.txt']
         assert 'type="%s"' % script.split('/')[1] in files['launch/exam.launch']
+
+
+def test_issue_45s_kinds_are_in_the_matrix_and_a_flagged_silent_output_is_held_to_its_points():
+    kinds = ('launch_no_root', 'node_no_name', 'slow_loop', 'silent_output', 'positional_queue')
+    assert all(len([a for a in ANSWERS if a.mistake == kind]) == 2 for kind in kinds)
+    forms = [a for a in ANSWERS if a.form != 'plain']
+    assert [(a.form, a.style.sheet) for a in forms] == [(f, s) for f in generator.FORMS for s in SHEETS]
+    assert all(a.mistake is None and a.expected == {} for a in forms)
+    assert generator.package_files(forms[0].style, None, 'declared')['launch/exam.launch'].startswith(
+        '<?xml version="1.0"?>\n<launch>')
+    queue = next(a for a in ANSWERS if a.mistake == 'positional_queue')
+    assert generator.verdict(queue, _record({'Q11': 1.5}, 'needs a hand grade'))[0]
+    fair, how = generator.verdict(queue, _record({'Q11': 1.5, 'Q13': 0.0}, 'needs a hand grade'))
+    assert not fair and 'Q13 0/4 (wanted 4)' in how, 'flagged, and still judged on its calls'
+    slow = next(a for a in ANSWERS if a.mistake == 'slow_loop')
+    assert generator.verdict(slow, _record({'Q11': 3.0}))[0]
+    assert not generator.verdict(slow, _record({'Q11': 1.5}))[0], 'the values\' 1.5 lost too: two losses'

@@ -447,3 +447,28 @@ def test_a_launch_file_that_is_not_xml_even_inside_a_launch_is_not_repaired(tmp_
     analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
     assert analysis.repairs == [] and analysis.exam_nodes == []
     assert analysis.problems and 'launch/exam.launch is not valid XML: mismatched tag' in analysis.problems[0]
+
+
+def test_the_inspection_reads_a_refused_launch_file_as_written_and_names_the_repair(tmp_path):
+    """Issue 45: launch_no_root's threshold is found and rewritten for the threshold run, its repair a
+    fix; a launch file that is not XML even inside a <launch> is the record's launch_unread, and
+    roslaunch's check still gets the file as handed in."""
+    from exam_lab.grader.boxed import inspect
+    ws = tmp_path / 'ws'
+    (ws / 'src').mkdir(parents=True)
+    found = inspect.inspect(os.path.join(SUBMISSIONS, 'launch_no_root', 'exam'), str(ws), str(tmp_path / 'out'),
+                            None, 0.5)
+    assert found['static']['threshold']['name'] == '/threshold' and found['threshold_launch'] is not None
+    assert found['static']['launch']['repairs'] == [f for f in found['fixes'] if 'roslaunch refuses it' in f]
+    assert len(found['static']['launch']['repairs']) == 1
+    assert found['handed_in_launch'] == 'exam/launch/exam.launch'
+    broken = tmp_path / 'broken'
+    shutil.copytree(os.path.join(SUBMISSIONS, 'good_student', 'exam'), str(broken / 'exam'))
+    (broken / 'exam' / 'launch' / 'exam.launch').write_text('<launch>\n  <node pkg="exam" name="exam" type="exam_node.py">\n</launch>\n')
+    ws2 = tmp_path / 'ws2'
+    (ws2 / 'src').mkdir(parents=True)
+    found = inspect.inspect(str(broken / 'exam'), str(ws2), str(tmp_path / 'out2'), None, 0.5)
+    assert found['static']['launch'] is None and found['threshold_launch'] is None
+    assert found['static']['launch_unread'].startswith('launch/exam.launch cannot be read, by roslaunch nor by the '
+                                                       'grader (mismatched tag: line 3'), found['static']
+    assert found['handed_in_launch'] == 'exam/launch/exam.launch'

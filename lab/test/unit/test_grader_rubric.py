@@ -404,3 +404,60 @@ def test_a_silent_output_of_a_probe_before_issue_45_is_not_judged_from_the_readi
     session = silent_flight([[7.5 + 0.4 + 5.1, 'WARNING'], [14.5 + 0.3, 'NORMAL']])
     del session['runs'][0]['probe']['silent']
     assert lost(session)['Q13'] == 4.0
+
+
+def slow_node(rows, lag=1.4, hz=0.78, max_gap=1.51):
+    """A node that publishes about once a temperature period (rospy.wait_for_message in its loop): its
+    own value reaches each leg ``lag`` s after the reading; Q11's ``rows`` as the probe keeps them."""
+    session = flown([[7.5 + lag + 5.0 + 1.2, 'WARNING'], [14.5 + lag + 0.05, 'NORMAL']], lag=lag)
+    probe = session['runs'][0]['probe']
+    probe['rate'] = {'samples': 15, 'hz': hz, 'max_gap': max_gap}
+    probe['formula'] = rows
+    return session
+
+
+#: Q11's first row: the pressure changed at t=100.0 (first read then), the temperature unchanged.
+BEFORE = {'/temperature': 15.0, '/pressure': 87000.0}
+ROW = {'inputs': {'/temperature': 15.0, '/pressure': 89570.9}, 'expected': 1040.0, 'samples': 2,
+       'before': BEFORE, 'changes': {'/pressure': 100.0}}
+
+
+def test_a_slow_node_read_before_it_saw_the_change_loses_the_rate_only():
+    """Issue 45: its last value in the row is still of the inputs before (1.2 s after the change, within
+    its measured lag of 1.4 s): the values' 1.5 kept, the 10 Hz point lost, the delay at its own pace."""
+    from exam_lab.harness import oracle
+    old = oracle.altitude_of(15.0, 87000.0)
+    rows = [dict(ROW, published=old, values=[[100.3, old], [101.2, old]])]
+    session = slow_node(rows)
+    assert lost(session) == {'Q11': 1.0}
+    q11 = evidence_of(session, 'Q11')
+    assert 'at its own pace: 1 value(s) read were of the inputs before the change, published within its ' \
+        'measured lag (1.40 s)' in q11, q11
+    assert 'WARNING 6.20 s after its own value went above the threshold and stayed (ok: 4.70-6.51 s)' in \
+        evidence_of(session, 'Q14b')
+
+
+def test_values_of_inputs_it_could_not_have_seen_are_wrong_at_any_pace():
+    from exam_lab.harness import oracle
+    old = oracle.altitude_of(15.0, 87000.0)
+    late = [dict(ROW, published=old, values=[[100.3, old], [101.6, old]])]  # 1.6 s after: beyond its 1.4 s lag
+    assert lost(slow_node(late)) == {'Q11': 2.5}
+    wrong = [dict(ROW, published=1100.0, values=[[100.3, 1100.0]])]
+    assert lost(slow_node(wrong)) == {'Q11': 2.5}
+    kept_before = [dict(ROW, published=old)]  # a probe of before: no window, judged on its last value
+    for key in ('before', 'changes'):
+        kept_before[0].pop(key)
+    assert lost(slow_node(kept_before)) == {'Q11': 2.5}
+
+
+def test_only_a_slow_node_gets_its_own_period():
+    """A 10 Hz node's longest gap (a blocked callback) is no pace of its own: its windows stay."""
+    session = slow_node([dict(ROW, published=1040.0, values=[[100.3, 1040.0]])])
+    probe = session['runs'][0]['probe']
+    assert flight.own_period(probe) == 1.51
+    assert flight.lag_tolerance(probe) == pytest.approx(1 / 0.778 + 1.51)
+    assert flight.warning_window(probe)[1] == pytest.approx(5.0 + 1.51)
+    probe['rate'] = {'samples': 180, 'hz': 9.9, 'max_gap': 5.0}
+    assert flight.own_period(probe) == 0.0
+    assert flight.lag_tolerance(probe) == pytest.approx(1 / 0.778 + tolerances.LAG_SLACK_S)
+    assert flight.warning_window(probe)[1] == pytest.approx(5.0 + 1 / 0.778 + 0.1)
