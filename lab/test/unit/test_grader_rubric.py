@@ -395,6 +395,8 @@ def test_a_silent_output_with_right_calls_is_judged_from_its_calls_against_the_j
                                             "object has no attribute 'peer_subscribe'")
     reason = rubric.status(static, session)[1]
     assert "rospy.Publisher's third positional argument is subscriber_listener" in reason, reason
+    synchronised = silent_flight([[7.5 + 1.2 + 5.0, 'WARNING'], [14.5 + 1.2, 'NORMAL']])  # a pair a slow period later
+    assert lost(synchronised, static) == {'Q11': 2.5}, 'timed from the readings: a period of the slowest input more'
     late = silent_flight([[7.5 + 0.4 + 3.0, 'WARNING'], [14.5 + 0.3, 'NORMAL']])
     assert lost(late, static) == {'Q11': 2.5, 'Q14b': 1.5}, 'the calls are judged, not given: a WARNING 3.4 s after'
 
