@@ -83,6 +83,18 @@ MISTAKES = [
      'the notes say nothing: half of Q12 (the file starts no executable); the node run as fixed'),
     ('duplicate_names', 'the launch file gives the exam node the drone\'s name: roslaunch refuses it',
      'the notes say nothing: Q12\'s point lost (the file does not run as handed in); the node run as fixed'),
+    ('launch_no_root', 'the launch file\'s elements without their `<launch>` root: roslaunch refuses it',
+     'the notes say nothing: Q12\'s point lost (the file does not run as handed in); its threshold and nodes judged '
+     'as written, the file run inside a `<launch>` (the fix named)'),
+    ('node_without_name', 'the exam node\'s `<node>` without its `name` (ROS 2\'s habit): roslaunch refuses it',
+     'as above: Q12\'s point lost; the node run named after its executable (the fix named)'),
+    ('wait_for_message', '`rospy.wait_for_message` for each input in the loop: a value about once a second',
+     NOTES['Q11'] + ': the 10 Hz point lost; its values judged against the inputs it could have seen within its '
+     'lag, its delay at its own pace'),
+    ('positional_queue', '`rospy.Publisher(\'/altitude\', Float32, 10)` (ROS 2\'s habit: rospy\'s third argument is '
+     '`subscriber_listener`): nothing is received',
+     NOTES['Q11'] + ': the publisher\'s 1.5 kept, rate and values not measured; Q13, Q14a, Q14b judged from its '
+     'calls against the judge\'s own value of the flight; the reason says so, and why'),
     ('crash_at_start', 'the node dies at start (`~threshold` read, `/threshold` set: KeyError)',
      NOTES['runs'] + ' and "on vérifie surtout l\'algorithmie": the build\'s point and Q12\'s (the launch file) only; read the code'),
     ('python2_prints', 'Python 2 `print` statements: SyntaxError at start', 'as the crash above'),

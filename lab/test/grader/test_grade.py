@@ -243,16 +243,23 @@ FAIR_EXPECTED = {
     'margin_normal': {'Q14b': 2.5},       # NORMAL only 5 m below the threshold: the return "at once" alone
     'delay_minus_period': {'Q14b': 1.5},  # 10 readings of the 2 Hz pressure from the first: 4.5 s, the delay alone
     'count_messages': {},                 # 10 periods of the 2 Hz pressure_robot (depth): right at the drone's rate
+    # Issue 45: one mistake, one loss; the evidence there is used.
+    'launch_no_root': {'Q12': 0.0},       # <param> and <node>s without <launch>: roslaunch refuses, read and run inside one
+    'node_without_name': {'Q12': 0.0},    # the exam <node> without name: roslaunch refuses, run named exam_node
+    'wait_for_message': {'Q11': 3.0},     # wait_for_message for each input in its loop: 0.78 Hz, the 10 Hz point only
+    'positional_queue': {'Q11': 1.5},     # Publisher(topic, Float32, 10): nothing received; calls judged from the readings
 }
 FAIR_STATUS = {'lowercase_service': 'needs a hand grade', 'duplicate_names': 'graded with fixes',
                'float64_temperature': 'graded with fixes', 'float64_pressure': 'graded with fixes',
                'led_colours': 'needs a hand grade', 'two_uploads': 'graded', 'args_threshold': 'graded',
                'rosparam_threshold': 'graded', 'included_threshold': 'graded', 'never_warns': 'needs a hand grade',
                'fresh_readings': 'graded', 'margin_normal': 'graded', 'delay_minus_period': 'graded',
-               'count_messages': 'graded'}
+               'count_messages': 'graded', 'launch_no_root': 'graded with fixes', 'node_without_name': 'graded with fixes',
+               'wait_for_message': 'graded', 'positional_queue': 'needs a hand grade'}
 FAIR_SHEETS = {'led_colours': 'depth', 'count_messages': 'depth'}
 #: Who must be in the page's "needs the teacher" box, whatever the status.
-FAIR_DOUBTS = ('lowercase_service', 'duplicate_names', 'led_colours', 'two_uploads', 'never_warns')
+FAIR_DOUBTS = ('lowercase_service', 'duplicate_names', 'led_colours', 'two_uploads', 'never_warns', 'launch_no_root',
+               'node_without_name', 'positional_queue')
 
 
 def dated_zip(source, path, when):
@@ -356,6 +363,20 @@ def test_fair_evidence_is_what_happened(fair):
     assert 'further below: it waits for a margin' in margin, margin
     short = evidence['delay_minus_period']['Q14b']
     assert 'WARNING 4.' in short and '(outside: 4.70-6.39 s)' in short, short
+    # Issue 45: a refused launch file's threshold judged as written, the run with the grader's repair, said
+    for name, repair in (('launch_no_root', 'the grader read and ran its elements inside a <launch>'),
+                         ('node_without_name', 'the grader read and ran it named "exam_node"')):
+        assert 'the node warned' in evidence[name]['Q14a'], evidence[name]['Q14a']
+        assert repair in records[name]['status_reason'], records[name]['status_reason']
+        assert 'roslaunch refuses launch/exam.launch as handed in' in evidence[name]['Q12'], evidence[name]['Q12']
+    slow = evidence['wait_for_message']
+    assert 'not 10 Hz' in slow['Q11'] and 'values agree with equation (1)' in slow['Q11'], slow['Q11']
+    assert 'subscribes to /pressure (std_msgs/Float32), /temperature' in slow['Q10'], slow['Q10']
+    queue = records['positional_queue']['status_reason']
+    assert "the judge received nothing on /altitude (rospy.Publisher's third positional argument is " \
+        "subscriber_listener" in queue, queue
+    assert 'WARNING while above, NORMAL once back below' in evidence['positional_queue']['Q13']
+    assert 'after the first reading went above the threshold' in evidence['positional_queue']['Q14b']
 
 
 def test_our_node_on_the_depth_sheet(singles):

@@ -229,6 +229,19 @@ def fake_modules(sim, node_params, node_state):
     def spin():
         sim.block(node_state['thread'])
 
+    def wait_for_message(topic, msg_type, timeout=None):
+        """The next message of ``topic``: the node's thread waits for it, the clock goes on."""
+        state, got, name = node_state['thread'], {}, resolve(topic)
+
+        def once(msg):
+            if 'msg' not in got:
+                got['msg'] = msg
+                sim.subs[name].remove(once)
+                sim.at(sim.now, lambda: sim.resume(state))
+        sim.subs[name].append(once)
+        sim.block(state)
+        return got['msg']
+
     rospy.ServiceException, rospy.ROSInterruptException = ServiceException, ROSInterruptException
     rospy.init_node = lambda name, **kw: node_state.update(name=name)
     rospy.get_param = get_param
@@ -239,6 +252,7 @@ def fake_modules(sim, node_params, node_state):
     rospy.Publisher, rospy.Subscriber, rospy.Timer, rospy.Rate = Publisher, subscriber, Timer, Rate
     rospy.Duration = float
     rospy.ServiceProxy, rospy.wait_for_service, rospy.spin = proxy, (lambda name, timeout=None: None), spin
+    rospy.wait_for_message = wait_for_message
     for level in ('loginfo', 'logwarn', 'logerr', 'logdebug'):
         setattr(rospy, level, lambda *a, **k: None)
 
@@ -291,7 +305,7 @@ def fake_modules(sim, node_params, node_state):
 
 def launch_nodes(text, overrides=None):
     """``{script: {'params': {...}, 'argv': [...]}}`` from the package's launch file (params, args)."""
-    root = ET.fromstring(text)
+    root = ET.fromstring(text if '<launch>' in text else '<launch>%s</launch>' % text)  # read as the grader does
     args = {a.get('name'): (overrides or {}).get(a.get('name'), a.get('default')) for a in root.iter('arg')}
     sub = lambda v: re.sub(r'\$\(arg (\w+)\)', lambda m: args[m.group(1)], v or '')
     top = {'/' + p.get('name'): float(sub(p.get('value'))) for p in root.findall('param')}
@@ -306,6 +320,9 @@ def launch_nodes(text, overrides=None):
             value = overrides['threshold'] if overrides and p.get('name') == 'threshold' else sub(p.get('value'))
             params['/%s/%s' % (node.get('name'), p.get('name'))] = float(value)
         nodes[node.get('type')] = {'params': params, 'argv': [node.get('type')] + sub(node.get('args')).split()}
+        if node.get('name') is None:  # named after its executable, as the grader runs it
+            params = {k.replace('/None/', '/%s/' % node.get('type')[:-3]): v for k, v in params.items()}
+            nodes[node.get('type')]['params'] = params
     return nodes
 
 
@@ -331,7 +348,7 @@ def inputs_at(sheet, t, threshold):
 
 def fly(answer, threshold_override=None):
     """Run the answer's scripts in a simulated flight; return the sim (published values, calls)."""
-    files = generator.package_files(answer.style, answer.mistake)
+    files = generator.package_files(answer.style, answer.mistake, answer.form)
     threshold = SHEETS[answer.style.sheet].threshold
     nodes = launch_nodes(files['launch/exam.launch'],
                          {'threshold': str(threshold_override)} if threshold_override else None)
@@ -442,6 +459,14 @@ MISTAKE_SEEN = {
     'launch_no_comment': None,
     'lowercase_request': lambda s, a: [c for _, c in s['calls']] == ['warning', 'normal'],
     'never_warns': lambda s, a: s['calls'] == [],
+    'launch_no_root': None,
+    'node_no_name': None,
+    # Issue 45: a value once a period of the slower input, the calls as a correct answer's.
+    'slow_loop': lambda s, a: s['hz'] < 1.5 and [c for _, c in s['calls']] == ['WARNING', 'NORMAL']
+    and 4.85 <= s['calls'][0][0] - s['crossings'][2] <= 5.15 + 1.0 / min(generator.DRONE_RATES[a.style.sheet].values())
+    + 1.0 / max(generator.DRONE_RATES[a.style.sheet].values()),
+    'silent_output': lambda s, a: not s['out'] and [c for _, c in s['calls']] == ['WARNING', 'NORMAL'],
+    'positional_queue': None,
 }
 
 
@@ -455,7 +480,21 @@ def test_each_one_mistake_answer_makes_its_mistake(answer):
         assert observed(answer, fly(answer, threshold_override='%g' % lower))['calls'][0][0] > 16.0
         assert observed(answer, fly(generator.Answer('x', answer.style, None, {}), '%g' % lower))['calls'][0][0] < 8
         return
-    if answer.mistake == 'launch_no_drone':
+    if answer.mistake == 'positional_queue':  # rospy's third argument is subscriber_listener: nothing received
+        script = files['scripts/exam_node.py']
+        assert ", Float32, 10)  # the output" in script and 'Float32, queue_size=10)' not in script
+        assert script.replace(', Float32, 10)', ', Float32, queue_size=10)') == correct['scripts/exam_node.py']
+        seen = observed(answer, fly(answer))  # the stand-in takes 10 for the queue: the calls are a correct one's
+        assert [c for _, c in seen['calls']] == ['WARNING', 'NORMAL'], seen['calls']
+        return
+    if answer.mistake == 'launch_no_root':
+        assert '<launch>' not in launch and '</launch>' not in launch and '<launch>' in correct['launch/exam.launch']
+        assert launch == correct['launch/exam.launch'].replace('<launch>\n', '').replace('</launch>\n', '')
+    elif answer.mistake == 'node_no_name':
+        exam = [line for line in launch.splitlines() if 'type="exam_node.py"' in line]
+        assert len(exam) == 1 and 'name=' not in exam[0], exam
+        assert launch.count('name=') == correct['launch/exam.launch'].count('name=') - 1
+    elif answer.mistake == 'launch_no_drone':
         assert SHEETS[answer.style.sheet].drone_type not in launch
         assert SHEETS[answer.style.sheet].drone_type in correct['launch/exam.launch']
     elif answer.mistake == 'launch_no_comment':
@@ -479,3 +518,20 @@ def test_each_package_is_a_catkin_package_named_exam(answer):
         assert files[script].startswith('#!/usr/bin/env python3\n')
         assert script in files['CMakeLists.txt']
         assert 'type="%s"' % script.split('/')[1] in files['launch/exam.launch']
+
+
+def test_issue_45s_kinds_are_in_the_matrix_and_a_flagged_silent_output_is_held_to_its_points():
+    kinds = ('launch_no_root', 'node_no_name', 'slow_loop', 'silent_output', 'positional_queue')
+    assert all(len([a for a in ANSWERS if a.mistake == kind]) == 2 for kind in kinds)
+    forms = [a for a in ANSWERS if a.form != 'plain']
+    assert [(a.form, a.style.sheet) for a in forms] == [(f, s) for f in generator.FORMS for s in SHEETS]
+    assert all(a.mistake is None and a.expected == {} for a in forms)
+    assert generator.package_files(forms[0].style, None, 'declared')['launch/exam.launch'].startswith(
+        '<?xml version="1.0"?>\n<launch>')
+    queue = next(a for a in ANSWERS if a.mistake == 'positional_queue')
+    assert generator.verdict(queue, _record({'Q11': 1.5}, 'needs a hand grade'))[0]
+    fair, how = generator.verdict(queue, _record({'Q11': 1.5, 'Q13': 0.0}, 'needs a hand grade'))
+    assert not fair and 'Q13 0/4 (wanted 4)' in how, 'flagged, and still judged on its calls'
+    slow = next(a for a in ANSWERS if a.mistake == 'slow_loop')
+    assert generator.verdict(slow, _record({'Q11': 3.0}))[0]
+    assert not generator.verdict(slow, _record({'Q11': 1.5}))[0], 'the values\' 1.5 lost too: two losses'

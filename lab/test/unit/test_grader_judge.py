@@ -133,3 +133,29 @@ def test_what_runs_in_a_slot_no_grader_holds_is_left_behind(tmp_path, monkeypatc
         assert uids.left_behind(uids.BOX_UID_BASE) == [uids.BOX_UID_BASE + 2]
         assert uids.left_behind(uids.JUDGE_UID_BASE) == []
     assert uids.left_behind(uids.BOX_UID_BASE) == sorted(running)
+
+
+def test_a_node_that_subscribes_to_each_input_in_turn_subscribes_to_both(monkeypatch):
+    """Issue 45: rospy.wait_for_message subscribes to one input, then the other, never both at one
+    instant; the inputs it subscribes to are those the master showed while the probe waited."""
+    pytest.importorskip('rospy')
+    import types
+    from exam_lab.grader.judge import node
+    polls = {'n': 0}
+
+    class Graph(object):
+        """The master as a node that waits for /temperature, then /pressure, then again."""
+
+        def student_nodes(self):
+            return ['/exam']
+
+        def subscribers(self, topic):
+            polls['n'] += 1
+            turn = '/temperature' if (polls['n'] // 6) % 2 == 0 else '/pressure'
+            return ['/exam'] if topic == turn else []
+
+    monkeypatch.setattr(node.NodeFinder, 'input_types', lambda self, inputs, timeout=3.0: {})
+    drone = types.SimpleNamespace(fixed_topic='temperature', moving_topic='pressure')
+    plan = types.SimpleNamespace(start_timeout=1.0)
+    found = node.NodeFinder(plan, Graph(), None, drone, 0.0).wait_for_node()
+    assert found['subscribed'] == {'/temperature': ['/exam'], '/pressure': ['/exam']}

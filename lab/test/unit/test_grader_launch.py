@@ -391,3 +391,84 @@ def test_the_threshold_run_value_is_drawn_once_written_and_planned(tmp_path, dra
     assert threshold == dict(main, kind='threshold', threshold=value), 'the main run\'s plan around the new value'
     with pytest.raises(ValueError):
         sheets.threshold_run_value(1300.0, 1.0)
+
+
+@pytest.mark.parametrize('text, words', [
+    # The elements side by side at the top, an XML declaration first (issue 45's fifth class).
+    ('<?xml version="1.0"?>\n<!-- the threshold -->\n<param name="threshold" value="1300" />\n'
+     '<node pkg="mydrone" name="mydrone" type="mydrone_node.py"/>\n'
+     '<node pkg="exam" name="exam" type="exam_node.py"/>\n', 'its elements are not inside one <launch>'),
+    # Another name for the root: its children are the launch file's elements.
+    ('<roslaunch>\n  <param name="threshold" value="1300" />\n  <node pkg="mydrone" name="mydrone" '
+     'type="mydrone_node.py"/>\n  <node pkg="exam" name="exam" type="exam_node.py"/>\n</roslaunch>\n',
+     'its root element is <roslaunch>'),
+    # One node as the whole file, its threshold inside it.
+    ('<node pkg="exam" name="exam" type="exam_node.py">\n  <param name="threshold" value="1300" />\n</node>\n',
+     'its root element is <node>'),
+])
+def test_a_launch_file_without_its_launch_root_is_read_and_run_as_written(tmp_path, text, words):
+    """roslaunch refuses it (Q12's loss, its verdict's); the grader reads what it starts and sets,
+    says the repair, and runs a derived copy rooted in <launch> with the threshold changed."""
+    pkg = package(tmp_path, {'launch/exam.launch': text})
+    analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
+    assert analysis.problems == []
+    assert [n.pkg for n in analysis.exam_nodes] == ['exam']
+    assert len(analysis.repairs) == 1 and words in analysis.repairs[0], analysis.repairs
+    assert 'launch/exam.launch: roslaunch refuses it (no root <launch> tag' in analysis.repairs[0]
+    found, _ = derive.threshold_param(analysis, 'altitude')
+    assert found is not None and launch.as_number(found.value) == 1300.0
+    derived = derive.derive(analysis, 'threshold', {found.origin: 900.0})
+    root = ET.parse(derived).getroot()
+    assert root.tag == 'launch'
+    assert [n.get('pkg') for n in root.iter('node')] == ['exam']
+    assert [p.get('value') for p in root.iter('param')] == ['900.0']
+
+
+def test_a_node_without_its_name_is_named_after_its_executable(tmp_path):
+    """ROS 2's habit: <node> without name; roslaunch requires one. Read and run named after its
+    script, said as a repair; its private parameter belongs to that name."""
+    pkg = package(tmp_path, {'launch/exam.launch': (
+        '<launch>\n  <node pkg="mydrone" name="mydrone" type="mydrone_node.py"/>\n'
+        '  <node pkg="exam" type="exam_node.py">\n    <param name="threshold" value="1300" />\n  </node>\n</launch>\n')})
+    analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
+    assert analysis.problems == []
+    assert [(n.pkg, n.name) for n in analysis.exam_nodes] == [('exam', 'exam_node')]
+    assert analysis.repairs == ['launch/exam.launch: roslaunch refuses <node pkg="exam" type="exam_node.py"> without '
+                                'a name (required in ROS 1, optional in ROS 2); the grader read and ran it named '
+                                '"exam_node", after its executable']
+    found, _ = derive.threshold_param(analysis, 'altitude')
+    assert found.name == '/exam_node/threshold'
+    root = ET.parse(derive.derive(analysis, 'main')).getroot()
+    assert [n.get('name') for n in root.iter('node')] == ['exam_node']
+
+
+def test_a_launch_file_that_is_not_xml_even_inside_a_launch_is_not_repaired(tmp_path):
+    pkg = package(tmp_path, {'launch/exam.launch': '<launch>\n  <node pkg="exam" name="exam" type="n.py">\n</launch>\n'})
+    analysis = launch.analyse(os.path.join(pkg, 'launch', 'exam.launch'), pkg)
+    assert analysis.repairs == [] and analysis.exam_nodes == []
+    assert analysis.problems and 'launch/exam.launch is not valid XML: mismatched tag' in analysis.problems[0]
+
+
+def test_the_inspection_reads_a_refused_launch_file_as_written_and_names_the_repair(tmp_path):
+    """Issue 45: launch_no_root's threshold is found and rewritten for the threshold run, its repair a
+    fix; a launch file that is not XML even inside a <launch> is the record's launch_unread, and
+    roslaunch's check still gets the file as handed in."""
+    from exam_lab.grader.boxed import inspect
+    ws = tmp_path / 'ws'
+    (ws / 'src').mkdir(parents=True)
+    found = inspect.inspect(os.path.join(SUBMISSIONS, 'launch_no_root', 'exam'), str(ws), str(tmp_path / 'out'),
+                            None, 0.5)
+    assert found['static']['threshold']['name'] == '/threshold' and found['threshold_launch'] is not None
+    assert found['static']['launch']['repairs'] == [f for f in found['fixes'] if 'roslaunch refuses it' in f]
+    assert len(found['static']['launch']['repairs']) == 1
+    assert found['handed_in_launch'] == 'exam/launch/exam.launch'
+    broken = tmp_path / 'broken'
+    shutil.copytree(os.path.join(SUBMISSIONS, 'good_student', 'exam'), str(broken / 'exam'))
+    (broken / 'exam' / 'launch' / 'exam.launch').write_text('<launch>\n  <node pkg="exam" name="exam" type="exam_node.py">\n</launch>\n')
+    ws2 = tmp_path / 'ws2'
+    (ws2 / 'src').mkdir(parents=True)
+    found = inspect.inspect(str(broken / 'exam'), str(ws2), str(tmp_path / 'out2'), None, 0.5)
+    assert found['static']['launch'] is None and found['threshold_launch'] is None
+    assert found['static']['launch_unread'].startswith('launch/exam.launch cannot be read, by roslaunch nor by the '
+                                                       'grader (mismatched tag: line 3'), found['static']
+    assert found['handed_in_launch'] == 'exam/launch/exam.launch'

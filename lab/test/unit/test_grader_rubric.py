@@ -327,3 +327,139 @@ def test_a_node_slower_than_one_input_period_is_timed_from_the_readings():
 def test_a_warning_in_the_short_excursion_is_judged_on_its_own_length():
     calls = [[2.1 + 2.0, 'WARNING'], [5.2, 'NORMAL'], [7.6 + 5.0, 'WARNING'], [14.6, 'NORMAL']]
     assert lost(flown(calls)) == {'Q14b': 1.0}
+
+
+REFUSED = {'file': 'launch/exam.launch', 'status': 1, 'warnings': [], 'nodes': [],
+           'refused': 'RLException: Invalid roslaunch XML syntax: junk after document element: line 3, column 0'}
+REPAIR = ('launch/exam.launch: roslaunch refuses it (no root <launch> tag: its elements are not inside one '
+          '<launch>); the grader read and ran its elements inside a <launch>')
+
+
+def test_a_launch_file_roslaunch_refuses_loses_q12_only_its_threshold_judged_as_written():
+    """Issue 45: one mistake, one loss. The inspection read its threshold and nodes through the repair;
+    the runs flew the repaired copy: Q12 is the loss, Q14a judged as written, said as a fix."""
+    session = dict(measured(threshold_shape='main'), launch_check=REFUSED)
+    static = dict(STATIC, launch=dict(STATIC['launch'], repairs=[REPAIR]))
+    assert lost(session, static) == {'Q12': 1.0}
+    q12 = _item(rubric.score('altitude', static, session), 'Q12')['evidence']
+    assert 'roslaunch refuses launch/exam.launch as handed in' in q12 and 'junk after document element' in q12, q12
+    assert 'ran it repaired and without the drone\'s node' in q12, q12
+    status, reason = rubric.status(static, session, [REPAIR])
+    assert status == rubric.GRADED_WITH_FIXES and reason.startswith(REPAIR), reason
+    reason = rubric.status(static, session)[1]
+    assert 'ran it repaired and without' in reason and 'the rest on what it starts and sets as written' in reason, reason
+
+
+def test_a_launch_file_the_grader_cannot_read_either_is_a_hand_grade_never_a_second_loss():
+    unread = ('launch/exam.launch cannot be read, by roslaunch nor by the grader (mismatched tag: line 9, column 2): '
+              'the nodes it starts and the threshold it sets are not judged by a run; read it by hand')
+    session = dict(measured(threshold_run=False), launch_check=dict(REFUSED, refused='RLException: mismatched tag'))
+    static = dict(STATIC, launch=None, threshold=None, launch_unread=unread, threshold_reason=unread)
+    status, reason = rubric.status(static, session)
+    assert status == rubric.HAND_GRADE and reason == unread, reason
+    q12 = _item(rubric.score('altitude', static, session), 'Q12')['evidence']
+    assert q12.startswith(unread) and 'RLException: mismatched tag' in q12, q12
+
+
+def silent_flight(calls, lag=1.0):
+    """A main run whose output the probe read and received nothing on (issue 45: a publisher made with
+    ``rospy.Publisher(topic, Float32, 10)``): every leg flown from the input's change at the oracle's
+    values, the legs' checks empty; the calls as given (``lag`` s after each reading, as its own value)."""
+    session = flown(calls)
+    probe = session['runs'][0]['probe']
+    probe.update(silent=True, rate={'samples': 0, 'hz': None, 'max_gap': None},
+                 calibration={'by': 'oracle', 'reason': 'no readable output: flying by the oracle\'s values',
+                              'lo': {'x': 1170.0, 'target': 1170.0, 'value': None},
+                              'hi': {'x': 1430.0, 'target': 1430.0, 'value': None},
+                              'near': {'x': 1299.9, 'target': 1299.9, 'value': None}})
+    probe['formula'] = [dict(row, published=None, samples=0) for row in probe['formula']]
+    for leg in probe['legs'].values():
+        leg.update(reached=None, stays=None, first=None, last=None, samples=0)
+    return session
+
+
+def test_a_silent_output_with_right_calls_is_judged_from_its_calls_against_the_judges_value():
+    """Q11's rate and values are lost; Q13, Q14a, Q14b judged from the calls, timed from the readings
+    (the judge's own value of the flight); a hand grade saying how, and why when rospy said it."""
+    calls = [[7.5 + 0.4 + 5.1, 'WARNING'], [14.5 + 0.3, 'NORMAL']]
+    session = silent_flight(calls)
+    static = dict(STATIC, code=CODE)
+    assert lost(session, static) == {'Q11': 2.5}
+    q14b = _item(rubric.score('altitude', static, session), 'Q14b')['evidence']
+    assert 'WARNING 5.50 s after the first reading went above the threshold' in q14b, q14b
+    status, reason = rubric.status(static, session)
+    assert status == rubric.HAND_GRADE, reason
+    assert 'the judge received nothing on /altitude, yet its code publishes at scripts/exam_node.py:62' in reason
+    assert 'Q13, Q14a, Q14b judged from its calls against the judge\'s own value of the flight' in reason, reason
+    session['runs'][0]['launch']['tail'] = ("[WARN] [1796157933.186073]: Inbound TCP/IP connection failed: 'int' "
+                                            "object has no attribute 'peer_subscribe'")
+    reason = rubric.status(static, session)[1]
+    assert "rospy.Publisher's third positional argument is subscriber_listener" in reason, reason
+    synchronised = silent_flight([[7.5 + 1.2 + 5.0, 'WARNING'], [14.5 + 1.2, 'NORMAL']])  # a pair a slow period later
+    assert lost(synchronised, static) == {'Q11': 2.5}, 'timed from the readings: a period of the slowest input more'
+    late = silent_flight([[7.5 + 0.4 + 3.0, 'WARNING'], [14.5 + 0.3, 'NORMAL']])
+    assert lost(late, static) == {'Q11': 2.5, 'Q14b': 1.5}, 'the calls are judged, not given: a WARNING 3.4 s after'
+
+
+def test_a_silent_output_of_a_probe_before_issue_45_is_not_judged_from_the_readings():
+    """Such a probe held each leg for a value that never came: its legs say nothing was reached."""
+    session = silent_flight([[7.5 + 0.4 + 5.1, 'WARNING'], [14.5 + 0.3, 'NORMAL']])
+    del session['runs'][0]['probe']['silent']
+    assert lost(session)['Q13'] == 4.0
+
+
+def slow_node(rows, lag=1.4, hz=0.78, max_gap=1.51):
+    """A node that publishes about once a temperature period (rospy.wait_for_message in its loop): its
+    own value reaches each leg ``lag`` s after the reading; Q11's ``rows`` as the probe keeps them."""
+    session = flown([[7.5 + lag + 5.0 + 1.2, 'WARNING'], [14.5 + lag + 0.05, 'NORMAL']], lag=lag)
+    probe = session['runs'][0]['probe']
+    probe['rate'] = {'samples': 15, 'hz': hz, 'max_gap': max_gap}
+    probe['formula'] = rows
+    return session
+
+
+#: Q11's first row: the pressure changed at t=100.0 (first read then), the temperature unchanged.
+BEFORE = {'/temperature': 15.0, '/pressure': 87000.0}
+ROW = {'inputs': {'/temperature': 15.0, '/pressure': 89570.9}, 'expected': 1040.0, 'samples': 2,
+       'before': BEFORE, 'changes': {'/pressure': 100.0}}
+
+
+def test_a_slow_node_read_before_it_saw_the_change_loses_the_rate_only():
+    """Issue 45: its last value in the row is still of the inputs before (1.2 s after the change, within
+    its measured lag of 1.4 s): the values' 1.5 kept, the 10 Hz point lost, the delay at its own pace."""
+    from exam_lab.harness import oracle
+    old = oracle.altitude_of(15.0, 87000.0)
+    rows = [dict(ROW, published=old, values=[[100.3, old], [101.2, old]])]
+    session = slow_node(rows)
+    assert lost(session) == {'Q11': 1.0}
+    q11 = evidence_of(session, 'Q11')
+    assert 'at its own pace: 1 value(s) read were of the inputs before the change, published within its ' \
+        'measured lag (1.40 s)' in q11, q11
+    assert 'WARNING 6.20 s after its own value went above the threshold and stayed (ok: 4.70-6.51 s)' in \
+        evidence_of(session, 'Q14b')
+
+
+def test_values_of_inputs_it_could_not_have_seen_are_wrong_at_any_pace():
+    from exam_lab.harness import oracle
+    old = oracle.altitude_of(15.0, 87000.0)
+    late = [dict(ROW, published=old, values=[[100.3, old], [101.6, old]])]  # 1.6 s after: beyond its 1.4 s lag
+    assert lost(slow_node(late)) == {'Q11': 2.5}
+    wrong = [dict(ROW, published=1100.0, values=[[100.3, 1100.0]])]
+    assert lost(slow_node(wrong)) == {'Q11': 2.5}
+    kept_before = [dict(ROW, published=old)]  # a probe of before: no window, judged on its last value
+    for key in ('before', 'changes'):
+        kept_before[0].pop(key)
+    assert lost(slow_node(kept_before)) == {'Q11': 2.5}
+
+
+def test_only_a_slow_node_gets_its_own_period():
+    """A 10 Hz node's longest gap (a blocked callback) is no pace of its own: its windows stay."""
+    session = slow_node([dict(ROW, published=1040.0, values=[[100.3, 1040.0]])])
+    probe = session['runs'][0]['probe']
+    assert flight.own_period(probe) == 1.51
+    assert flight.lag_tolerance(probe) == pytest.approx(1 / 0.778 + 1.51)
+    assert flight.warning_window(probe)[1] == pytest.approx(5.0 + 1.51)
+    probe['rate'] = {'samples': 180, 'hz': 9.9, 'max_gap': 5.0}
+    assert flight.own_period(probe) == 0.0
+    assert flight.lag_tolerance(probe) == pytest.approx(1 / 0.778 + tolerances.LAG_SLACK_S)
+    assert flight.warning_window(probe)[1] == pytest.approx(5.0 + 1 / 0.778 + 0.1)

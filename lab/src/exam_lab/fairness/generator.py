@@ -61,7 +61,15 @@ FLAGGED = 'flagged'
 Style = collections.namedtuple('Style', list(AXES))
 #: One generated answer: its student name, its style, its mistake (None: correct) and what it must get:
 #: ``{item: points}`` for the items below their maximum (``{}``: 17/17), or FLAGGED.
-Answer = collections.namedtuple('Answer', 'name style mistake expected')
+Answer = collections.namedtuple('Answer', 'name style mistake expected form', defaults=('plain',))
+
+#: Correct forms of the rules issue 45 added (an answer's ``form``; 'plain' for the others): a launch
+#: file opened by its XML declaration, each input awaited once with ``rospy.wait_for_message`` before
+#: the node's loop or spin (the drone's first readings). Each is graded as any correct answer: 17/17.
+FORMS = collections.OrderedDict([
+    ('declared', 'the launch file opened by <?xml version="1.0"?>'),
+    ('wait_first', 'rospy.wait_for_message for each input once, before the loop'),
+])
 
 #: What one mistake is: the rule it breaks, in words; the points the items must get then (FLAGGED: a
 #: hand grade; ``(low, high)``: any points in that range); the sheets it applies to; and what the
@@ -104,7 +112,23 @@ MISTAKES = collections.OrderedDict([
                                   {'Q13': 2.0}, ('altitude', 'depth'), {})),
     ('never_warns', Mistake('one misplaced word: the WARNING call can never run', FLAGGED, ('altitude', 'depth'),
                             _COUNTER)),
+    # Issue 45: one mistake, one loss, on launch files roslaunch refuses, a slow loop, a silent output.
+    ('launch_no_root', Mistake('the launch file\'s elements without their <launch> root (roslaunch refuses it)',
+                               {'Q12': 0.0}, ('altitude', 'depth'), {})),
+    ('node_no_name', Mistake('the exam node\'s <node> without its name (ROS 2\'s habit; roslaunch refuses it)',
+                             {'Q12': 0.0}, ('altitude', 'depth'), {})),
+    ('slow_loop', Mistake('rospy.wait_for_message for each input in the loop: a value about once a second',
+                          {'Q11': 3.0}, ('altitude', 'depth'),
+                          {'loop': ('rate',), 'nodes': ('one',), 'inputs': ('cache',), 'delay': ('stamps',)})),
+    ('silent_output', Mistake('the value computed and the LED set, but never published', {'Q11': 1.5},
+                              ('altitude', 'depth'), {'nodes': ('one',), 'loop': ('rate', 'timer')})),
+    ('positional_queue', Mistake('rospy.Publisher(topic, Float32, 10): the queue size given as the third '
+                                 'argument, subscriber_listener (nothing is received)', {'Q11': 1.5},
+                                 ('altitude', 'depth'), {'nodes': ('one',)})),
 ])
+#: Mistakes whose grade is flagged (a hand grade) and must still give the points it says: the output
+#: silent while the code publishes, the calls judged against the judge's own value (issue 45).
+JUDGED_WHEN_FLAGGED = ('positional_queue',)
 
 
 def valid(style):
@@ -182,6 +206,10 @@ def answers(correct=40, seed=0):
     # the sheet's own answer of each sheet, correct, so its variants' other losses can be read
     references = [s for s in (Style(**dict(REFERENCE, sheet=sheet)) for sheet in SHEETS) if s not in styles]
     out += [Answer('r%02d-%s' % (n + 1, style_name(s)), s, None, {}) for n, s in enumerate(references)]
+    # each correct form of issue 45's rules, on the sheet's own answer of each sheet
+    forms = [(form, Style(**dict(REFERENCE, sheet=sheet))) for form in FORMS for sheet in SHEETS]
+    out += [Answer('v%02d-%s-%s' % (n + 1, form.replace('_', ''), style_name(s)), s, None, {}, form)
+            for n, (form, s) in enumerate(forms)]
     rng = random.Random(seed + 1)
     pool = _all_valid()
     made = []
@@ -249,7 +277,7 @@ def verdict(answer, record):
     got = collections.OrderedDict((i['id'], i['points']) for i in record.get('items', []))
     status = record.get('status')
     wanted = wanted_points(answer)
-    if answer.mistake is not None and status == HAND_GRADE:
+    if answer.mistake is not None and status == HAND_GRADE and answer.mistake not in JUDGED_WHEN_FLAGGED:
         return True, 'flagged: %s' % record.get('status_reason', '')
     if wanted is None:
         return False, 'not flagged (%s), %s' % (status, _points_words(got))
@@ -257,7 +285,7 @@ def verdict(answer, record):
             for item, points in wanted.items() if not _within(got.get(item), points)]
     if answer.mistake is None and status != GRADED:
         diff.append('status "%s": %s' % (status, record.get('status_reason', '')))
-    elif status not in (GRADED, 'graded with fixes'):
+    elif status not in (GRADED, 'graded with fixes', HAND_GRADE if answer.mistake in JUDGED_WHEN_FLAGGED else GRADED):
         diff.append('status "%s": %s' % (status, record.get('status_reason', '')))
     return (not diff), '; '.join(diff) if diff else 'as wanted'
 
@@ -532,7 +560,7 @@ def _inputs(node, style, sheet, mistake, on_new):
         node.var('sync', 'None', 'the synchroniser of the two inputs')
         return
     for topic in (a, b):
-        if mistake == 'one_subscriber' and topic == 'temperature':
+        if (mistake == 'one_subscriber' and topic == 'temperature') or mistake == 'slow_loop':
             continue
         node.fn('on_%s' % topic, 'msg', 'A new reading of /%s: keep it.' % topic,
                 ['@last_%s = msg.data' % topic] + on_new(topic))
@@ -573,7 +601,20 @@ def _driver(node, style, step_lines, with_publish_timer=False):
         node.run.append('rospy.spin()  # the callbacks do the work')
 
 
-def exam_node(style, mistake=None):
+def _slowest_first(sheet):
+    """The sheet's two inputs, the slower first (the order a node that waits for each reading in turn
+    follows its inputs soonest in)."""
+    rates = DRONE_RATES[sheet]
+    return sorted(rates, key=lambda topic: rates[topic])
+
+
+def _waits(sheet, keep):
+    """``rospy.wait_for_message`` for each input, the slower first; ``keep``: store each reading."""
+    return ['%srospy.wait_for_message(\'/%s\', Float32)%s  # a new reading of /%s' % (
+        '@last_%s = ' % topic if keep else '', topic, '.data' if keep else '', topic) for topic in _slowest_first(sheet)]
+
+
+def exam_node(style, mistake=None, form='plain'):
     """The script of the node that computes (and, with one node, warns)."""
     sheet = style.sheet
     two = style.nodes == 'two'
@@ -591,7 +632,8 @@ def exam_node(style, mistake=None):
         node.var('led', 'None', 'the warning service')
         node.setup += _threshold_lines(style, sheet, mistake) + _service_lines(sheet)
         _logic(node, style, sheet, mistake)
-    node.setup.insert(0, '@pub = rospy.Publisher(%r, Float32, queue_size=10)  # the output' % _output_topic(sheet, mistake))
+    queue = '10' if mistake == 'positional_queue' else 'queue_size=10'
+    node.setup.insert(0, '@pub = rospy.Publisher(%r, Float32, %s)  # the output' % (_output_topic(sheet, mistake), queue))
     node.fn('compute_value', '', 'The %s from the last readings, None before both arrived.' % SHEETS[sheet].output,
             _value_lines(sheet))
     counted = COUNTED[sheet]
@@ -608,7 +650,11 @@ def exam_node(style, mistake=None):
         return lines
 
     _inputs(node, style, sheet, mistake, on_new)
-    step = ['@value = &compute_value()', 'if @value is None:', '    return', '@pub.publish(@value)  # the output']
+    if form == 'wait_first':
+        node.setup += ['# wait for the drone: a first reading of each input'] + _waits(sheet, keep=False)
+    step = (_waits(sheet, keep=True) if mistake == 'slow_loop' else []) + [
+        '@value = &compute_value()', 'if @value is None:', '    return'] + (
+        [] if mistake == 'silent_output' else ['@pub.publish(@value)  # the output'])
     if not two and not logic_in_callback:
         step.append('&check(@value)')
     _driver(node, style, step, with_publish_timer=mistake != 'slow_rate')
@@ -640,11 +686,12 @@ def warning_node(style, mistake=None):
     return render(node, style.state)
 
 
-def launch_file(style, mistake=None):
+def launch_file(style, mistake=None, form='plain'):
     s = SHEETS[style.sheet]
     comment = (lambda text: []) if mistake == 'launch_no_comment' else (lambda text: ['  <!-- %s -->' % text])
     value = '%g' % s.threshold
-    lines = ['<launch>']
+    lines = ['<?xml version="1.0"?>'] if form == 'declared' else []
+    lines += [] if mistake == 'launch_no_root' else ['<launch>']
     warner = 'warning_node.py' if style.nodes == 'two' else 'exam_node.py'
     if style.threshold == 'global':
         lines += comment('the %s threshold (m) of the warning' % s.output) + [
@@ -664,7 +711,10 @@ def launch_file(style, mistake=None):
                       '    <param name="threshold" value="%s" />' % value, '  </node>']
         else:
             lines.append('  <node pkg="exam" type="%s" name="%s" output="screen"%s />' % (script, name, args))
-    lines.append('</launch>')
+        if mistake == 'node_no_name' and script == 'exam_node.py':
+            lines[-1 if lines[-1].endswith('/>') else -3] = lines[-1 if lines[-1].endswith('/>') else -3].replace(
+                ' name="%s"' % name, '')
+    lines += [] if mistake == 'launch_no_root' else ['</launch>']
     return '\n'.join(lines) + '\n'
 
 
@@ -697,8 +747,9 @@ catkin_install_python(PROGRAMS {scripts}
 '''
 
 
-def package_files(style, mistake=None):
-    """``{relative path: text}`` of the answer's package (its root is the folder ``exam``)."""
+def package_files(style, mistake=None, form='plain'):
+    """``{relative path: text}`` of the answer's package (its root is the folder ``exam``), in its
+    ``form`` (:data:`FORMS`)."""
     deps = [SHEETS[style.sheet].drone_pkg, 'rospy', 'std_msgs'] + (['message_filters'] if style.inputs == 'sync' else [])
     scripts = ['scripts/exam_node.py'] + (['scripts/warning_node.py'] if style.nodes == 'two' else [])
     files = collections.OrderedDict()
@@ -706,8 +757,8 @@ def package_files(style, mistake=None):
         '  <%s>%s</%s>' % (kind, dep, kind) for kind in ('build_depend', 'build_export_depend', 'exec_depend')
         for dep in deps))
     files['CMakeLists.txt'] = CMAKE.format(components='\n'.join('  %s' % d for d in deps), scripts=' '.join(scripts))
-    files['launch/exam.launch'] = launch_file(style, mistake)
-    files['scripts/exam_node.py'] = exam_node(style, mistake)
+    files['launch/exam.launch'] = launch_file(style, mistake, form)
+    files['scripts/exam_node.py'] = exam_node(style, mistake, form)
     if style.nodes == 'two':
         files['scripts/warning_node.py'] = warning_node(style, mistake)
     return files
@@ -716,7 +767,7 @@ def package_files(style, mistake=None):
 def write_package(answer, folder):
     """Write the answer's package into ``folder/exam``; return that path."""
     root = os.path.join(folder, 'exam')
-    for rel, text in package_files(answer.style, answer.mistake).items():
+    for rel, text in package_files(answer.style, answer.mistake, answer.form).items():
         path = os.path.join(root, rel)
         os.makedirs(os.path.dirname(path), exist_ok=True)
         with open(path, 'w') as f:

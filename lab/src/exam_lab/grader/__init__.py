@@ -11,6 +11,7 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   class's students, from a folder or an archive), :mod:`~.boxed.source` (what the sources say;
   the teacher's fixes before running), :mod:`~.boxed.code_quality` (the code's comments per function
   and block, its signs of bad practice), :mod:`~.boxed.launch` (the launch file read without running it),
+  :mod:`~.boxed.repair` (a launch file roslaunch refuses for its form, read and run repaired),
   :mod:`~.boxed.derive` (which launch file and threshold are run; the derived launch files the grader
   runs), :mod:`~.boxed.documents` (participant number, PDF
   reports), :mod:`~.boxed.report_reader` (the student's report read: text layer, OCR; converted by

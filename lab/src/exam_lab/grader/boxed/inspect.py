@@ -121,7 +121,9 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
         exam = chosen.exam_nodes[0]
         static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),
                             'exam_type': exam.type, 'exam_name': exam.name, 'package': name,
-                            'comments': chosen.comments(), 'exam_type_found': _executable_in(pkg, exam.type)}
+                            'comments': chosen.comments(), 'exam_type_found': _executable_in(pkg, exam.type),
+                            'repairs': chosen.repairs}
+        fixes.extend(chosen.repairs)
         param, why = derive.threshold_param(chosen, sheet)
         static['threshold_reason'] = why
         if param is not None:
@@ -145,6 +147,10 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
             static['threshold']['not_rewritable'] = 'its value comes from no literal the grader can change'
     else:
         static['threshold_reason'] = 'no launch file starts an exam node, so no parameter'
+        unread = _unread_launch(analyses, pkg)
+        if unread is not None:
+            static['launch_unread'] = static['threshold_reason'] = unread[1]
+            record['handed_in_launch'] = os.path.relpath(unread[0], os.path.join(ws, 'src'))
         if scripts:
             notes.append('no launch file starts an exam node: ran %s alone, without parameters'
                          % os.path.relpath(scripts[0], pkg))
@@ -157,6 +163,20 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     record['notes'] = bounds.closed(notes + capped, keep=capped)
     record['fixes'] = bounds.closed(fixes, 'fixes')
     return record
+
+
+def _unread_launch(analyses, pkg):
+    """``(path, sentence)`` of the first launch file the grader could not read at all (not XML even
+    inside a ``<launch>``), when no other starts an exam node: what it starts and sets is then for the
+    teacher to read (a hand grade, never a second loss); None when every launch file was read."""
+    for analysis in analyses:
+        where = os.path.relpath(analysis.path, pkg)
+        unread = [p for p in analysis.problems if p.startswith('%s is not valid XML' % where)]
+        if unread:
+            return analysis.path, ('%s cannot be read, by roslaunch nor by the grader (%s): the nodes it starts and '
+                                   'the threshold it sets are not judged by a run; read it by hand'
+                                   % (where, unread[0].split(': ', 1)[-1]))
+    return None
 
 
 def _bound_static(static, notes):

@@ -22,10 +22,10 @@ import collections
 import os
 import re
 import shlex
-import xml.etree.ElementTree as ET
 
 import yaml
 
+from exam_lab.grader.boxed import repair
 from exam_lab.grader.score.sheets import PACKAGE, SHEETS, sheet_of_drone
 
 #: Substitution pattern of roslaunch: ``$(command args)``.
@@ -92,6 +92,9 @@ class Analysis(object):
         #: Drone packages started through an ``<include>`` of their own launch files.
         self.included_drones = []
         self.problems = []
+        #: What roslaunch refuses in these files and the grader repaired to read and run them, one
+        #: sentence each (:mod:`~exam_lab.grader.boxed.repair`): question 12's loss, nothing else.
+        self.repairs = []
         #: real path -> parsed tree of every file read (the top one and the exam package's includes).
         self.trees = collections.OrderedDict()
 
@@ -280,17 +283,11 @@ def _read_file(analysis, path, scope, ns, depth):
     analysis.files_read += 1
     if analysis.files_read > MAX_FILES:
         raise Unsupported('more than %d launch files read (includes of includes)' % MAX_FILES)
-    try:
-        tree = ET.parse(path)
-    except (ET.ParseError, OSError) as err:
-        analysis.problems.append('%s is not valid XML: %s' % (os.path.relpath(path, analysis.package_dir), err))
+    tree = repair.read(path, os.path.relpath(path, analysis.package_dir), analysis.problems, analysis.repairs)
+    if tree is None:
         return
     analysis.trees[os.path.realpath(path)] = tree
-    root = tree.getroot()
-    if root.tag != 'launch':
-        analysis.problems.append('%s: the root element is <%s>, not <launch>' % (path, root.tag))
-        return
-    _read_children(analysis, root, scope, ns, None, depth)
+    _read_children(analysis, tree.getroot(), scope, ns, None, depth)
 
 
 def _enabled(element, scope):
@@ -312,6 +309,8 @@ def _read_children(analysis, parent, scope, ns, node, depth):
             inner = _join(ns, scope.substitute(group_ns)[0]) if group_ns else ns
             _read_children(analysis, element, scope, inner, node, depth)
         elif tag == 'node':
+            if element.get('name') is None and element.get('type'):
+                repair.name_node(analysis, element, scope)
             name = scope.substitute(element.get('name'))[0] or ''
             node_ns = _join(ns, scope.substitute(element.get('ns'))[0]) if element.get('ns') else ns
             node_type, type_origin = scope.substitute(element.get('type'))

@@ -38,8 +38,16 @@ class NodeFinder(object):
         if not nodes:
             return found
         inputs = [rospy.resolve_name(t) for t in (self.drone.fixed_topic, self.drone.moving_topic)]
-        wait_until(lambda: all(self.graph.subscribers(t) for t in inputs), SUBSCRIBE_S, period=0.1)
-        found['subscribed'] = {t: self.graph.subscribers(t) for t in inputs}
+        # Every subscriber seen while waiting, not only those of one instant: a node that subscribes to
+        # each input in turn (rospy.wait_for_message in its loop) subscribes to both (issue 45).
+        seen = {t: [] for t in inputs}
+
+        def both_seen():
+            for topic in inputs:
+                seen[topic] += [n for n in self.graph.subscribers(topic) if n not in seen[topic]]
+            return all(seen.values())
+        wait_until(both_seen, SUBSCRIBE_S, period=0.05)
+        found['subscribed'] = seen
         found['input_types'] = self.input_types(dict(zip(inputs, (self.drone.fixed_topic, self.drone.moving_topic))))
         return found
 

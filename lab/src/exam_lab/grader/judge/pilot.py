@@ -7,8 +7,8 @@ module only flies them, on the wall clock.
 import math
 import time
 
-from exam_lab.grader.judge.legs import (AFTER_S, BACK_S, DEEP_S, FLIGHT_LEGS, GAP_S, REST_S, SETTLE_S, SHORT_S,
-                                        last_value, leg_check, normal_wait, on_side, owes, settled)
+from exam_lab.grader.judge.legs import (AFTER_S, BACK_S, DEEP_S, FLIGHT_LEGS, GAP_S, IGNORE_S, REST_S, SETTLE_S,
+                                        SHORT_S, last_value, leg_check, normal_wait, on_side, owes, settled)
 from exam_lab.harness import oracle
 from exam_lab.harness.wait import wait_until
 
@@ -19,6 +19,8 @@ SETTLE_SLACK_S = 0.5
 #: alone moves the altitude by about 0.45 m).
 NEAR_M = 0.1
 NEAR_MAX_M = 0.2
+#: The most values of a question 11 row's window kept (its last ones): 6 s at 10 Hz.
+MAX_ROW_VALUES = 60
 #: The most seconds a leg waits for the node's own value to reach the side of the threshold it is
 #: flown for (a node that blocks a callback for 5 s publishes a stale value meanwhile).
 REACH_S = 8.0
@@ -34,6 +36,8 @@ class Inputs(object):
         #: How long after the last change the node's value is read (see set).
         self.settle = SETTLE_S
         self.flown = []  # [time, oracle value] at every input change, for the flight plot's trace
+        #: Each input's value now, and when each input set last was first read ({topic: time}).
+        self.now, self.changes = {}, {}
 
     def set(self, fixed, moving):
         """Change the inputs (the fixed one only when it changes, as a real drone's would); return the
@@ -41,14 +45,16 @@ class Inputs(object):
         drone = self.drone
         changed = None
         self.settle = SETTLE_S
+        self.changes = {}
         if fixed != self.fixed_now:
-            changed = drone.feeder.set(drone.fixed_topic, fixed)
+            changed = self.changes[drone.fixed_topic] = drone.feeder.set(drone.fixed_topic, fixed)
             self.fixed_now = fixed
             # A node that computes on each reading publishes a mixed pair in between (new fixed, old
             # moving); one that waits for a fresh reading of each follows up to the slowest period later.
             self.settle = max(SETTLE_S, 1.0 / min(drone.rates.values()) + SETTLE_SLACK_S)
-        since = drone.feeder.set(drone.moving_topic, moving)
+        since = self.changes[drone.moving_topic] = drone.feeder.set(drone.moving_topic, moving)
         since = max(since, changed or since)
+        self.now.update({drone.fixed_topic: fixed, drone.moving_topic: moving})
         self.flown.append([since, drone.expected(fixed, moving)])
         return since
 
@@ -83,11 +89,16 @@ class Calibration(object):
                 moving = oracle.pressure_at(x, fixed)
             else:
                 moving = oracle.pressure_robot_at(x, fixed)
+            earlier = dict(self.inputs.now)
             since = self.inputs.set(fixed, moving)
             value, count = settled(self.recorder, since, before, self.inputs.settle)
             before = value
+            # Every value of the row's window, the inputs before and when each changed: the rubric
+            # judges each value against the inputs the node could have seen (issue 45).
             rows.append({'inputs': {drone.fixed_topic: fixed, drone.moving_topic: moving},
-                         'expected': drone.expected(fixed, moving), 'published': value, 'samples': count})
+                         'expected': drone.expected(fixed, moving), 'published': value, 'samples': count,
+                         'before': earlier, 'changes': dict(self.inputs.changes),
+                         'values': [[t, v] for t, v in self.recorder.samples(since + IGNORE_S)][-MAX_ROW_VALUES:]})
             if fixed == drone.fixed_value:
                 points.append((x, value))
         return rows, points
@@ -152,16 +163,21 @@ class Flight(object):
         #: s a late WARNING is waited for, asked again as the wait goes (the threshold run flown beside
         #: the main run learns the main run's latency during its flight: :class:`~.probe.MainWord`).
         self.late_warning = late_warning or (lambda: plan.late_warning)
+        #: The output is read but nothing came on it before the flight (the node publishes nothing a
+        #: subscriber receives): each leg is held from the input's change, as with no output, and the
+        #: rubric times the calls against the judge's own value of the flight (issue 45).
+        self.silent = recorder is not None and not recorder.samples(0.0)
 
     def leg(self, x, side, hold, late=0.0, late_from=None):
         """Fly at ``x`` for ``hold`` s counted from the node's own first value on ``side`` (the input's
-        change when the output cannot be read, or when that value never comes within REACH_S); with
+        change when the output cannot be read or is :attr:`silent`, or when that value never comes
+        within REACH_S); with
         ``late``, keep flying while the node still owes this side's call (:func:`owes`), up to ``late``
         s after ``late_from`` (default: that first value). Returns ``(the input's change, that first
         value's time)``. ``late`` may be a function, asked on every look: the bound as it is known now."""
         since = self.fly(x)
         start = since
-        if self.recorder is not None:
+        if self.recorder is not None and not self.silent:
             threshold = self.plan.threshold
             reached = wait_until(lambda: next((t for t, v in self.recorder.samples(since)
                                                if on_side(v, threshold, side)), None), REACH_S, period=0.05)
@@ -189,7 +205,7 @@ class Flight(object):
         schedule['long_down'], back = self.leg(near, 'below', BACK_S)
         schedule['deep_down'] = self.leg(lo, 'below', DEEP_S, late_normal, late_from=back)[0]
         schedule['end'] = time.time()
-        flown = {'schedule': schedule, 'legs': self.legs(schedule, FLIGHT_LEGS)}
+        flown = {'schedule': schedule, 'legs': self.legs(schedule, FLIGHT_LEGS), 'silent': self.silent}
         if self.recorder is not None:
             samples = self.recorder.samples(schedule['rest'], schedule['end'])
             rate = {'samples': len(samples), 'hz': None, 'max_gap': None}

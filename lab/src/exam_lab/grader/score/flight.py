@@ -8,7 +8,8 @@ kept or as its view, and reads the view.
 """
 from exam_lab.grader.score.measured import otherwise, probe_of
 from exam_lab.grader.score.sheets import DELAY, REQUESTS, request_meaning
-from exam_lab.grader.score.tolerances import LAG_SLACK_S, OLD_SLOWEST_HZ, RATE_HZ, WARNING_EARLY_S, WARNING_LATE_S
+from exam_lab.grader.score.tolerances import (LAG_SLACK_S, OLD_SLOWEST_HZ, RATE_HZ, RATE_TOLERANCE, WARNING_EARLY_S,
+                                              WARNING_LATE_S)
 
 #: The legs of the flights, in words.
 LEG_WORDS = {'rest': 'rest below', 'short_up': 'short excursion above', 'short_down': 'gap below',
@@ -66,9 +67,24 @@ def driven_by(probe):
         otherwise(calibration.reason if calibration else None, ''))
 
 
+def silent(probe):
+    """Whether the node published nothing the judge received, its output there all the same (a
+    publisher rospy never connects, a value never published): the probe then flew each leg from the
+    input's change, at the oracle's values, and every timing rule is judged from its calls against
+    the judge's own value of the flight, from the readings (issue 45). A probe of before recorded no
+    such flight (it held each leg for a value that never came): never silent then."""
+    return bool(probe_of(probe).silent)
+
+
+def _legs(probe):
+    """The legs checked on the node's own values: none for a :func:`silent` output."""
+    probe = probe_of(probe)
+    return {} if silent(probe) else (probe.legs or {})
+
+
 def unreached_legs(probe, names=None):
     """Legs of a flight whose node's own value never reached the side they were flown for."""
-    legs = probe_of(probe).legs or {}
+    legs = _legs(probe)
     return [n for n in (names or sorted(legs)) if n in legs and legs[n].reached is None]
 
 
@@ -84,7 +100,7 @@ def leg_words(probe, name):
 def reached(probe, name):
     """When the node's own value reached the leg's side (the input's change when it cannot be read)."""
     probe = probe_of(probe)
-    leg = (probe.legs or {}).get(name)
+    leg = _legs(probe).get(name)
     return (leg.reached if leg else None) or probe.schedule[name]
 
 
@@ -97,23 +113,39 @@ def slowest_period(probe):
 
 def lag_tolerance(probe):
     """Seconds the node's value may take to follow its inputs: one period of the slowest input the
-    drone flew plus LAG_SLACK_S."""
-    return slowest_period(probe) + LAG_SLACK_S
+    drone flew plus LAG_SLACK_S, or plus its own period when it is slow (:func:`own_period`: its rate
+    is question 11's loss, not the timing items' too, issue 45)."""
+    return slowest_period(probe) + max(LAG_SLACK_S, own_period(probe))
+
+
+def own_period(probe):
+    """A slow node's own pace: the longest gap between two values it published in the flight, s, when
+    its rate is below the sheet's 10 Hz (question 11's loss); 0 otherwise (a 10 Hz node's tick is
+    counted where it matters; a long gap of a 10 Hz node is a block, not its pace) or when not measured.
+    A node that publishes once a second shows an input change, and checks its delay, that much later."""
+    rate = probe_of(probe).rate
+    hz, gap = (rate.hz, rate.max_gap) if rate else (None, None)
+    if hz is None or gap is None or hz >= RATE_HZ * (1 - RATE_TOLERANCE):
+        return 0.0
+    return gap
 
 
 def warning_window(probe):
     """``(earliest, latest)`` s after the node's own value went beyond and stayed, for a WARNING on time:
-    the delay less WARNING_EARLY_S; the delay and the larger of WARNING_LATE_S and one period of the
-    slowest input and one tick of the node's 10 Hz (a node that checks at each reading)."""
+    the delay less WARNING_EARLY_S; the delay and the larger of WARNING_LATE_S, one period of the
+    slowest input and one tick of the node's 10 Hz (a node that checks at each reading), and the node's
+    own period (:func:`own_period`: one that publishes slowly checks as slowly, its rate question 11's
+    loss alone, issue 45)."""
     delay = otherwise(probe_of(probe).delay, DELAY)
-    return delay - WARNING_EARLY_S, delay + max(WARNING_LATE_S, slowest_period(probe) + 1.0 / RATE_HZ)
+    return delay - WARNING_EARLY_S, delay + max(WARNING_LATE_S, slowest_period(probe) + 1.0 / RATE_HZ,
+                                                own_period(probe))
 
 
 def leg_lag(probe, name):
     """Seconds from the input's change to the node's own first value on leg ``name``'s side, or None
     (the leg was not flown, its value never reached the side, or the output cannot be read)."""
     probe = probe_of(probe)
-    leg = (probe.legs or {}).get(name)
+    leg = _legs(probe).get(name)
     start = (probe.schedule or {}).get(name)
     if (leg.reached if leg else None) is None or start is None:
         return None
@@ -139,19 +171,28 @@ def timed_from(probe, name, stays=False):
     return own, 'its own value'
 
 
+def worst_lag(probe):
+    """``(leg, seconds)``: the flight's leg where the node's value followed its inputs latest, and how
+    late; None when nothing was measured."""
+    probe = probe_of(probe)
+    measured = [(name, leg_lag(probe, name)) for name in LEG_WORDS if leg_lag(probe, name) is not None
+                and name in (probe.schedule or {}) and name not in ('start', 'step')]
+    return max(measured, key=lambda m: m[1]) if measured else None
+
+
 def lag_words(probe):
     """Question 11's evidence of how fast the node's value followed its inputs on the flight's legs,
     or '' when nothing was measured."""
     probe = probe_of(probe)
-    measured = [(name, leg_lag(probe, name)) for name in LEG_WORDS if leg_lag(probe, name) is not None
-                and name in (probe.schedule or {}) and name not in ('start', 'step')]
-    if not measured:
+    if worst_lag(probe) is None:
         return ''
-    name, worst = max(measured, key=lambda m: m[1])
+    name, worst = worst_lag(probe)
     tolerance = lag_tolerance(probe)
     if worst <= tolerance:
         return 'its value followed the inputs within %.2f s (at most %.2f s: one period of the slowest input ' \
-               'and a tick); the timing items are judged from its own values' % (max(worst, 0.0), tolerance)
+               'and %s); the timing items are judged from its own values' % (
+                   max(worst, 0.0), tolerance, 'its own period, %.2f s' % own_period(probe) if own_period(probe) > LAG_SLACK_S
+                   else 'a tick')
     return 'its value followed the inputs %.1f s late in the %s, more than one period of the slowest input ' \
            '(%.2f s): the timing items are judged from the readings there' % (worst, LEG_WORDS[name], tolerance)
 

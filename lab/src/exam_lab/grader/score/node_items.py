@@ -6,9 +6,10 @@ Each ``score_*`` takes the views of the inspection's and the session's records
 (:func:`~exam_lab.grader.score.measured.static_of`, :func:`~exam_lab.grader.score.measured.session_of`)
 and gives the item's ``{"id", "points", "max", "evidence"}``.
 """
+import itertools
 import math
 
-from exam_lab.grader.score.flight import lag_words
+from exam_lab.grader.score.flight import lag_words, worst_lag
 from exam_lab.grader.score.measured import item, main_probe, node_ran, not_run, otherwise, refused_inputs
 from exam_lab.grader.score.sheets import SHEETS
 from exam_lab.grader.score.tolerances import (NO_COMMENT_LOSS, NUMERIC_TYPES, RATE_HZ, RATE_TOLERANCE,
@@ -120,7 +121,9 @@ def score_q11(sheet, session):
         notes.append('rate: %d message(s) in the flight, cannot measure (0/1)'
                      % otherwise(rate.samples if rate else None, 0))
     rows = otherwise(probe.formula, ())
-    wrong = [r for r in rows if not _agrees(r.expected, r.published)]
+    lag = max(0.0, (worst_lag(probe) or (None, 0.0))[1])
+    paced = [r for r in rows if not _agrees(r.expected, r.published) and _agrees_at_its_pace(sheet, r, lag)]
+    wrong = [r for r in rows if not _agrees(r.expected, r.published) and r not in paced]
     shown = '; '.join('%s -> %s, expected %.2f%s' % (
         ', '.join('%s %g' % (k.lstrip('/'), v) for k, v in sorted(r.inputs.items())),
         'nothing' if r.published is None else '%.2f' % r.published, r.expected,
@@ -129,8 +132,8 @@ def score_q11(sheet, session):
     constant = _constant_input(sheet, rows, refused_inputs(probe)) if rows and wrong else None
     if rows and not wrong:
         points += 1.5
-        notes.append('values agree with equation (1) within max(%.1f m, %.1f %%) (1.5): %s'
-                     % (VALUE_TOLERANCE_M, VALUE_TOLERANCE_REL * 100, shown))
+        notes.append('values agree with equation (1) within max(%.1f m, %.1f %%)%s (1.5): %s'
+                     % (VALUE_TOLERANCE_M, VALUE_TOLERANCE_REL * 100, _pace_words(paced, lag), shown))
     elif constant is not None:
         points += 1.5
         notes.append('values agree with equation (1) within max(%.1f m, %.1f %%) at the constant %s %g the node '
@@ -146,6 +149,50 @@ def score_q11(sheet, session):
     if lag:
         notes.append(lag)
     return item('Q11', points, '; '.join(notes))
+
+
+def _could_have_seen(row, t, lag):
+    """The input pairs (``{topic: value}``) a value published at ``t`` may have been computed from:
+    each input's value before its change too, when the change came less than ``lag`` s before ``t``."""
+    options = []
+    for topic, value in sorted(row.inputs.items()):
+        changed = (row.changes or {}).get(topic)
+        old = (row.before or {}).get(topic)
+        seen = [value] + ([old] if old is not None and changed is not None and t - lag < changed else [])
+        options.append([(topic, v) for v in seen])
+    return [dict(pair) for pair in itertools.product(*options)]
+
+
+def _expected(sheet, inputs):
+    """Equation (1) of one pair of the drone's inputs, by their topics' names."""
+    named = {topic.rstrip('/').split('/')[-1]: value for topic, value in inputs.items()}
+    try:
+        if sheet == 'altitude':
+            return oracle.altitude_of(named['temperature'], named['pressure'])
+        return oracle.depth_of(named['pressure_robot'], named['pressure_remote'])
+    except (KeyError, ValueError, ZeroDivisionError):
+        return None
+
+
+def _agrees_at_its_pace(sheet, row, lag):
+    """Whether every value the node published in the row's window agrees with equation (1) of inputs
+    it could have seen within its measured ``lag`` (issue 45: a node that publishes once a second is
+    read still showing the inputs of before; its rate is question 11's loss, not its values). A row
+    kept without its window (a probe of before) is judged on its last value alone."""
+    if not row.values or row.changes is None:
+        return False
+    for t, value in row.values:
+        expected = [_expected(sheet, pair) for pair in _could_have_seen(row, t, lag)]
+        if not any(e is not None and _agrees(e, value) for e in expected):
+            return False
+    return True
+
+
+def _pace_words(paced, lag):
+    if not paced:
+        return ''
+    return (' at its own pace: %d value(s) read were of the inputs before the change, published within its '
+            'measured lag (%.2f s) of it' % (len(paced), lag))
 
 
 def _constant_input(sheet, rows, refused):
@@ -178,14 +225,20 @@ def score_q12(sheet, static, session):
     launch = static.launch
     if static.launch_files is None:
         return item('Q12', 0, 'not judged: the package was not read (see runs)')
+    verdict = session.launch_check
+    if launch is None and static.launch_unread:
+        return item('Q12', 0, '%s%s' % (static.launch_unread, ': "%s"' % verdict.refused if verdict and verdict.refused
+                                        else ''))
     if launch is None:
         return item('Q12', 0, 'no launch file in the package starts an exam node (launch files: %s)'
                     % (', '.join(static.launch_files) or 'none'))
     drone = SHEETS[sheet]
-    verdict = session.launch_check
     if verdict and verdict.refused:
+        # The file's one loss (issue 45): what it starts and sets is judged as written, run repaired.
         return item('Q12', 0, 'roslaunch refuses %s as handed in, so `roslaunch` starts nothing: "%s" (the grader '
-                    'ran it without the drone\'s node, a fix named in the status)' % (verdict.file, verdict.refused))
+                    'ran it %swithout the drone\'s node, the fixes named in the status; the rest is judged on what '
+                    'it starts and sets as written)' % (verdict.file, verdict.refused,
+                                                        'repaired and ' if launch.repairs else ''))
     warned = ('; roslaunch warns: %s' % ' | '.join(verdict.warnings)) if verdict and verdict.warnings else ''
     has_drone = launch.starts_drone
     exam_ok = launch.exam_type_found

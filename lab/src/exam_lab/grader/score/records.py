@@ -36,7 +36,9 @@ STATIC = {
     'code': Optional({'service_calls': [str], 'publishes': [str], 'timers': [str],
                       'private_before_init': Optional([str])}),
     'launch': Maybe({'file': str, 'starts_drone': bool, 'exam_type': str, 'exam_name': str, 'package': Text(255),
-                     'comments': Number(0, 1e9, integer=True), 'exam_type_found': bool}),
+                     'comments': Number(0, 1e9, integer=True), 'exam_type_found': bool,
+                     'repairs': Optional([str])}),
+    'launch_unread': Optional(str),
     'threshold': Maybe({'name': str, 'value': Maybe((str, Number(), bool)), 'where': str,
                         'how': Optional(OneOf('param', 'args')), 'run_value': Optional(float),
                         'not_rewritable': Optional(str)}),
@@ -193,14 +195,20 @@ class ProbeRecord(Record):
         'input_types': Optional(Map(_NAME, {'type': Maybe(_NAME), 'connected': bool, 'refused': Maybe(Text()),
                                             'adapted': Maybe(_NAME), 'published': Optional(_NAME)}, 10)),
         'output': Optional({'expected': _NAME, 'topic': Maybe(_NAME), 'type': Maybe(_NAME), 'candidates': [_NAME]}),
+        # A probe of before issue 45 kept the last value of each row only: no 'before', 'changes', 'values'.
         'formula': Optional(Items({'inputs': Map(Text(100), _VALUE, 4), 'expected': _VALUE,
-                                   'published': Maybe(_VALUE), 'samples': _COUNT}, 20)),
+                                   'published': Maybe(_VALUE), 'samples': _COUNT,
+                                   'before': Optional(Map(Text(100), _VALUE, 4)),
+                                   'changes': Optional(Map(Text(100), _TIME, 4)),
+                                   'values': Optional(Items(Row(_TIME, _VALUE), 100))}, 20)),
         # A probe of before 2026-11-26 18:20 calibrated on lo and hi only: measurements kept then have no 'near'.
         'calibration': Optional(dict({'by': OneOf('own', 'oracle'), 'reason': Text(), 'fit': Maybe(Row(_VALUE, _VALUE))},
                                      **{side: schema({'x': _VALUE, 'target': _VALUE, 'value': Maybe(_VALUE)})
                                         for side, schema in (('lo', dict), ('hi', dict), ('near', Optional))})),
         'schedule': Optional(Map(Text(50), _TIME, 20)),
         'legs': Optional(Maybe(Map(Text(50), LEG, 20))),
+        # A probe of before issue 45 held each leg for a value of a silent output: no 'silent' then.
+        'silent': Optional(bool),
         'rate': Optional({'samples': _COUNT, 'hz': Maybe(Number()), 'max_gap': Maybe(Number()),
                           'non_finite': Optional(_COUNT)}),
         'node_watch': {'deaths': Items({'node': _NAME, 't': Maybe(_TIME), 'detail': Text()}, MAX_DEATHS),

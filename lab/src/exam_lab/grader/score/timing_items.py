@@ -141,10 +141,10 @@ def score_q14a(sheet, static, session):
         side = calibration.lo if calibration else None
     flown = otherwise(side.target if side else None, float('nan'))
     if warned:
-        return item('Q14a', 1, 'launch file %s = %s; set to %g, the node warned %.2f s after its own value went '
+        return item('Q14a', 1, 'launch file %s = %s; set to %g, the node warned %.2f s after %s went '
                     'above it, flown at %.1f, a value it kept NORMAL with %s' % (
-                        what, threshold.value, probe2.threshold, warned[0][0] - flight.reached(probe2, leg), flown,
-                        threshold.value))
+                        what, threshold.value, probe2.threshold, warned[0][0] - flight.reached(probe2, leg),
+                        'the first reading' if flight.silent(probe2) else 'its own value', flown, threshold.value))
     return item('Q14a', 0, 'launch file %s = %s; set to %g, the node stayed NORMAL for %.1f s at %.1f, above the new '
                 'threshold: it does not obey the %s (%s)' % (
                     what, threshold.value, probe2.threshold, end - flight.reached(probe2, leg), flown,
@@ -179,7 +179,9 @@ def score_q14b(sheet, session):
     back_from, back_words = flight.timed_from(probe, 'long_down')
     normals = flight.calls_between(probe, schedule['long_down'], flight.back_end(probe), 'NORMAL')
     normal_latency = normals[0][0] - back_from if normals else None
-    normal_ok = normal_judged and normal_latency is not None and normal_latency <= NORMAL_LATE_S
+    # Timed from the readings for a silent output: its node may see the reading one slowest period later.
+    normal_late = NORMAL_LATE_S + (flight.slowest_period(probe) if flight.silent(probe) else 0.0)
+    normal_ok = normal_judged and normal_latency is not None and normal_latency <= normal_late
     points = 1.5 * warn_ok + 1.0 * short_ok + (0.5 * normal_ok if (warn_ok or short_ok) else 0.0)
     notes = ['WARNING %.2f s after %s went above the threshold and stayed (%s: %.2f-%.2f s) (%s/1.5)' % (
         latency, up_words, 'ok' if warn_ok else 'outside', early, late, 1.5 if warn_ok else 0)]

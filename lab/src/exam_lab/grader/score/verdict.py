@@ -8,7 +8,7 @@ their views, and read the views.
 import re
 
 from exam_lab.grader.score.flight import LEG_WORDS, calls, reached, refused_calls, refused_words, schedule_of, \
-    unreached_legs
+    silent, unreached_legs
 from exam_lab.grader.score.measured import adapted_inputs, main_probe, node_ran, otherwise, published, \
     refused_inputs, session_of, static_of, stayed_up
 from exam_lab.grader.score.sheets import SHEETS
@@ -53,7 +53,12 @@ def missing_evidence(static, session):
     out = []
     sheet = SHEETS.get(probe.sheet) or SHEETS['altitude']
     rate = probe.rate
-    if rate is not None and not rate.samples and publishes:
+    if rate is not None and not rate.samples and publishes and silent(probe) and calls(probe):
+        out.append('the judge received nothing on %s%s, yet its code publishes at %s: Q13, Q14a, Q14b judged from its '
+                   'calls against the judge\'s own value of the flight, Q11\'s rate and values not measured; read '
+                   'its code' % (probe.output.topic if probe.output else '?', _silence_cause(session),
+                                 ', '.join(publishes[:3])))
+    elif rate is not None and not rate.samples and publishes:
         out.append('the node never published its value while flown, yet its code publishes at %s: nothing '
                    'measured for Q11, Q13, Q14; read its code' % ', '.join(publishes[:3]))
     elif not calls(probe) and service_calls and not unreached_legs(probe, ['long_up']):
@@ -62,6 +67,25 @@ def missing_evidence(static, session):
                    'the call is never reached' % ('/' + sheet.service.lstrip('/'), schedule['long_down'] - reached(probe, 'long_up'),
                                                   ', '.join(service_calls[:3])))
     return out
+
+
+#: rospy's words, in the node's log, for a subscriber's connection its publisher failed to take.
+_INBOUND_FAILED = re.compile(r'Inbound TCP/IP connection failed: ([^\n]{1,200})')
+
+
+def _silence_cause(session):
+    """Why a publisher's subscribers received nothing, when its node's log (the main run's) says it:
+    rospy's words for the failed connection, or '' (rospy/topics.py: ``Publisher(name, data_class,
+    subscriber_listener=None, ...)``, so a ROS 2 style ``Publisher(topic, Float32, 10)`` makes 10 the
+    listener, whose ``peer_subscribe`` fails at every subscriber's connection, which rospy then closes)."""
+    run = [r for r in session.runs or () if r.tag == 'main']
+    found = _INBOUND_FAILED.search((run[0].launch.tail if run and run[0].launch else None) or '')
+    if not found:
+        return ''
+    if 'peer_subscribe' in found.group(1):
+        return (' (rospy.Publisher\'s third positional argument is subscriber_listener, not the queue size: '
+                'every connection failed)')
+    return ' (rospy: "Inbound TCP/IP connection failed: %s")' % found.group(1).strip()
 
 
 def status(static, session, fixes=()):
@@ -124,11 +148,19 @@ def status(static, session, fixes=()):
     ambiguous = [u for u in static.uploads or () if u.ambiguous]
     if ambiguous:
         return HAND_GRADE, _one_line('several uploads: %s; check which one is the last' % ambiguous[0].why)
+    if static.launch_unread:
+        return HAND_GRADE, _one_line(static.launch_unread)
     verdict = session.launch_check
     if verdict and verdict.refused:
-        fixes = list(fixes) + ['roslaunch refuses %s as handed in ("%s"): the grader ran it without the drone\'s '
-                               'node; Q12 judged on the file as handed in' % (verdict.file, verdict.refused)]
+        fixes = list(fixes) + ['roslaunch refuses %s as handed in ("%s"): the grader ran it %swithout the drone\'s '
+                               'node; Q12 judged on the file as handed in (its one loss), the rest on what it starts '
+                               'and sets as written' % (verdict.file, verdict.refused,
+                                                        'repaired and ' if static.launch and static.launch.repairs
+                                                        else '')]
     fixes = list(fixes) + adapted_inputs(main_probe(session))
+    if silent(main_probe(session)) and calls(main_probe(session)):
+        fixes.append('the judge received nothing on %s: Q13, Q14a, Q14b judged from its calls against the judge\'s '
+                     'own value of the flight, timed from the readings' % main_probe(session).output.topic)
     if fixes:
         return GRADED_WITH_FIXES, _one_line('; '.join(fixes))
     return GRADED, ''
