@@ -333,8 +333,8 @@ def test_report_pdf_has_at_most_ten_pages_of_questions_then_the_appendices_in_it
     assert 'Questions 1 to 14' in top and top.index('Questions 1 to 14') < top.index('Appendices'), top
     assert last_question_page <= QUESTION_PAGES, 'the questions part runs to page %d' % last_question_page
     titles = [title for _, _, title in outline]
-    for expected in ['14b. The 5 s delay', 'A. This project\'s node, and what it does differently',
-                     'D. Corrections to the exam sheets and the grader\'s notes']:
+    for expected in ['14b. The 5 s delay', 'E. This project\'s node, and what it does differently',
+                     'C. Corrections to the exam sheets and the grader\'s notes']:
         assert any(t.replace('&#39;', "'").replace('&apos;', "'") == expected for t in titles), (expected, titles)
 
 
