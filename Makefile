@@ -25,7 +25,7 @@ help:
 	@echo "make bench          benchmarks of the exam node against the naive baseline"
 	@echo "make soak           30-minute soak run, checked offline against the debounce rule"
 	@echo "make mutation       mutation testing of the nodes' code against its tests (about 30 min)"
-	@echo "make fairness [JOBS=n] [OUT=<dir>]  the grader on generated student answers (42 correct, 36 one-mistake,"
+	@echo "make fairness [JOBS=n] [OUT=<dir>]  the grader on generated student answers (46 correct, 46 one-mistake,"
 	@echo "                    both sheets) as one class; its report into docs/grading.md (about 30 min)"
 	@echo "make grade SUBMISSION=<dir|zip> | CLASS=<dir|zip> [SHEET=altitude|depth] [OUT=<dir>] [JOBS=n]"
 	@echo "                    [WORKSHEET=<Moodle grading worksheet.csv>] [ENGINE=local|slurm] [SLURM_ARGS='...']"
