@@ -28,6 +28,8 @@ packages=(
   zip unzip libarchive-tools p7zip-full locales
   # the code-quality proposal's static check of the student's node (run in the inspection's box)
   python3-pyflakes
+  # the report reader's pictures (screenshots prepared for OCR, page images) are PIL's
+  python3-pil
   "$@"
 )
 

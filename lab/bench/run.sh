@@ -104,7 +104,14 @@ if [ "$grader" = record ]; then
   cp "$scratch/grader/results.json" "$repo/lab/bench/grader_results.json"
   # docs/benchmarks.md again, now with the new lab/bench/grader.md appended.
   /usr/bin/python3 "$repo/lab/bench/bench.py" "${args[@]}" --render-only
+  # The reports' reading time (lab/bench/report_bench.py, reader47's piece: a few minutes), lab/bench/reports.md.
+  /usr/bin/python3 "$repo/lab/bench/report_bench.py" --out "$scratch/reports" --record &
+  bench_pid=$!
+  wait "$bench_pid"
 elif [ "$grader" = quick ]; then
+  /usr/bin/python3 "$repo/lab/bench/report_bench.py" --repeat 2 --out "$out/reports" &
+  bench_pid=$!
+  wait "$bench_pid"
   /usr/bin/python3 "$repo/lab/bench/grader_bench.py" --students 4 --jobs 2 --out "$out/grader" &
   bench_pid=$!
   wait "$bench_pid"

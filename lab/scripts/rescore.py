@@ -6,7 +6,9 @@
 For each student of OUT (or the one submission graded there), the rubric is applied to the
 measurements.json that ``make grade`` kept beside its grade.json; grade.json (with the points it had,
 ``previous``, and its provenance), grade.md, grades.csv, the page, results.json, moodle-feedback.zip and hand.csv (the
-teacher's points kept) are written again, and each student whose points or status moved is printed
+teacher's points kept) are written again, each student's report.json read back as its record (the
+report is never read again: a student whose report was not read, or whose report.json is not a record
+of the grader, is said), and each student whose points or status moved is printed
 with the items that moved; a student whose measurements.json or grade.json is not a record of the
 grader is listed as not rescored (its files left as they were; the exit status is 1). No ROS, no
 sandbox, no root. A change of the rubric that needs measurements
@@ -17,6 +19,7 @@ import os
 import sys
 
 from exam_lab.grader.publish import desk, grades, report
+from exam_lab.grader.score import records as records_
 from exam_lab.grader.score import safe_text
 
 
@@ -43,6 +46,12 @@ def main(argv=None):
         print('%d student(s) NOT rescored (a kept file that is not a record of the grader):' % len(refused))
         for line in refused:
             print('  ' + safe_text.one_line(line))
+    # Each student's report as its run read it (report.json, checked as a box's record is): never read
+    # again from the PDF, no box here. One not read, or a kept file refused, is said.
+    for folder in grades.graded_folders(out):
+        kept = records_.ReportRecord.kept(folder)
+        if kept.state != 'read':
+            print('  report of %s not read: %s' % (safe_text.one_line(os.path.basename(folder)), safe_text.one_line(kept.why)))
     single = grades.graded_folders(out) == [out]
     # The run's similarity check, read as its record (capped, checked, its text clean); one that is
     # not is said where its pairs would be.

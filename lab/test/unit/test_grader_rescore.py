@@ -72,3 +72,38 @@ def test_every_similarity_json_the_class_run_writes_is_read_back_as_its_record(t
         errors.append(kept.error)
     assert errors[0] == 'the archive failed on  entry 3'
     assert len(kept.error) == SimilarityRecord.SCHEMA['error'].schema.limit and kept.error.endswith('x at its end')
+
+
+def test_make_rescore_reads_each_kept_report_as_its_record_never_the_box(tmp_path, monkeypatch, capsys):
+    """Each student's report.json is read back through ReportRecord (capped, checked); one not read, or
+    a garbled one, is said by name; the reader's box is never started again (issue 47 point 1)."""
+    import os
+    import sys
+    from exam_lab.grader.host import reports
+    from exam_lab.grader.score.records import ReportRecord
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), '..', 'scripts'))
+    import rescore
+    for name in ('read', 'encrypted', 'garbled', 'none'):
+        folder = tmp_path / name
+        folder.mkdir()
+        kept = dict(kept_copy('before-version'), student=name)
+        (folder / MEASUREMENTS).write_text(json.dumps(kept))
+        (folder / 'grade.json').write_text(json.dumps(grades.score(kept)))
+    page = {'file': 0, 'number': 1, 'source': 'text', 'text': 'rosnode list', 'layout': '', 'confidence': None,
+            'unsure': [], 'pictures': 0, 'image': None}
+    reports.write(str(tmp_path / 'read'), ReportRecord.make({
+        'version': 1, 'state': 'read', 'why': '', 'notes': [], 'seconds': 1.0, 'pages': [page],
+        'files': [{'name': 'r.pdf', 'kind': 'pdf', 'converted': False, 'pages': 1, 'note': '', 'state': 'read',
+                   'copy': None}]}))
+    reports.write(str(tmp_path / 'encrypted'), ReportRecord.not_read("'r.pdf': an encrypted PDF"))
+    (tmp_path / 'garbled' / 'report.json').write_text('{"state": "read"}')
+
+    def never(*args, **kwargs):
+        raise AssertionError('the reader was run again')
+    monkeypatch.setattr(reports, 'read_report', never)
+    rescore.main(['--out', str(tmp_path)])
+    lines = [line.strip() for line in capsys.readouterr().out.splitlines() if line.strip().startswith('report of')]
+    assert lines[0] == "report of encrypted not read: 'r.pdf': an encrypted PDF"
+    assert lines[1].startswith('report of garbled not read: the kept report.json is not a record of the grader: ')
+    assert lines[2].startswith('report of none not read: no report.json kept')
+    assert len(lines) == 3

@@ -13,7 +13,11 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   and block, its signs of bad practice), :mod:`~.boxed.launch` (the launch file read without running it),
   :mod:`~.boxed.derive` (which launch file and threshold are run; the derived launch files the grader
   runs), :mod:`~.boxed.documents` (participant number, PDF
-  reports), :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own),
+  reports), :mod:`~.boxed.report_reader` (the student's report read: text layer, OCR; converted by
+  LibreOffice), :mod:`~.boxed.report_files` (which files are the report, of what kind),
+  :mod:`~.boxed.report_text` (its text: lines, OCR words, underscores, pictures' places),
+  :mod:`~.boxed.report_images` (its pictures prepared for OCR, PIL),
+  :mod:`~.boxed.similarity` (similar submissions, copydetect in a venv of its own),
   :mod:`~.boxed.bounds` (what a box puts into its record, cut to the record's caps with a sentence).
 - ``judge/`` -- a judge uid, never root, never reading the student's files: :mod:`~.judge.probe`
   (rospy: plays the drone with the harness's fake drone, measures; its entry point), :mod:`~.judge.graph`
@@ -28,9 +32,10 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.host.staging` (the upload copied byte for byte; the box's work folder),
   :mod:`~.host.egress` (the only reader of what a box leaves: its record, capped, never a link, checked
   against its schema; its logs, capped), :mod:`~.host.boxed_run` (one of the grader's modules run in a
-  box on student bytes, its record read back), :mod:`~.host.underlay` (the simulators' workspace,
-  built once, under every student's package) and :mod:`~.host.reference` (the sheet's drone run alone
-  in a network namespace, the report's commands' outputs captured: the reference of questions 4-9).
+  box on student bytes, its record read back), :mod:`~.host.reports` (the report read in a box of its
+  own; the report's and the code's copies kept for the teacher), :mod:`~.host.underlay` (the simulators'
+  workspace, built once, under every student's package) and :mod:`~.host.reference` (the sheet's drone
+  run alone in a network namespace, the report's commands' outputs captured: the reference of questions 4-9).
 - ``score/`` -- pure: :mod:`~.score.sheets` (each sheet's names, the delay, the items and maxima),
   :mod:`~.score.rubric` (points, evidence and status from the measurements: :func:`~.score.rubric.score`)
   and its parts: :mod:`~.score.tolerances` (each tolerance, one constant), :mod:`~.score.measured` (the

@@ -10,7 +10,7 @@ import shutil
 
 from exam_lab.grader import runner
 from exam_lab.grader.boxed import archives, bounds, classlist, similarity
-from exam_lab.grader.host import sandbox, staging
+from exam_lab.grader.host import reports, sandbox, staging
 from exam_lab.grader.host.boxed_run import INTAKE_BOUNDS, SIMILARITY_BOUNDS, Boxed, InspectionFailed
 from exam_lab.grader.host.underlay import default_underlay, ensure_underlay
 from exam_lab.grader.host.bwrap import can_isolate
@@ -191,6 +191,8 @@ def _refused_at_intake(name, folder, out_dir, sheet, why):
                 'extra': {'participant': identity.participant_number(folder_name), 'folder': folder_name,
                           'documents': [], 'seconds': 0.0}}
     os.makedirs(out_dir, exist_ok=True)
+    reports.write(out_dir, records.ReportRecord.not_read(bounds.cut('the class\'s intake refused this student\'s '
+                                                                    'files: %s' % why)))
     return grades.keep_and_score(out_dir, measured)
 
 

@@ -16,7 +16,11 @@ record out:
    network namespace with only loopback (:func:`~exam_lab.grader.host.bwrap.network_namespace`) under a
    :class:`~exam_lab.harness.supervisor.Supervisor` with the student's time limit; root reads back its
    :class:`~exam_lab.grader.score.records.SessionRecord` (:func:`session_outcome`);
-5. **score** and **publish** (:func:`publish`): the measurements kept, the grade made from them by
+5. **report** (:func:`~exam_lab.grader.host.reports.read_report`): the student's report read in a box
+   of its own (:mod:`~exam_lab.grader.boxed.report_reader`), kept as ``report.json`` with the files
+   handed in and the pages' images (``report/``); the package's source as handed in is kept in ``code/``
+   (:func:`~exam_lab.grader.host.reports.keep_code`, from the inspection's copy);
+6. **score** and **publish** (:func:`publish`): the measurements kept, the grade made from them by
    :func:`~exam_lab.grader.publish.grades.score` (the rubric; a rescore does the same), grade.json and
    grade.md written; the session's logs copied as data (regular files only, each capped:
    :func:`keep_logs`).
@@ -32,7 +36,8 @@ import sys
 import time
 
 from exam_lab.grader.boxed import archives
-from exam_lab.grader.host import bwrap, egress, limits, sandbox, staging
+from exam_lab.grader.boxed.inspect import CODE_COPY
+from exam_lab.grader.host import bwrap, egress, limits, reports, sandbox, staging
 from exam_lab.grader.host.boxed_run import INSPECT_BOUNDS, Boxed, InspectionFailed, session_tail
 from exam_lab.grader.host.bwrap import can_isolate
 from exam_lab.grader.host.session import budget_sentence
@@ -98,6 +103,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                 facts, comments = found.facts, found.comments
                 if found.refused is not None:
                     raise archives.UnpackError(found.refused)
+                notes.extend(reports.keep_code(os.path.join(work, 'out', CODE_COPY), out_dir))
                 chosen_sheet, static = found.sheet, found.static
                 job = plan_job(found)
                 if job is None:
@@ -118,6 +124,9 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
             session = grades.no_session(Outcome.GRADER_FAILED, 'the grader failed on this submission: %r' % err)
             notes.append(grades.bug_note())
         notes.extend(keep_logs(work, out_dir))
+        # The report, read after the flights in a box of its own: its time is not the student's budget.
+        progress.report(on_step, 'report')
+        reports.read_report(submission, out_dir, jobs=jobs)
         measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session.value,
                     'notes': notes, 'fixes': fixes, 'comments': comments, 'isolate': isolate, 'how_run': how_run,
                     'extra': dict(facts, **dict(extra or {}, seconds=round(time.monotonic() - start, 1)))}

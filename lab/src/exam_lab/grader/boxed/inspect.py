@@ -27,6 +27,9 @@ from exam_lab.grader.score import boxenv, records
 from exam_lab.grader.score.sheets import PACKAGE, SHEETS, threshold_run_value
 
 
+#: The package's source as handed in (before the teacher's fixes), copied below ``OUT``: root keeps it
+#: for the teacher as ``code/`` of the student's folder (:func:`exam_lab.grader.host.reports.keep_code`).
+CODE_COPY = 'code'
 #: Notes of one kind, one a file (a file that does not parse, a launch file's problem), named at most:
 #: a package of hundreds of such files must leave room in the record's notes for the others.
 NOTES_OF_A_KIND = 50
@@ -78,6 +81,7 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     except archives.UnpackError as err:
         record['refused'] = str(err)
         return record
+    package.copy_package(pkg_source, os.path.join(out, CODE_COPY), [])  # as handed in, for the teacher (code/)
     name = package.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
     pkg = os.path.join(ws, 'src', name if re.match(r'^[A-Za-z][\w-]*$', name) else PACKAGE)
     package.copy_package(pkg_source, pkg, fixes)

@@ -95,3 +95,55 @@ def copy_results(source, target, suffixes=('.log', '.json', '.md'), part=LOG_PAR
         with open(os.path.join(target, name), 'w') as f:
             f.write(text)
     return skipped
+
+
+def read_bytes(path, max_bytes):
+    """The bytes of the regular file ``path`` (a box's), or None when it is missing, not a regular file
+    (never followed, never blocking) or over ``max_bytes``: a file kept for the teacher whole or not at all."""
+    try:
+        fd = os.open(path, _READ_FLAGS)
+    except OSError:
+        return None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode) or info.st_size > max_bytes:
+            return None
+        chunks, size = [], 0
+        while size <= max_bytes:
+            chunk = os.read(fd, max_bytes + 1 - size)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        return b''.join(chunks) if size <= max_bytes else None
+    finally:
+        os.close(fd)
+
+
+def copy_tree(source, target, max_files, max_bytes):
+    """Copy the folder ``source`` (a box's) to ``target``: its folders and regular files, each read by
+    :func:`read_bytes`, at most ``max_files`` files and ``max_bytes`` in all; links, FIFOs, devices and
+    files past the caps are left out. Returns the relative names left out."""
+    skipped, budget = [], {'files': max_files, 'bytes': max_bytes}
+    os.makedirs(target)
+    for dirpath, dirnames, filenames in os.walk(source):
+        rel = os.path.relpath(dirpath, source)
+        for name in sorted(dirnames):
+            if os.path.islink(os.path.join(dirpath, name)) or '\n' in name:
+                skipped.append(os.path.normpath(os.path.join(rel, name)))
+                dirnames.remove(name)
+            else:
+                os.mkdir(os.path.join(target, rel, name))
+        dirnames.sort()
+        for name in sorted(filenames):
+            shown = os.path.normpath(os.path.join(rel, name))
+            data = None if budget['files'] <= 0 or '\n' in name else \
+                read_bytes(os.path.join(dirpath, name), budget['bytes'])
+            if data is None:
+                skipped.append(shown)
+                continue
+            budget['files'] -= 1
+            budget['bytes'] -= len(data)
+            with open(os.path.join(target, rel, name), 'xb') as f:
+                f.write(data)
+    return skipped

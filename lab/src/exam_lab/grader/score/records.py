@@ -9,6 +9,7 @@ that box, never data to use. What the grader keeps of a grading (its measurement
 records too: :mod:`exam_lab.grader.score.kept`.
 """
 import enum
+import os
 import re
 
 # The schema machinery, importable from here as well (records.check, records.Text...).
@@ -334,3 +335,92 @@ class SessionRecord(Record):
     @classmethod
     def converted(cls, value):
         return dict(value, outcome=Outcome(value['outcome']))
+
+
+#: What the report reader reads at most (:mod:`exam_lab.grader.boxed.report_reader`): files of one
+#: student, pages of one file, and of the whole report; the characters of one page's text.
+REPORT_FILES = 10
+REPORT_FILE_PAGES = 40
+REPORT_PAGES = 80
+REPORT_PAGE_TEXT = 20000
+#: Words of one page read by OCR with a confidence under the reader's floor, listed at most.
+REPORT_UNSURE = 200
+#: The kinds of file a student hands in as a report (``other``: not read, said in its note).
+REPORT_KINDS = ('pdf', 'odt', 'docx', 'doc', 'rtf', 'image', 'other')
+#: The version of report.json (it is kept in OUT and read again by make rescore).
+REPORT_VERSION = 1
+_REPORT_TEXT = Text(REPORT_PAGE_TEXT)
+#: A file of OUT/<student>/report/ as the record names it: one name, no folder.
+_REPORT_NAME = re.compile(r'^[A-Za-z0-9][A-Za-z0-9._ -]{0,199}$')
+
+
+class ReportRecord(Record):
+    """A student's report as read in a box (:mod:`exam_lab.grader.boxed.report_reader`,
+    ``report.json``; root reads it back with :func:`exam_lab.grader.host.reports.read_report` and keeps
+    it as ``OUT/<student>/report.json``; make rescore reads the kept one again, never the box).
+
+    ``state`` "read" when at least one page of one file was read, else "not read" with ``why`` (one
+    sentence: "no report handed in", "report.pdf: an encrypted PDF"...): a report not read is never
+    zero points, it is the teacher's to read. ``files``: each file handed in as a report, ``{name``
+    (as handed in, cleaned), ``kind``, ``converted`` (made a PDF by LibreOffice in the box), ``pages``
+    (read), ``note`` (why not read, or what was left out), ``state``, ``copy`` (the file as handed in,
+    relative to OUT/<student>/, or None when it was not kept)``}``. ``pages``: each page read, ``{file``
+    (index into files), ``number`` (1-based), ``source`` ("text": the PDF's text layer; "ocr": the page
+    had none and was read from its image), ``text`` (in reading order; on a text page the OCR of its
+    pictures, a terminal's screenshot, is put where the picture stands, between lines ``[picture N,
+    OCR]`` and ``[end of picture N]``), ``layout`` (``pdftotext -layout`` of the page, columns kept, for
+    tables; "" for an OCR page), ``confidence`` (the OCR's mean word confidence 0-100 of what was read
+    by OCR on the page, None when nothing was), ``unsure`` (OCR words under the confidence floor),
+    ``pictures`` (how many pictures were read by OCR on a text page), ``image`` (the page's PNG relative
+    to OUT/<student>/, ``report/page-<file>-<number>.png``, None when not rendered)``}``. ``seconds``:
+    how long the reading took, box included."""
+    FILE = 'report.json'
+    MAX_BYTES = 8 << 20
+    CLEAN = ('why', 'files', 'pages', 'notes')
+    SCHEMA = {
+        'version': OneOf(REPORT_VERSION),
+        'state': OneOf('read', 'not read'),
+        'why': Text(),
+        'files': Items({'name': Text(255), 'kind': OneOf(*REPORT_KINDS), 'converted': bool,
+                        'pages': Number(0, REPORT_FILE_PAGES, integer=True), 'note': Text(),
+                        'state': OneOf('read', 'not read'), 'copy': Maybe(Text(255))}, REPORT_FILES),
+        'pages': Items({'file': Number(0, REPORT_FILES - 1, integer=True),
+                        'number': Number(1, 1e6, integer=True), 'source': OneOf('text', 'ocr'),
+                        'text': _REPORT_TEXT, 'layout': _REPORT_TEXT,
+                        'confidence': Maybe(Number(0, 100)), 'unsure': Items(Text(100), REPORT_UNSURE),
+                        'pictures': Number(0, 1000, integer=True), 'image': Maybe(Text(255))}, REPORT_PAGES),
+        'notes': [str],
+        'seconds': Number(0, 1e6),
+    }
+
+    def validate(self):
+        if (self.state == 'read') != bool(self.pages):
+            raise RecordError('report.json: state %s with %d page(s) read' % (self.state, len(self.pages)))
+        if (self.state == 'read') == bool(self.why):
+            raise RecordError('report.json: state %s %s a why' % (self.state, 'with' if self.why else 'without'))
+        for index, page in enumerate(self.pages):
+            if page['file'] >= len(self.files):
+                raise RecordError('report.json.pages[%d].file: %d of %d file(s)' % (index, page['file'], len(self.files)))
+        for where, path in [('files[%d].copy' % i, f['copy']) for i, f in enumerate(self.files)] + \
+                [('pages[%d].image' % i, p['image']) for i, p in enumerate(self.pages)]:
+            if path is not None and not (path.startswith('report/') and _REPORT_NAME.match(path[len('report/'):])):
+                raise RecordError('report.json.%s: %s is not a file of report/' % (where, shown(path)))
+
+    @classmethod
+    def not_read(cls, why, files=(), notes=(), seconds=0.0):
+        """The record of a report that was not read, and why (one sentence)."""
+        return cls.make({'version': REPORT_VERSION, 'state': 'not read', 'why': why, 'files': list(files),
+                         'pages': [], 'notes': list(notes), 'seconds': seconds})
+
+    @classmethod
+    def kept(cls, folder):
+        """The report.json kept in a student's ``folder`` of OUT, read as a box's record is (capped,
+        checked): what make rescore and the proposals read, never the box again. A file missing or
+        refused is a report "not read" saying so (the student's report is then the teacher's to read)."""
+        path = os.path.join(folder, cls.FILE)
+        if not os.path.isfile(path):
+            return cls.not_read('no report.json kept (graded before reports were read: make grade again)')
+        try:
+            return cls.read(path)
+        except RecordError as err:
+            return cls.not_read('the kept report.json is not a record of the grader: %s' % err)

@@ -1,0 +1,105 @@
+#!/usr/bin/env python3
+"""How long a student's report takes to read, in its real box (issue 47 point 8): the grader's stage's
+report part (reader47's piece of make bench, beside grader_bench.py).
+
+    python3 lab/bench/report_bench.py [--repeat 5] [--out DIR] [--record]
+
+(from the repository, after ``make build`` and ``source tools/env.sh``). Each text-layer report of
+lab/test/unit/data/reports (LibreOffice's PDFs, one a .docx converted in the box) and a 10-page scan
+(the French report's pages, made an image-only PDF as make_reports.py makes its scan) are read
+``--repeat`` times by :func:`exam_lab.grader.host.reports.read_report`, box included; the median and
+the worst of each kind, against the goals (a text report under 5 s, a 10-page scan under 30 s on two
+cores), and what a class of 60 adds at the default JOBS. Prints a Markdown section and writes
+``reports_results.json`` in --out; ``--record`` also writes the section to lab/bench/reports.md.
+"""
+import argparse
+import datetime
+import json
+import os
+import shutil
+import statistics
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.realpath(__file__))
+DATA = os.path.join(HERE, '..', 'test', 'unit', 'data', 'reports')
+sys.path.insert(0, os.path.join(HERE, '..', 'test', 'reports'))
+
+from exam_lab.grader import class_run  # noqa: E402
+from exam_lab.grader.host import reports  # noqa: E402
+import make_reports  # noqa: E402
+
+TEXT = ('fr_odt.pdf', 'en_docx_table.pdf', 'en_docx_table.docx')
+GOALS = {'text': 5.0, 'scan': 30.0}
+CLASS = 60
+
+
+def measure(path, scratch, repeat):
+    """The seconds of each reading of the report ``path`` (a student's folder holding it)."""
+    seconds = []
+    for n in range(repeat):
+        folder = os.path.join(scratch, 'student%d' % n)
+        os.makedirs(folder)
+        shutil.copyfile(path, os.path.join(folder, os.path.basename(path)))
+        record = reports.read_report(folder, os.path.join(scratch, 'out%d' % n))
+        if record.state != 'read':
+            raise SystemExit('report_bench: %s not read: %s' % (path, record.why))
+        seconds.append(record.seconds)
+        shutil.rmtree(folder)
+        reports.remove_read_only(os.path.join(scratch, 'out%d' % n))
+    return seconds
+
+
+def section(results):
+    jobs = class_run.default_jobs()
+    lines = ['### Reading the reports', '',
+             'Each report read in its own box (`host/reports.read_report`: staged, boxed, read, copied back), '
+             '%d times, on %s (%d cores; `lab/bench/report_bench.py`, %s).' % (
+                 results['repeat'], results['host'], results['cores'], results['date']), '',
+             '| report | pages | median s | worst s | goal |', '|---|---|---|---|---|']
+    for name, row in results['reports'].items():
+        lines.append('| %s | %d | %.1f | %.1f | under %.0f s%s |' % (
+            name, row['pages'], statistics.median(row['seconds']), max(row['seconds']), GOALS[row['kind']],
+            '' if max(row['seconds']) < GOALS[row['kind']] else ' (**missed**)'))
+    text = [s for row in results['reports'].values() if row['kind'] == 'text' for s in row['seconds']]
+    lines += ['', 'Text reports: median %.1f s, worst %.1f s. A class of %d with a text report each adds about '
+              '%.0f s to its grading at the default JOBS=%d (the reports are read side by side as the students '
+              'are graded: %d x median / JOBS).' % (statistics.median(text), max(text), CLASS,
+                                                     CLASS * statistics.median(text) / jobs, jobs, CLASS), '']
+    return '\n'.join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--repeat', type=int, default=5)
+    parser.add_argument('--out', default=None)
+    parser.add_argument('--record', action='store_true')
+    args = parser.parse_args(argv)
+    out = args.out or tempfile.mkdtemp(prefix='report-bench-')
+    os.makedirs(out, exist_ok=True)
+    scratch = tempfile.mkdtemp(prefix='report-bench-scratch-')
+    try:
+        scan = os.path.join(scratch, 'scan_10_pages.pdf')
+        make_reports.scan(os.path.join(DATA, 'fr_odt.pdf'), scan, pages=range(10))
+        results = {'repeat': args.repeat, 'host': os.uname()[1], 'cores': os.cpu_count(),
+                   'date': datetime.datetime.utcnow().strftime('%Y-%m-%d %H:%M UTC'), 'reports': {}}
+        for name, path, kind, pages in [(n, os.path.join(DATA, n), 'text', 2) for n in TEXT] + \
+                [('scan, 10 pages', scan, 'scan', 10)]:
+            work = os.path.join(scratch, kind + str(len(results['reports'])))
+            os.makedirs(work)
+            results['reports'][name] = {'kind': kind, 'pages': pages, 'seconds': measure(path, work, args.repeat)}
+            print('report_bench: %s: %s s' % (name, results['reports'][name]['seconds']), flush=True)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    with open(os.path.join(out, 'reports_results.json'), 'w') as f:
+        json.dump(results, f, indent=1)
+    text = section(results)
+    print(text)
+    if args.record:
+        with open(os.path.join(HERE, 'reports.md'), 'w') as f:
+            f.write(text)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

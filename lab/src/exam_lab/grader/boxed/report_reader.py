@@ -1,0 +1,412 @@
+"""Read a student's report, as its box's uid: every page's text, from the PDF's text layer or by OCR.
+
+Root starts it in a box of its own (:func:`exam_lab.grader.host.reports.read_report`), without network,
+within :data:`~exam_lab.grader.host.reports.REPORT_BOUNDS`::
+
+    python3 -m exam_lab.grader.boxed.report_reader --upload U --out /box/out [--seconds S]
+
+and reads back ``/box/out/report.json``, one :class:`~exam_lab.grader.score.records.ReportRecord`, and
+the files it names in ``/box/out/report/``. What it reads:
+
+- **The files.** Every report the student handed in: the files of the Moodle folder (a PDF, an ``.odt``
+  or ``.docx``, a ``.doc`` or ``.rtf``, a picture) and the documents inside its archives (the package's
+  zip often holds the PDF), each archive unpacked by :func:`~exam_lab.grader.boxed.archives.safe_extract`
+  within one budget. A file's kind is read from its bytes, not its name; the same bytes twice are read
+  once. A word processor's file is made a PDF by LibreOffice headless, here, its profile in the box's
+  /tmp.
+- **Each page** (poppler's command-line tools, each bounded in time and memory): the text layer
+  (``pdftotext -bbox-layout``: the words, their lines and where they stand; ``pdftotext -layout`` for
+  the columns of a table). A page without text is rendered (``pdftoppm``, its longest side bounded
+  whatever the page's size) and read by tesseract (French and English), every word with its
+  confidence. A page with text and pictures (a terminal pasted as a screenshot) has the pictures read
+  by OCR too, where they stand: the ink the text layer does not explain is found on the page's image,
+  and each such region read from the picture of its shape as the PDF holds it (``pdfimages``: a
+  screenshot at its own pixels), else cut out of the page (the text layer's words painted out).
+  Light-on-dark pictures (a terminal) are grayscaled, inverted, enlarged twice and stretched first, so
+  ``/pressure_remote``, underscores and ``0.778`` read as printed (a threshold loses the underscores).
+- **Not read** (that file, or the whole report when no file was): an encrypted PDF, a broken one, one
+  of more than :data:`~exam_lab.grader.score.records.REPORT_FILE_PAGES` pages or whose pages are huge,
+  a tool killed by its bounds (a decompression bomb), a file of no kind the reader knows, a file with
+  neither text nor picture. Each said in one sentence.
+
+No rospy, nothing of root's. Not PyMuPDF (AGPL): poppler, tesseract and PIL only.
+"""
+import argparse
+import concurrent.futures
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+from exam_lab.grader.boxed import archives, bounds
+from exam_lab.grader.boxed.report_files import FILE_BYTES, find_reports, kind_of, copy_name
+from exam_lab.grader.boxed.report_text import ToolFailed, matching_picture, merge_pictures, ocr_facts, \
+    parse_bbox, parse_tsv, join_underscores, records_clean, words_text
+from exam_lab.grader.score import records
+from exam_lab.grader.score.records import REPORT_FILE_PAGES, REPORT_PAGE_TEXT, REPORT_PAGES, REPORT_VERSION, \
+    ReportRecord
+
+#: The reading's own time (the box's wall clock is a little more): pages past it are said, not read.
+SECONDS = 120.0
+#: A page larger than this (points, either side: 200 inches) is not rendered.
+MAX_PAGE_POINTS = 14400
+#: Pixels of the longest side: a page's PNG for the review page; a page rendered for OCR (about 300 dpi
+#: on A4, 215 dpi: tesseract reads it as well as at 300 and a third faster); a picture handed in (larger ones are not read).
+PREVIEW_PIXELS = 1400
+OCR_PIXELS = 2500
+MAX_PICTURE_PIXELS = 40 * 1000 * 1000
+#: A page whose text layer holds fewer letters and digits than this is read by OCR.
+MIN_TEXT = 20
+#: Each tool's bounds inside the box: (wall clock s, address space bytes).
+TOOL_BOUNDS = {'pdfinfo': (20, 1 << 30), 'pdftotext': (60, 1 << 30), 'pdfimages': (20, 1 << 30),
+               'pdftoppm': (60, 1536 << 20), 'tesseract': (60, 1536 << 20), 'soffice': (90, 3 << 30)}
+#: A picture of a text page is read when it covers at least this (inches, both sides) and this share
+#: of its cells holds ink.
+MIN_PICTURE_INCHES = (0.8, 0.25)
+MIN_PICTURE_INK = 0.2
+_CELL = 8  # pixels of the page's PNG per cell of the ink grid
+
+
+class Tools(object):
+    """The reading's folders (``out/report/``: the copies and the pages' PNGs; ``out/scratch/``:
+    conversions and renderings), its time (``seconds``) and its tools, each run within its bounds."""
+
+    def __init__(self, out, seconds=SECONDS, workers=None):
+        self.out, self.deadline = out, time.monotonic() + seconds
+        self.report = os.path.join(out, 'report')
+        self.scratch = os.path.join(out, 'scratch')
+        for folder in (self.report, self.scratch):
+            os.makedirs(folder, exist_ok=True)
+        self.workers = workers or max(1, min(2, len(os.sched_getaffinity(0)) if hasattr(os, 'sched_getaffinity') else 2))
+        self.notes = []
+
+    def left(self):
+        return self.deadline - time.monotonic()
+
+    def tool(self, name, args, output=None, what=None):
+        """Run the tool ``name`` with ``args`` within its bounds and the reading's time; its stdout into
+        the file ``output`` (or returned, decoded, when None: at most 16 MB). Raises ToolFailed."""
+        wall, memory = TOOL_BOUNDS[name]
+        wall = min(wall, self.left())
+        if wall <= 1:
+            raise ToolFailed('the reader\'s time (%d s) ran out' % SECONDS)
+        argv = ['prlimit', '--as=%d' % memory, '--cpu=%d' % (int(wall) + 1), '--fsize=%d' % (64 << 20), '--',
+                name] + list(args)
+        env = {'PATH': '/usr/bin:/bin', 'HOME': os.environ.get('HOME', '/tmp'), 'OMP_THREAD_LIMIT': '1',
+               'LANG': 'C.UTF-8', 'TMPDIR': self.scratch}
+        sink = open(output, 'wb') if output else subprocess.PIPE
+        try:
+            done = subprocess.run(argv, stdin=subprocess.DEVNULL, stdout=sink, stderr=subprocess.PIPE,
+                                  timeout=wall, env=env)
+        except subprocess.TimeoutExpired:
+            raise ToolFailed('%s took more than %d s' % (what or name, wall))
+        finally:
+            if output:
+                sink.close()
+        if done.returncode != 0:
+            err = done.stderr.decode('utf-8', 'replace').strip().splitlines()
+            last = [line for line in err if 'Warning' not in line and 'javaldx' not in line][-1:] or err[-1:]
+            raise ToolFailed('%s %s%s' % (what or name, 'was killed (its bounds: %d s, %d MB)' % (wall, memory >> 20)
+                                          if done.returncode < 0 or done.returncode > 128 else
+                                          'failed (exit %d)' % done.returncode, ': %s' % last[0][:300] if last else ''))
+        return None if output else done.stdout[:16 << 20].decode('utf-8', 'replace')
+
+
+class Pages(object):
+    """A PDF's pages: its text layer, its pictures, its pages' PNGs."""
+
+    def read_pdf(self, index, path, count, info):
+        """The pages of one PDF: the text layer, the pages' PNGs, OCR where there is no text."""
+        for number, (w, h) in info['sizes'].items():
+            if number <= count and max(w, h) > MAX_PAGE_POINTS:
+                raise ToolFailed('page %d is %.0f x %.0f inches (at most %d): not read' % (number, w / 72, h / 72,
+                                                                                       MAX_PAGE_POINTS // 72))
+        layout = self.text(path, count, ['-layout'])
+        boxes = self.word_boxes(path, count)
+        pictures = self.pictures(path, count)
+        previews = self.render(index, path, count)
+        pages, ocr = [], []
+        for number in range(1, count + 1):
+            lines = boxes.get(number, [])
+            text = '\n'.join(line['text'] for line in lines)
+            page = {'file': index, 'number': number, 'source': 'text', 'text': text,
+                    'layout': layout[number - 1] if number <= len(layout) else '',
+                    'confidence': None, 'unsure': [], 'pictures': 0, 'image': previews.get(number)}
+            pages.append(page)
+            if len(re.findall(r'\w', text)) < MIN_TEXT:
+                page.update(source='ocr', layout='', text='')
+                ocr.append((page, None))
+            elif pictures.get(number) and page['image']:
+                ocr.append((page, lines))
+        with concurrent.futures.ThreadPoolExecutor(max_workers=self.workers) as pool:
+            for _ in pool.map(lambda job: self.ocr_page(path, info, job[0], job[1], pictures.get(job[0]['number'], ())),
+                              ocr):
+                pass
+        for page in pages:
+            for key in ('text', 'layout'):
+                page[key] = bounds.cut(records_clean(page[key]), REPORT_PAGE_TEXT)
+        return pages
+
+    def text(self, path, count, options):
+        """Each page's text by ``pdftotext options`` (a list of ``count`` texts)."""
+        output = os.path.join(self.scratch, 'text.txt')
+        self.tool('pdftotext', options + ['-enc', 'UTF-8', '-f', '1', '-l', str(count), path, output],
+                  what='pdftotext')
+        with open(output, 'rb') as f:
+            pages = f.read(8 * REPORT_PAGE_TEXT * count).decode('utf-8', 'replace').split('\f')
+        return (pages + [''] * count)[:count]
+
+    def word_boxes(self, path, count):
+        """``{page: [{"text", "top", "bottom", "boxes": [(x0, y0, x1, y1)]}]}`` in points, in reading order:
+        the text layer's lines (``pdftotext -bbox-layout``)."""
+        output = os.path.join(self.scratch, 'bbox.html')
+        self.tool('pdftotext', ['-bbox-layout', '-enc', 'UTF-8', '-f', '1', '-l', str(count), path, output],
+                  what='pdftotext')
+        return parse_bbox(output)
+
+    def pictures(self, path, count):
+        """``{page: [(width, height, file)]}``: the pictures of each page large enough to hold text,
+        extracted at their own resolution (``pdfimages``: a screenshot is read best as it was taken);
+        a page with a picture too large to decode holds none (its page's image is read instead)."""
+        try:
+            listing = self.tool('pdfimages', ['-list', '-f', '1', '-l', str(count), path])
+        except ToolFailed as err:
+            self.notes.append('pictures not listed: %s' % err)
+            return {}
+        found, too_large = {}, set()
+        for line in listing.splitlines()[2:]:
+            fields = line.split()
+            if len(fields) > 4 and fields[0].isdigit() and fields[1].isdigit() and fields[3].isdigit() \
+                    and fields[4].isdigit() and fields[2] == 'image':
+                page, num, w, h = int(fields[0]), int(fields[1]), int(fields[3]), int(fields[4])
+                if w * h > MAX_PICTURE_PIXELS:
+                    too_large.add(page)
+                elif w >= 100 and h >= 30:
+                    found.setdefault(page, []).append((w, h, num))
+        pages = sorted(set(found) - too_large)
+        prefix = os.path.join(self.scratch, 'picture')
+        extracted = {}
+        for page in pages:
+            try:
+                self.tool('pdfimages', ['-png', '-p', '-f', str(page), '-l', str(page), path, prefix],
+                          what='extracting the pictures of page %d' % page)
+            except ToolFailed as err:
+                self.notes.append('page %d: pictures not extracted: %s' % (page, err))
+                continue
+            extracted[page] = [(w, h, os.path.join(self.scratch, 'picture-%03d-%03d.png' % (page, num)))
+                               for w, h, num in found[page]]
+        return {page: [p for p in pictures if os.path.isfile(p[2])] for page, pictures in extracted.items()}
+
+    def render(self, index, path, count):
+        """``{page: "report/page-<file>-<page>.png"}``: each page's PNG, its longest side PREVIEW_PIXELS."""
+        prefix = os.path.join(self.scratch, 'preview%d' % index)
+        try:
+            self.tool('pdftoppm', ['-png', '-scale-to', str(PREVIEW_PIXELS), '-f', '1', '-l', str(count), path, prefix],
+                      what='rendering its pages')
+        except ToolFailed as err:
+            self.notes.append('%s: pages not rendered: %s' % (os.path.basename(path), err))
+        done = {}
+        for name in os.listdir(self.scratch):
+            match = re.match(r'^preview%d-0*(\d+)\.png$' % index, name)
+            if match and int(match.group(1)) <= count:
+                number = int(match.group(1))
+                target = 'page-%d-%d.png' % (index + 1, number)
+                os.rename(os.path.join(self.scratch, name), os.path.join(self.report, target))
+                done[number] = 'report/' + target
+        return done
+
+
+class Ocr(object):
+    """What tesseract reads: a page without text, the pictures of a text page, a picture handed in."""
+
+    def ocr_page(self, path, info, page, lines, pictures=()):
+        """OCR of a page without text (``lines`` None), or of the pictures of a text page, each where it
+        stands (:func:`~exam_lab.grader.boxed.report_images.picture_regions`): read from the picture
+        itself when one of ``pictures`` (:meth:`pictures`) has its shape, else cut out of the page."""
+        from exam_lab.grader.boxed import report_images
+        stem = os.path.join(self.scratch, 'ocr-%d-%d' % (page['file'], page['number']))
+        rendered = []
+
+        def page_image():
+            if not rendered:
+                self.tool('pdftoppm', ['-gray', '-png', '-scale-to', str(OCR_PIXELS), '-f', str(page['number']), '-l',
+                                       str(page['number']), '-singlefile', path, stem],
+                          what='rendering page %d' % page['number'])
+                rendered.append(report_images.open_image(stem + '.png', MAX_PICTURE_PIXELS))
+            return rendered[0]
+        try:
+            w, h = info['sizes'].get(page['number'], (595.0, 842.0))
+            if lines is None:
+                words = self.tesseract(report_images.prepare_page(page_image()), stem, 3)
+                page.update(text=words_text(words), **ocr_facts(words))
+                return
+            boxes = [b for line in lines for b in line['boxes']]
+            regions = report_images.picture_regions(
+                report_images.open_image(os.path.join(self.out, page['image']), MAX_PICTURE_PIXELS), boxes, w,
+                MIN_PICTURE_INCHES, MIN_PICTURE_INK, _CELL)
+            left = list(pictures)
+            blocks, everything = [], []
+            for n, region in enumerate(regions + [None] * len(pictures)):
+                if region is None and not left:
+                    break
+                match = matching_picture(region, left) if region is not None else left[0]
+                if match is not None:
+                    left.remove(match)
+                    image = report_images.prepare_picture(report_images.open_image(match[2], MAX_PICTURE_PIXELS))
+                else:
+                    image = report_images.prepare_picture(report_images.cut_out(
+                        page_image(), region, boxes, page_image().size[0] / w))
+                words = self.tesseract(image, '%s-%d' % (stem, n), 6)
+                if words:
+                    blocks.append((region[1] if region is not None else h, words_text(words)))
+                    everything += words
+            if blocks:
+                page.update(text=merge_pictures(lines, blocks), pictures=len(blocks), **ocr_facts(everything))
+        except (ToolFailed, report_images.PictureError) as err:
+            self.notes.append('page %d of %s: not read by OCR: %s' % (page['number'], os.path.basename(path), err))
+
+    def tesseract(self, image, stem, psm):
+        """The words tesseract reads in the PIL ``image`` (:data:`Word`), underscores it dropped put back."""
+        from exam_lab.grader.boxed import report_images
+        image.save(stem + '-in.png')
+        self.tool('tesseract', [stem + '-in.png', stem, '-l', 'fra+eng', '--psm', str(psm),
+                                '-c', 'preserve_interword_spaces=1', 'tsv'], what='tesseract')
+        with open(stem + '.tsv', 'rb') as f:
+            words = parse_tsv(f.read(4 << 20).decode('utf-8', 'replace'))
+        return join_underscores(words, lambda a, b: report_images.underscore_between(image, a, b))
+
+    def read_picture(self, index, path):
+        """A picture handed in as (part of) the report: one page, read by OCR."""
+        from exam_lab.grader.boxed import report_images
+        try:
+            image = report_images.open_image(path, MAX_PICTURE_PIXELS)
+        except report_images.PictureError as err:
+            raise ToolFailed(str(err))
+        target = 'page-%d-1.png' % (index + 1)
+        report_images.preview(image, PREVIEW_PIXELS).save(os.path.join(self.report, target))
+        words = self.tesseract(report_images.prepare_picture(image), os.path.join(self.scratch, 'picture%d' % index), 6)
+        return dict({'file': index, 'number': 1, 'source': 'ocr', 'text': bounds.cut(records_clean(words_text(words)),
+                                                                                    REPORT_PAGE_TEXT),
+                     'layout': '', 'pictures': 0, 'image': 'report/' + target}, **ocr_facts(words))
+
+
+class Reader(Pages, Ocr, Tools):
+    """One submission's report read into ``out`` within ``seconds``."""
+
+    def read(self, upload):
+        """The record's value of the reports in ``upload``."""
+        files, pages = [], []
+        found = find_reports(upload, self.scratch, self.notes)
+        if not found:
+            return self.value('no report handed in (no PDF, no document, no picture among the files)', files, pages)
+        for index, (name, path) in enumerate(found):
+            entry = {'name': bounds.cut(name, 255), 'kind': kind_of(path), 'converted': False, 'pages': 0, 'note': '',
+                     'state': 'not read', 'copy': None}
+            files.append(entry)
+            try:
+                size = os.path.getsize(path)
+                if size > FILE_BYTES:
+                    raise ToolFailed('%d MB (the reader reads at most %d MB)' % (size >> 20, FILE_BYTES >> 20))
+                entry['copy'] = self.keep(index, name, path)
+                read = self.read_file(index, entry, path, REPORT_PAGES - len(pages))
+            except ToolFailed as err:
+                entry['note'] = bounds.cut('%s: %s' % (archives.shown_name(name), err))
+                continue
+            pages.extend(read)
+            entry['pages'] = len(read)
+            if any(p['text'].strip() for p in read):
+                entry['state'] = 'read'
+            else:
+                entry['note'] = entry['note'] or '%s: no text and no picture the reader can read' % archives.shown_name(name)
+        if any(f['state'] == 'read' for f in files):
+            return self.value('', files, [p for p in pages if files[p['file']]['state'] == 'read'])
+        why = '; '.join(f['note'] for f in files if f['note']) or 'nothing could be read'
+        return self.value(bounds.cut(why), files, [])
+
+    def value(self, why, files, pages):
+        return {'version': REPORT_VERSION, 'state': 'read' if pages else 'not read', 'why': why if not pages else '',
+                'files': files, 'pages': pages, 'notes': self.notes, 'seconds': 0.0}
+
+    def keep(self, index, name, path):
+        """The file as handed in, copied to report/ (root copies it to OUT read-only)."""
+        copy = copy_name(index, name)
+        shutil.copyfile(path, os.path.join(self.report, copy))
+        return 'report/' + copy
+
+    def read_file(self, index, entry, path, room):
+        kind = entry['kind']
+        if kind in ('odt', 'docx', 'doc', 'rtf'):
+            path = self.convert(index, path)
+            entry['converted'] = True
+        elif kind == 'image':
+            return [self.read_picture(index, path)]
+        elif kind != 'pdf':
+            raise ToolFailed('not a PDF, a document or a picture the reader reads (a report is read from a PDF)')
+        info = self.pdf_info(path)
+        count = info['pages']
+        if count > REPORT_FILE_PAGES:
+            raise ToolFailed('%d pages, the reader reads %d' % (count, REPORT_FILE_PAGES))
+        if count > room:
+            self.notes.append('%s: pages %d-%d not read (the report\'s %d pages are read at most)'
+                              % (archives.shown_name(entry['name']), room + 1, count, REPORT_PAGES))
+            count = room
+        return self.read_pdf(index, path, count, info)
+
+    def convert(self, index, path):
+        """``path`` made a PDF by LibreOffice headless (its profile in the box's /tmp)."""
+        target = os.path.join(self.scratch, 'converted%d' % index)
+        os.makedirs(target)
+        source = os.path.join(target, 'report%s' % {'odt': '.odt', 'docx': '.docx', 'doc': '.doc', 'rtf': '.rtf'}
+                              [kind_of(path)])
+        shutil.copyfile(path, source)
+        self.tool('soffice', ['--headless', '--norestore', '--nolockcheck',
+                              '-env:UserInstallation=file://%s/lo-profile' % self.scratch,
+                              '--convert-to', 'pdf', '--outdir', target, source], what='LibreOffice\'s conversion to PDF')
+        pdf = os.path.join(target, 'report.pdf')
+        if not os.path.isfile(pdf):
+            raise ToolFailed('LibreOffice made no PDF of it')
+        return pdf
+
+    def pdf_info(self, path):
+        """``{"pages", "sizes": {page: (w, h) points}}``; ToolFailed for an encrypted or broken PDF."""
+        try:
+            text = self.tool('pdfinfo', ['-f', '1', '-l', str(REPORT_FILE_PAGES + 1), path])
+        except ToolFailed as err:
+            if 'password' in str(err).lower():
+                raise ToolFailed('an encrypted PDF (it opens with a password): ask for it without one')
+            raise ToolFailed('a broken PDF (%s)' % err)
+        pages = re.search(r'^Pages:\s+(\d+)', text, re.M)
+        if not pages:
+            raise ToolFailed('a broken PDF (no page count)')
+        sizes = {int(n): (float(w), float(h)) for n, w, h in
+                 re.findall(r'^Page\s+(\d+) size:\s+([\d.]+) x ([\d.]+)', text, re.M)}
+        return {'pages': int(pages.group(1)), 'sizes': sizes}
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--upload', required=True, help='the submission: a folder, or one file')
+    parser.add_argument('--out', required=True)
+    parser.add_argument('--seconds', type=float, default=SECONDS, help='the reading\'s own time')
+    args = parser.parse_args(argv)
+    if os.getuid() == 0:
+        sys.stderr.write('report_reader: refusing to read a student\'s report as root\n')
+        return 2
+    start = time.monotonic()
+    reader = Reader(args.out, args.seconds)
+    value = reader.read(args.upload)
+    value['seconds'] = round(time.monotonic() - start, 2)
+    try:
+        records.write(args.out, ReportRecord, bounds.fit(value, ReportRecord))
+    except records.RecordError as err:
+        sys.stderr.write('report_reader: its record exceeds a bound: %s\n' % err)
+        return 4
+    finally:
+        shutil.rmtree(reader.scratch, ignore_errors=True)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
