@@ -33,10 +33,11 @@ def make(*args, timeout=WINDOW):
 
 
 def writable(path):
-    """The files and folders below ``path`` that anyone may write."""
+    """The files below ``path`` that anyone may write (the copies are read-only files; their folders are
+    the grader's, written again by the next make grade)."""
     found = []
     for top, dirs, files in os.walk(path):
-        for name in [top] + [os.path.join(top, f) for f in files]:
+        for name in [os.path.join(top, f) for f in files]:
             if os.lstat(name).st_mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH):
                 found.append(name)
     return found
