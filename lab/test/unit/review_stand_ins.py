@@ -1,4 +1,4 @@
-"""STAND-INS for the output of reader47 (``OUT/<student>/report.json``, ``report/`` with the PDF and its
+"""Stand-ins for the output of reader47 (``OUT/<student>/report.json``, ``report/`` with the PDF and its
 page images, ``code/``) and of answers47 (``OUT/proposals.csv``, ``OUT/<student>/proposals.json``), written
 by the shapes of /work/wt/REPORT_CONTRACT.md into an OUT that the grader's real code made, so that the
 review page is tested before their work is merged. Once it is, the review's tests read what make grade
@@ -15,6 +15,7 @@ import shutil
 import stat
 
 from exam_lab.grader.publish import grades, hand
+from exam_lab.grader.score.records import ReportRecord
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
 COLUMNS = ['participant', 'student', 'item', 'points', 'max', 'state', 'evidence']
@@ -71,16 +72,18 @@ def write(out, proposals, code=None, report_state=None):
             why = why or 'no report handed in'
             mine = [proposal(item, None, 'not read', evidence='report not read: %s' % why) for item in HAND_ITEMS]
         if why:
-            report = {'version': 1, 'state': 'not read', 'why': why, 'files': [], 'pages': [], 'notes': []}
+            report = ReportRecord.not_read(why)
         else:
             text = _draw_report(folder, [p['passage'] for p in mine if p['passage']])
-            report = {'version': 1, 'state': 'read', 'why': '',
-                      'files': [{'name': 'report.pdf', 'kind': 'pdf', 'converted': False, 'pages': 1, 'note': ''}],
-                      'pages': [{'file': 0, 'number': 1, 'source': 'text', 'text': text, 'layout': '',
-                                 'confidence': None, 'unsure': [], 'image': 'report/page-1.png'}],
-                      'notes': []}
-        with open(os.path.join(folder, 'report.json'), 'w') as f:
-            json.dump(report, f)
+            report = ReportRecord.make({
+                'version': 1, 'state': 'read', 'why': '', 'seconds': 0.5,
+                'files': [{'name': 'report.pdf', 'kind': 'pdf', 'converted': False, 'pages': 1, 'note': '',
+                           'state': 'read', 'copy': 'report/report.pdf'}],
+                'pages': [{'file': 0, 'number': 1, 'source': 'text', 'text': text, 'layout': '', 'pictures': 0,
+                           'confidence': None, 'unsure': [], 'image': 'report/page-1.png'}],
+                'notes': []})
+        with open(os.path.join(folder, ReportRecord.FILE), 'w') as f:
+            json.dump(report.value, f)
         with open(os.path.join(folder, 'proposals.json'), 'w') as f:
             json.dump(mine, f)
         if code and name in code:

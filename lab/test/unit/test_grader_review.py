@@ -15,7 +15,7 @@ import pytest
 import review_stand_ins as stand_ins
 from exam_lab.grader.publish import grades, hand
 from exam_lab.grader.publish.review import decisions, folder, groups, page, server
-from exam_lab.grader.score.records import MEASUREMENTS
+from exam_lab.grader.score.records import MEASUREMENTS, ReportRecord
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
 from test_grader_kept import kept_copy
@@ -199,6 +199,25 @@ def test_a_page_image_must_be_a_png_report_json_names(out):
     students, _ = folder.load(str(out))
     with pytest.raises(folder.Refused):
         folder.page_image([s for s in students if s.name == 'ann'][0], 0)
+
+
+def test_the_report_is_read_through_its_checked_record_as_make_rescore_reads_it(out):
+    """A report.json that is no record of the grader (a state 'read' without a page, a page of a file it
+    does not list) is shown "not read" with why and a note, never its text; a report.json that is a link
+    is not read at all."""
+    record = json.loads((out / 'ann' / 'report.json').read_text())
+    assert folder.report_record(str(out / 'ann'), 'ann', []) == ReportRecord.kept(str(out / 'ann')).value
+    record['pages'][0]['file'] = 3
+    record['pages'][0]['text'] = 'PLANTED TEXT'
+    (out / 'ann' / 'report.json').write_text(json.dumps(record))
+    (out / 'cyd' / 'report.json').unlink()
+    (out / 'cyd' / 'report.json').symlink_to(out / 'bob' / 'report.json')
+    students, notes = folder.load(str(out))
+    ann, cyd = [s for s in students if s.name == 'ann'][0], [s for s in students if s.name == 'cyd'][0]
+    assert ann.report['state'] == 'not read' and ann.report['pages'] == [] and 'pages[0].file' in ann.report['why']
+    assert 'PLANTED' not in json.dumps(ann.report)
+    assert any(n.startswith('ann/report.json: the kept report.json is not a record') for n in notes)
+    assert cyd.report is None
 
 
 def test_fields_of_another_type_are_dropped_with_a_note(out):

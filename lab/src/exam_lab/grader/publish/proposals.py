@@ -14,6 +14,7 @@ proposals.csv has exactly the columns :data:`COLUMNS`, 8 rows a student (:data:`
 cell safe in a spreadsheet (:mod:`~exam_lab.grader.publish.cells`), the evidence on one line.
 """
 import csv
+import io
 import json
 import os
 
@@ -119,4 +120,11 @@ def _num(value):
 def read(path):
     """proposals.csv's rows as dicts (each cell read back as written): what make check and a test read."""
     with open(path, newline='') as f:
-        return [{key: cells.read_cell(value) for key, value in row.items()} for row in csv.DictReader(f)]
+        return rows(f.read())
+
+
+def rows(text):
+    """The rows of proposals.csv's ``text`` as dicts, each cell read back as written (the review page
+    reads the file's bytes itself, never through a link)."""
+    return [{key: cells.read_cell(value) if isinstance(value, str) else value for key, value in row.items()}
+            for row in csv.DictReader(io.StringIO(text, newline=''))]

@@ -8,20 +8,21 @@ is read through a link: :func:`read_inside` opens each component of the path bel
 folder without following one (``O_NOFOLLOW``), so a link planted among the copies of a student's files
 (``code/notes -> /etc``) is never read, and a path with ``..`` is refused before anything is opened.
 
-Stand-ins: until the report reader (``report.json``) and the proposals (``proposals.csv``,
-``proposals.json``) land, their files are read here by the shapes of /work/wt/REPORT_CONTRACT.md, field
-by field; a field of another type is dropped, with a note.
+The report is read as make rescore and the proposals read it, through its record
+(:meth:`~exam_lab.grader.score.records.ReportRecord.kept`: capped, checked against its schema, a record
+that is none said as a report "not read"); proposals.csv through the proposals' own reader
+(:func:`~exam_lab.grader.publish.proposals.rows`), each of its rows and of proposals.json checked field by
+field again (a field of another type is dropped, with a note): the page trusts no file of OUT.
 """
 import collections
-import csv
-import io
 import json
 import os
 import stat
 
 from exam_lab.grader.publish import grades
-from exam_lab.grader.publish import hand
+from exam_lab.grader.publish import hand, proposals as proposals_csv
 from exam_lab.grader.score import safe_text
+from exam_lab.grader.score.records import ReportRecord
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
 PROPOSALS_CSV = 'proposals.csv'
@@ -151,7 +152,7 @@ def _class_proposals(out, notes):
         notes.append('proposals.csv not read: %s' % err)
         return {}
     found = {}
-    for number, row in enumerate(csv.DictReader(io.StringIO(text)), start=2):
+    for number, row in enumerate(proposals_csv.rows(text), start=2):
         where = 'proposals.csv line %d' % number
         participant = (row.get('participant') or '').strip()
         who = int(participant) if participant.isdigit() else (row.get('student') or '').strip()
@@ -178,35 +179,21 @@ def _student_proposals(folder, name, notes):
 
 
 def report_record(folder, name, notes):
-    """The student's report.json as the page shows it (None when there is none): ``state``, ``why``,
-    ``files`` (names, kinds, pages), ``pages`` (file, number, source, confidence, unsure, text, image)."""
+    """The student's report.json as the page shows it (None when there is none): its
+    :class:`~exam_lab.grader.score.records.ReportRecord`'s value, read as make rescore reads it; a
+    record that is none is a report "not read" saying why, with a note. Only a page image below
+    ``report/`` that is a PNG is shown."""
     try:
-        raw = json.loads(read_inside(folder, REPORT_JSON, RECORD_CAP).decode('utf-8'))
+        read_inside(folder, REPORT_JSON, RECORD_CAP)  # no link, no folder, under the cap
     except Refused:
         return None
-    except ValueError as err:
-        notes.append('%s/%s is no JSON (%s)' % (name, REPORT_JSON, err))
-        return None
-    if not isinstance(raw, dict):
-        return None
-    files = [{'name': _text(f.get('name'), 300), 'kind': _text(f.get('kind'), 20),
-              'converted': f.get('converted') is True, 'pages': _number(f.get('pages')),
-              'note': _text(f.get('note'), 500)}
-             for f in (raw.get('files') if isinstance(raw.get('files'), list) else []) if isinstance(f, dict)]
-    pages = []
-    for page in raw.get('pages') if isinstance(raw.get('pages'), list) else []:
-        if not isinstance(page, dict):
-            continue
-        image = page.get('image')
-        pages.append({'file': int(_number(page.get('file')) or 0), 'number': int(_number(page.get('number')) or 0),
-                      'source': _text(page.get('source'), 10), 'text': _text(page.get('text'), PAGE_TEXT_CAP),
-                      'confidence': _number(page.get('confidence')),
-                      'unsure': [_text(w, 80) for w in (page.get('unsure') or [])[:50]]
-                      if isinstance(page.get('unsure'), list) else [],
-                      'image': image if isinstance(image, str) and image.lower().endswith('.png') else None})
-    return {'state': _text(raw.get('state'), 20), 'why': _text(raw.get('why'), 500), 'files': files[:20],
-            'pages': pages[:200], 'notes': [_text(n, 500) for n in (raw.get('notes') or [])[:20]]
-            if isinstance(raw.get('notes'), list) else []}
+    record = ReportRecord.kept(folder).value
+    if record['state'] == 'not read' and record['why'].startswith('the kept report.json is not'):
+        notes.append('%s/%s: %s' % (name, REPORT_JSON, record['why']))
+    for page in record['pages']:
+        if not (page['image'] or '').lower().endswith('.png'):
+            page['image'] = None
+    return record
 
 
 def page_image(student, index):
