@@ -29,31 +29,24 @@ import os
 import random
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), 'src'))
+from exam_lab.harness.supervisor import free_port  # noqa: E402 (the lab's harness, from its source)
+from exam_lab.harness.wait import wait_until  # noqa: E402
+
 DEFAULT_OUT = os.path.join(os.path.dirname(HERE), 'unit', 'data', 'reports')
 PROMPT = '\033[1;32mstudent@vm\033[0m:\033[1;34m~/catkin_ws\033[0m$ '
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(('127.0.0.1', 0))
-        return s.getsockname()[1]
-
-
 def wait_for(check, timeout, what):
-    """Poll ``check`` until it holds (an event the tools give no other way to wait for)."""
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if check():
-            return
-        time.sleep(0.2)
-    raise RuntimeError('timed out waiting for %s' % what)
+    """Wait until ``check`` holds (the harness's wait: an event the tools give no other way to wait for)."""
+    if wait_until(check, timeout, period=0.2) is None:
+        raise RuntimeError('timed out waiting for %s' % what)
 
 
 class Ros(object):
