@@ -15,7 +15,7 @@ import subprocess
 
 import pytest
 
-REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), '..', '..', '..'))
+REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..', '..'))
 DOCS = [os.path.join(REPO, 'README.md')] + sorted(glob.glob(os.path.join(REPO, 'docs', '*.md')))
 SHELL = ('sh', 'bash', 'shell')
 _FENCE = re.compile(r'^(?P<indent>[ >]*)```(?P<lang>[\w-]*)\s*$')

@@ -121,8 +121,15 @@ def detached_children():
     return [pid for pid in found if pid != os.getpid()]
 
 
+#: The folders of a student's OUT that hold its own bytes as handed in, kept read-only for the teacher
+#: (host/reports.py): its source's text is data there, never a sign that its code ran.
+KEPT_AS_HANDED_IN = ('code', 'report')
+
+
 def files_under(folder):
-    for dirpath, _, filenames in os.walk(folder):
+    for dirpath, dirnames, filenames in os.walk(folder):
+        if folder.rstrip('/') in (dirpath, os.path.dirname(dirpath)):
+            dirnames[:] = [d for d in dirnames if d not in KEPT_AS_HANDED_IN]
         for name in filenames:
             path = os.path.join(dirpath, name)
             if os.path.isfile(path) and not os.path.islink(path):
