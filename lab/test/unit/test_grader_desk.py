@@ -348,21 +348,23 @@ def crafted_pdf(path, size=4 << 20):
 
 
 def test_pdf_pages_in_linear_time(tmp_path):
-    """A crafted report of a few MB is read in well under a second (a backtracking regular expression
-    took 76 s on 325 KB, hours on 5 MB). In a child process, so that a regression fails, never hangs."""
+    """A crafted report of a few MB is read in linear time (a backtracking regular expression took 76 s on
+    325 KB, hours on 5 MB; the linear reader takes about 0.1 s). The bound is on the child's CPU time, 20
+    times the linear reader's, which a busy machine does not stretch; in a child process, so that a
+    regression fails, never hangs."""
     import subprocess
     import sys
     path = str(tmp_path / 'crafted.pdf')
     crafted_pdf(path)
     assert os.path.getsize(path) > 3 << 20
-    code = ('import sys, time\nfrom exam_lab.grader.boxed import documents\nstarted = time.monotonic()\n'
-            'pages = documents.pdf_pages(sys.argv[1])\nprint(pages, time.monotonic() - started)\n')
+    code = ('import sys, time\nfrom exam_lab.grader.boxed import documents\nstarted = time.process_time()\n'
+            'pages = documents.pdf_pages(sys.argv[1])\nprint(pages, time.process_time() - started)\n')
     try:
-        out = subprocess.run([sys.executable, '-c', code, path], stdout=subprocess.PIPE, timeout=60, check=True)
+        out = subprocess.run([sys.executable, '-c', code, path], stdout=subprocess.PIPE, timeout=120, check=True)
     except subprocess.TimeoutExpired:
-        pytest.fail('pdf_pages took over 60 s on a 4 MB PDF')
+        pytest.fail('pdf_pages took over 120 s on a 4 MB PDF')
     pages, seconds = out.stdout.decode().split()
-    assert pages == '7' and float(seconds) < 0.5, out.stdout
+    assert pages == '7' and float(seconds) < 2.0, out.stdout
 
 
 def test_the_default_out_is_pasted_as_it_is():
