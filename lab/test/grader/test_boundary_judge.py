@@ -76,7 +76,9 @@ def test_the_classmate_of_a_burner_keeps_its_points_and_its_timing(judged_class)
     record = judged_class['records'][VICTIM_NAME]
     assert {i['id']: i['points'] for i in record['items']} == FULL, evidence(record)
     main = json.loads(logs_of(judged_class, VICTIM_NAME, 'probe-main.json'))
-    assert main['node_seen_s'] is not None and main['node_seen_s'] < runner.START_TIMEOUT, main['node_seen_s']
+    # The node's start counts from roslaunch's (its /roslaunch/uris/ parameter on the master), never before.
+    assert main['launch_seen_s'] is not None and main['node_seen_s'] is not None, main
+    assert main['launch_seen_s'] <= main['node_seen_s'] < main['launch_seen_s'] + runner.START_TIMEOUT, main
 
 
 def test_a_node_on_a_clock_of_its_own_is_refused(judged_class):

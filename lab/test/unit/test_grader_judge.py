@@ -159,3 +159,53 @@ def test_a_node_that_subscribes_to_each_input_in_turn_subscribes_to_both(monkeyp
     plan = types.SimpleNamespace(start_timeout=1.0)
     found = node.NodeFinder(plan, Graph(), None, drone, 0.0).wait_for_node()
     assert found['subscribed'] == {'/temperature': ['/exam'], '/pressure': ['/exam']}
+
+
+def test_the_nodes_start_counts_from_roslaunchs(monkeypatch):
+    """Issue 45: a loaded machine's roslaunch took 25 s to come up, and its node was counted as not
+    starting within START_TIMEOUT of the probe's start. The node's time counts from roslaunch's
+    parameter on the master (``launch_seen_s``); a roslaunch that never comes up ends the wait after
+    LAUNCH_START_S. Results only: every wait here ends on its deadline or its event, whatever the load."""
+    pytest.importorskip('rospy')
+    import time
+    import types
+    from exam_lab.grader.judge import node
+    monkeypatch.setattr(node, 'LAUNCH_START_S', 0.5)
+    monkeypatch.setattr(node.NodeFinder, 'input_types', lambda self, inputs, timeout=3.0: {})
+    monkeypatch.setattr(node, 'SUBSCRIBE_S', 0.1)
+    drone = types.SimpleNamespace(fixed_topic='temperature', moving_topic='pressure')
+
+    class Graph(object):
+        """roslaunch up after ``launch_after`` polls (None: never), the node ``node_after`` polls later."""
+
+        def __init__(self, launch_after, node_after):
+            self.polls, self.launched_at, self.launch_after, self.node_after = 0, None, launch_after, node_after
+
+        def launch_started(self):
+            if self.launch_after is not None and self.polls >= self.launch_after and self.launched_at is None:
+                self.launched_at = self.polls
+            return self.launched_at is not None
+
+        def student_nodes(self):
+            self.polls += 1
+            up = self.launched_at is not None and self.node_after is not None and \
+                self.polls >= self.launched_at + self.node_after
+            return ['/exam'] if up else []
+
+        def subscribers(self, topic):
+            return ['/exam']
+
+    def found(graph, start_timeout):
+        return node.NodeFinder(types.SimpleNamespace(start_timeout=start_timeout), graph, None, drone,
+                               time.time()).wait_for_node()
+
+    # roslaunch comes up after a few polls, its node 10 polls later: found, its time after roslaunch's
+    late = found(Graph(launch_after=3, node_after=10), start_timeout=30.0)
+    assert late['nodes'] == ['/exam'] and late['launch_seen_s'] is not None
+    assert late['node_seen_s'] >= late['launch_seen_s']
+    # roslaunch up, its node never registers: the wait ends start_timeout after roslaunch came up
+    never = found(Graph(launch_after=2, node_after=None), start_timeout=0.3)
+    assert never['nodes'] == [] and never['launch_seen_s'] is not None and never['node_seen_s'] is None
+    # roslaunch never comes up (a launch file it refuses): the wait ends after LAUNCH_START_S
+    refused = found(Graph(launch_after=None, node_after=None), start_timeout=30.0)
+    assert refused['nodes'] == [] and refused['launch_seen_s'] is None

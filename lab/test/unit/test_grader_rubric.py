@@ -188,6 +188,38 @@ def test_threshold_run_flown_as_the_main_run():
     assert rubric.threshold_run_value(STATIC, measured(threshold_run=False)) is None
 
 
+def test_a_threshold_run_whose_node_never_came_is_a_doubt_never_a_second_loss():
+    """Issue 45: the same package and code as the main run, only the threshold changed, and its node never
+    registered (no death seen): the machine's doing as far as the grader can tell (a start under heavy
+    load). Q14a is judged from the code (0.5 for reading it), the runs item keeps both points, the status
+    asks for a hand grade and the doubt says why. A node that died in that run is still its own loss."""
+    session = measured(threshold_shape='main')
+    session['runs'][1]['probe'].update(nodes=[], launch_seen_s=4.2, start_timeout=20.0, schedule={}, calls=[])
+    assert lost(session) == {'Q14a': 0.5}
+    items = rubric.score('altitude', STATIC, session)
+    assert 'no node of the package registered with the master within 20 s of roslaunch\'s start' in \
+        _item(items, 'Q14a')['evidence'], _item(items, 'Q14a')
+    assert 'judged from the code' in _item(items, 'Q14a')['evidence']
+    assert 'in the threshold run its node never came' in _item(items, 'runs')['evidence']
+    status, reason = rubric.status(STATIC, session)
+    assert status == rubric.HAND_GRADE and 'in the threshold run no node of the package registered' in reason, reason
+    assert [d for d in rubric.doubts(STATIC, session) if 'while the main run\'s node did' in d]
+    session['runs'][1]['probe']['launch_seen_s'] = None
+    assert 'roslaunch never came up on the master' in rubric.status(STATIC, session)[1]
+    # Its node died in that run: the package's doing, judged as before (the runs item and Q14a lose).
+    died = measured(threshold_shape='main')
+    died['runs'][1]['probe'].update(nodes=[], schedule={}, calls=[])
+    died['runs'][1]['launch']['ended'] = [{'node': 'exam-1', 'how': 'died', 'detail': 'exit code 1'}]
+    assert set(lost(died)) == {'runs', 'Q14a'}
+    assert not [d for d in rubric.doubts(STATIC, died) if 'while the main run\'s node did' in d]
+    # The main run's node never came: nothing to compare with, no such doubt (the node does not start).
+    never = measured(threshold_shape='main')
+    for run in never['runs']:
+        run['probe'].update(nodes=[], schedule={}, calls=[])
+    assert rubric.status(STATIC, never)[0] == rubric.HAND_GRADE
+    assert not [d for d in rubric.doubts(STATIC, never) if 'while the main run\'s node did' in d]
+
+
 def test_a_threshold_given_as_an_argument():
     """Issue 35 point 4: args="--threshold 1300" read with argparse on rospy.myargv(), or by index."""
     static = dict(STATIC, threshold={'name': '--threshold', 'value': 1300, 'how': 'args'}, params_in_code=[],

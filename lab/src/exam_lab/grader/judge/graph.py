@@ -119,6 +119,16 @@ class Graph(object):
                     nodes[name]['services'].append(service)
         return nodes
 
+    def launch_started(self):
+        """Whether roslaunch is up on this master: it sets ``/roslaunch/uris/<host>__<port>`` once its
+        own server runs, right before it sets the launch file's parameters and starts the nodes
+        (roslaunch/launch.py, ``_launch_master``). Each run has a master of its own, so the parameter is
+        this run's roslaunch's."""
+        try:
+            return any(name.startswith('/roslaunch/uris/') for name in self._master.getParamNames())
+        except Exception:  # the master answers; a failure is a transient of the XML-RPC call
+            return False
+
     def publishers(self, topic):
         """Every node that publishes ``topic``, this probe included."""
         return sorted(dict(self._state()[0]).get(topic, []))

@@ -11,6 +11,10 @@ from std_msgs import msg as std_msgs
 from exam_lab.harness.fake_drone import TopicRecorder
 from exam_lab.harness.wait import wait_until
 
+#: Seconds to wait for roslaunch to come up on the master (its ``/roslaunch/uris/`` parameter): the
+#: node's ``start_timeout`` counts from then, so a loaded machine's slow ``roslaunch`` start (bash, its
+#: imports, the launch file read: 25 s seen at a load of 45) is never counted against the node.
+LAUNCH_START_S = 60.0
 #: Seconds to wait for the second input's subscription once the node is up.
 SUBSCRIBE_S = 6.0
 #: Seconds a publisher in the node's type waits for its connection before it is registered anew.
@@ -31,10 +35,23 @@ class NodeFinder(object):
         self.plan, self.graph, self.refusals, self.drone, self.t0 = plan, graph, refusals, drone, t0
 
     def wait_for_node(self):
-        """The probe's result's ``nodes`` (none when no node came within the plan's ``start_timeout``)
-        and ``node_seen_s``; once a node came, also ``subscribed`` and ``input_types``."""
-        nodes = wait_until(lambda: self.graph.student_nodes() or None, self.plan.start_timeout, period=0.1)
-        found = {'nodes': nodes or [], 'node_seen_s': None if not nodes else time.time() - self.t0}
+        """The probe's result's ``nodes`` (none when no node came within the plan's ``start_timeout``
+        of roslaunch's start, or roslaunch never came up within LAUNCH_START_S), ``launch_seen_s`` (when
+        roslaunch came up, None if never) and ``node_seen_s`` (both s from the probe's start); once a node
+        came, also ``subscribed`` and ``input_types``."""
+        launched = []
+
+        def nodes_or_end():
+            """``(nodes,)`` once a node came or the wait is over (``([],)``), else None."""
+            nodes = self.graph.student_nodes()
+            now = time.time()
+            if not nodes and not launched and self.graph.launch_started():
+                launched.append(now)
+            over = now > launched[0] + self.plan.start_timeout if launched else now > self.t0 + LAUNCH_START_S
+            return (nodes,) if nodes or over else None
+        nodes = (wait_until(nodes_or_end, LAUNCH_START_S + self.plan.start_timeout, period=0.1) or ([],))[0]
+        found = {'nodes': nodes or [], 'node_seen_s': None if not nodes else time.time() - self.t0,
+                 'launch_seen_s': launched[0] - self.t0 if launched else None}
         if not nodes:
             return found
         inputs = [rospy.resolve_name(t) for t in (self.drone.fixed_topic, self.drone.moving_topic)]

@@ -86,6 +86,27 @@ def stayed_up(session):
     return not (launch and launch.ended)
 
 
+def no_node_words(probe):
+    """Why a run's probe saw no node: none registered within its ``start_timeout`` of roslaunch's start
+    (the probe's ``launch_seen_s``), or roslaunch never came up on the master."""
+    probe = probe_of(probe)
+    if probe.launch_seen_s is None:
+        return 'roslaunch never came up on the master: no node of the package registered'
+    return ('no node of the package registered with the master within %.0f s of roslaunch\'s start'
+            % otherwise(probe.start_timeout, 0))
+
+
+def unstarted_runs(session):
+    """The runs after the main one whose node never registered, no death of it seen, while the main
+    run's did: the same package and code, only the threshold changed, so the cause is the machine (a
+    start under heavy load), not the student's. A doubt for the teacher, never a point lost."""
+    if not node_ran(session):
+        return []
+    return [run for run in session_of(session).runs or ()
+            if run.tag != 'main' and run.probe is not None and not run.probe.nodes
+            and not (run.launch and run.launch.ended)]
+
+
 def not_run(session):
     """Why an item was not measured: the upload refused, nothing run, no build, or no node."""
     session = session_of(session)

@@ -10,7 +10,8 @@ import itertools
 import math
 
 from exam_lab.grader.score.flight import lag_words, worst_lag
-from exam_lab.grader.score.measured import item, main_probe, node_ran, not_run, otherwise, refused_inputs
+from exam_lab.grader.score.measured import (item, main_probe, no_node_words, node_ran, not_run, otherwise,
+                                            refused_inputs, run_of, unstarted_runs)
 from exam_lab.grader.score.sheets import SHEETS
 from exam_lab.grader.score.tolerances import (NO_COMMENT_LOSS, NUMERIC_TYPES, RATE_HZ, RATE_TOLERANCE,
                                               VALUE_TOLERANCE_M, VALUE_TOLERANCE_REL)
@@ -26,8 +27,10 @@ def score_runs(session):
     if build.status != 0:
         return item('runs', 0, 'catkin_make failed (exit %s) in a workspace of its own next to the '
                     'simulators; its last lines:\n%s' % (build.status, build.tail))
-    problems = []
+    problems, unstarted = [], [r.tag for r in unstarted_runs(session)]
     for run in session.runs or ():
+        if run.tag in unstarted:
+            continue
         probe, launch = run.probe, run.launch
         for line in (launch.not_started if launch else None) or ():
             problems.append('%s run: %s' % (run.tag, line))
@@ -38,8 +41,7 @@ def score_runs(session):
         if probe is None:
             problems.append('%s run: the probe failed: %s' % (run.tag, otherwise(run.probe_error, '?')))
         elif not probe.nodes and not (launch and launch.ended):
-            problems.append('%s run: no node of the package registered with the master within %.0f s'
-                            % (run.tag, otherwise(probe.start_timeout, 0)))
+            problems.append('%s run: %s' % (run.tag, no_node_words(probe)))
     if not session.runs:
         problems.append('the node was not run')
     if problems:
@@ -47,8 +49,10 @@ def score_runs(session):
         return item('runs', 1, 'builds (%.0f s); but: %s%s' % (
             build.seconds, '; '.join(problems), '\nlast lines of its launch:\n%s' % tails[0] if tails else ''))
     seconds = sum(otherwise(r.seconds, 0) for r in session.runs)
-    return item('runs', 2, 'builds (%.0f s); node up in %.1f s and still up after %.0f s of flight in %d run(s)'
-                % (build.seconds, main_probe(session).node_seen_s or 0, seconds, len(session.runs)))
+    return item('runs', 2, 'builds (%.0f s); node up in %.1f s and still up after %.0f s of flight in %d run(s)%s'
+                % (build.seconds, main_probe(session).node_seen_s or 0, seconds, len(session.runs),
+                   ''.join('; in the %s run its node never came (%s) while the main run\'s did: not counted, see the '
+                           'doubt' % (tag, no_node_words(run_of(session, tag).probe)) for tag in unstarted)))
 
 
 def score_q10(sheet, session):

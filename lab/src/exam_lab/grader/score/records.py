@@ -190,7 +190,7 @@ class ProbeRecord(Record):
         'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
         'margin': Number(), 'delay': Number(), 'start_timeout': Number(),
         'input_rates': Map(Text(100), Number(0, 1e6), 10),
-        'nodes': Optional([_NAME]), 'node_seen_s': Optional(Maybe(Number())),
+        'nodes': Optional([_NAME]), 'node_seen_s': Optional(Maybe(Number())), 'launch_seen_s': Optional(Maybe(Number())),
         'subscribed': Optional(Map(_NAME, [_NAME], 10)),
         'input_types': Optional(Map(_NAME, {'type': Maybe(_NAME), 'connected': bool, 'refused': Maybe(Text()),
                                             'adapted': Maybe(_NAME), 'published': Optional(_NAME)}, 10)),

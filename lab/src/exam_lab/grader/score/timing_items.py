@@ -10,7 +10,8 @@ and gives the item's ``{"id", "points", "max", "evidence"}``. The windows are re
 import math
 
 from exam_lab.grader.score import flight
-from exam_lab.grader.score.measured import item, main_probe, node_ran, not_run, otherwise, stayed_up, threshold_probe
+from exam_lab.grader.score.measured import (item, main_probe, no_node_words, node_ran, not_run, otherwise, stayed_up,
+                                            threshold_probe, unstarted_runs)
 from exam_lab.grader.score.sheets import DELAY, REQUESTS, SHEETS
 from exam_lab.grader.score.tolerances import LOOP_REPEATS, NORMAL_LATE_S, WARNING_EARLY_S
 
@@ -118,8 +119,10 @@ def score_q14a(sheet, static, session):
                        'until then), not as the node\'s parameter' % (early[0][0], early[0][1], early[0][0].lstrip('~'))
     probe2 = threshold_probe(session)
     skipped = session.threshold_skipped
-    if probe2 is None:
-        why = skipped or threshold.not_rewritable or 'the threshold run failed'
+    unstarted = [r for r in unstarted_runs(session) if r.tag == 'threshold']
+    if probe2 is None or unstarted:
+        why = ('in the threshold run %s, while the main run\'s node did (a doubt, see the status)'
+               % no_node_words(probe2) if unstarted else skipped or threshold.not_rewritable or 'the threshold run failed')
         return item('Q14a', static_points, '%s = %s in the launch file; its effect could not be observed (%s); '
                     'judged from the code: %s' % (what, threshold.value, why, static_note))
     schedule = probe2.schedule or {}

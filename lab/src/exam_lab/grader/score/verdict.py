@@ -9,8 +9,8 @@ import re
 
 from exam_lab.grader.score.flight import LEG_WORDS, calls, reached, refused_calls, refused_words, schedule_of, \
     silent, unreached_legs
-from exam_lab.grader.score.measured import adapted_inputs, main_probe, node_ran, otherwise, published, \
-    refused_inputs, session_of, static_of, stayed_up
+from exam_lab.grader.score.measured import adapted_inputs, main_probe, no_node_words, node_ran, otherwise, \
+    published, refused_inputs, session_of, static_of, stayed_up, unstarted_runs
 from exam_lab.grader.score.sheets import SHEETS
 
 #: Every student's status: what the teacher must do with the grade.
@@ -127,6 +127,9 @@ def status(static, session, fixes=()):
         crash = crash_summary(tails)
         return HAND_GRADE, _one_line('the node %s%s' % ('died' if published(session) else 'does not start',
                                                           ': %s' % crash if crash else ' (see runs)'))
+    unstarted = unstarted_runs(session)
+    if unstarted:
+        return HAND_GRADE, _one_line(_unstarted_words(unstarted[0]))
     missing = missing_evidence(static, session)
     if missing:
         return HAND_GRADE, _one_line(missing[0])
@@ -182,10 +185,16 @@ def doubts(static, session):
         out.append('roslaunch warns about %s: %s' % (verdict.file, ' | '.join(verdict.warnings)))
     for upload in static.uploads or ():
         out.append('several uploads: %s' % upload.why)
+    out.extend(_unstarted_words(run) for run in unstarted_runs(session))
     for run in session.runs or ():
         if run.probe is None and run.probe_error:
             out.append('%s run: %s' % (run.tag, run.probe_error.splitlines()[0] if run.probe_error else ''))
     return [_one_line(line) for line in out]
+
+
+def _unstarted_words(run):
+    return ('in the %s run %s, while the main run\'s node did with the same code: what that run judges (Q14a '
+            'for the threshold run) was judged from the code; grade again or by hand' % (run.tag, no_node_words(run.probe)))
 
 
 def _one_line(text, limit=300):
