@@ -195,9 +195,9 @@ def test_the_nodes_start_counts_from_roslaunchs(monkeypatch):
         def subscribers(self, topic):
             return ['/exam']
 
-    def found(graph, start_timeout):
+    def found(graph, start_timeout, launch_ended=lambda: False):
         return node.NodeFinder(types.SimpleNamespace(start_timeout=start_timeout), graph, None, drone,
-                               time.time()).wait_for_node()
+                               time.time(), launch_ended).wait_for_node()
 
     # roslaunch comes up after a few polls, its node 10 polls later: found, its time after roslaunch's
     late = found(Graph(launch_after=3, node_after=10), start_timeout=30.0)
@@ -209,3 +209,7 @@ def test_the_nodes_start_counts_from_roslaunchs(monkeypatch):
     # roslaunch never comes up (a launch file it refuses): the wait ends after LAUNCH_START_S
     refused = found(Graph(launch_after=None, node_after=None), start_timeout=30.0)
     assert refused['nodes'] == [] and refused['launch_seen_s'] is None
+    # the session saw roslaunch exit: the wait ends then, not after LAUNCH_START_S (here an hour)
+    monkeypatch.setattr(node, 'LAUNCH_START_S', 3600.0)
+    ended = found(Graph(launch_after=None, node_after=None), start_timeout=3600.0, launch_ended=lambda: True)
+    assert ended['nodes'] == [] and ended['launch_seen_s'] is None

@@ -12,7 +12,7 @@ import time
 
 from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
 from exam_lab.grader.contract import read_capped, read_record
-from exam_lab.grader.score.records import MAX_ENDED, MAX_LOG_TEXT, PlanRecord, ProbeRecord, RecordError
+from exam_lab.grader.score.records import LAUNCH_ENDED, MAX_ENDED, MAX_LOG_TEXT, PlanRecord, ProbeRecord, RecordError
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import ros_env, workspace_env
@@ -233,8 +233,14 @@ def run_one(sup, job, run, base_env, box, budget):
     # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
     # nothing it does when its drone goes away (a failed service call, a crash) is counted.
     limit, by_budget = budget.limit(job.run_timeout, RUN_STOP_S)
-    wait_until(lambda: os.path.isfile(result_path) or probe.poll() is not None or master.proc.poll() is not None,
-               limit, period=0.1)
+
+    def over():
+        """The probe's result, or its end or its master's; roslaunch's exit told to the probe, which then
+        waits no longer for a node that cannot come."""
+        if launch.poll() is not None and not os.path.lexists(result_path + LAUNCH_ENDED):
+            open(result_path + LAUNCH_ENDED, 'w').close()
+        return os.path.isfile(result_path) or probe.poll() is not None or master.proc.poll() is not None
+    wait_until(over, limit, period=0.1)
     record['seconds'] = time.monotonic() - started
     if by_budget and not os.path.isfile(result_path) and probe.poll() is None:
         record['budget'] = budget.spend('the %s run was stopped after %.0f s' % (tag, record['seconds']))

@@ -31,14 +31,16 @@ class NodeFinder(object):
     (``graph``: :class:`~exam_lab.grader.judge.graph.Graph`) and what rospy refused (``refusals``:
     :class:`~exam_lab.grader.judge.graph.RefusedConnections`), while ``drone`` feeds its inputs."""
 
-    def __init__(self, plan, graph, refusals, drone, t0):
+    def __init__(self, plan, graph, refusals, drone, t0, launch_ended=lambda: False):
         self.plan, self.graph, self.refusals, self.drone, self.t0 = plan, graph, refusals, drone, t0
+        #: Whether the session saw roslaunch exit (a launch file it refuses at once): no node will come.
+        self.launch_ended = launch_ended
 
     def wait_for_node(self):
         """The probe's result's ``nodes`` (none when no node came within the plan's ``start_timeout``
-        of roslaunch's start, or roslaunch never came up within LAUNCH_START_S), ``launch_seen_s`` (when
-        roslaunch came up, None if never) and ``node_seen_s`` (both s from the probe's start); once a node
-        came, also ``subscribed`` and ``input_types``."""
+        of roslaunch's start, or roslaunch never came up within LAUNCH_START_S, or ended first),
+        ``launch_seen_s`` (when roslaunch came up, None if never) and ``node_seen_s`` (both s from the
+        probe's start); once a node came, also ``subscribed`` and ``input_types``."""
         launched = []
 
         def nodes_or_end():
@@ -47,7 +49,8 @@ class NodeFinder(object):
             now = time.time()
             if not nodes and not launched and self.graph.launch_started():
                 launched.append(now)
-            over = now > launched[0] + self.plan.start_timeout if launched else now > self.t0 + LAUNCH_START_S
+            over = self.launch_ended() or (now > launched[0] + self.plan.start_timeout if launched
+                                           else now > self.t0 + LAUNCH_START_S)
             return (nodes,) if nodes or over else None
         nodes = (wait_until(nodes_or_end, LAUNCH_START_S + self.plan.start_timeout, period=0.1) or ([],))[0]
         found = {'nodes': nodes or [], 'node_seen_s': None if not nodes else time.time() - self.t0,

@@ -55,7 +55,7 @@ from exam_lab.grader.judge.pilot import Calibration, Flight, Inputs
 from exam_lab.grader.judge.graph import ClockWatch, Graph, NodeWatch, RefusedConnections, node_pid, node_uri
 from exam_lab.grader.judge.legs import AFTER_S, trace
 from exam_lab.grader.judge.node import NodeFinder
-from exam_lab.grader.score.records import PlanRecord, RecordError
+from exam_lab.grader.score.records import LAUNCH_ENDED, PlanRecord, RecordError
 from exam_lab.harness.fake_drone import Drone
 
 
@@ -63,8 +63,8 @@ class Probe(object):
     """One run of the probe: the drone up and the graph watched from its start, then the plan flown
     (:meth:`run`); ``result`` is what it measured."""
 
-    def __init__(self, plan):
-        self.plan = plan
+    def __init__(self, plan, launch_ended=lambda: False):
+        self.plan, self.launch_ended = plan, launch_ended
         self.result = {'kind': plan.kind, 'sheet': plan.sheet, 'threshold': plan.threshold,
                        'margin': plan.margin, 'delay': plan.delay, 'start_timeout': plan.start_timeout}
         self.graph = Graph()
@@ -96,7 +96,7 @@ class Probe(object):
         """The scenario's steps 1 to 4: a step whose node, or whose readable output, is missing ends it."""
         # Inputs from the start: a node that waits for data before it subscribes to the rest still runs.
         self.inputs.fly(self.plan.threshold - self.plan.margin)
-        finder = NodeFinder(self.plan, self.graph, self.refusals, self.drone, self.t0)
+        finder = NodeFinder(self.plan, self.graph, self.refusals, self.drone, self.t0, self.launch_ended)
         found = finder.wait_for_node()
         self.result.update(found)
         if not found['nodes']:
@@ -180,7 +180,7 @@ def main(argv):
         sys.stderr.write('the plan is not one: %s\n' % err)
         return 2
     rospy.init_node('grader_probe', disable_signals=True)
-    probe = Probe(plan)
+    probe = Probe(plan, launch_ended=lambda: os.path.lexists(argv[1] + LAUNCH_ENDED))
     try:
         result = probe.run()
         with open(argv[1] + '.part', 'w') as f:
