@@ -12,7 +12,9 @@
 - **Real documents.** Each report is written as HTML (the screenshots embedded) and converted by
   LibreOffice headless to .odt or .docx, then to PDF, as a student's word processor exports it:
   French, in order, answers as text and screenshots (``fr_odt``); English, the sheet 001's answers in
-  a table, out of order, question 6 missing (``en_docx_table``, also handed in as the .docx itself).
+  a table, out of order, question 6 missing (``en_docx_table``, also handed in as the .docx itself);
+  a hostile one, question 4 missing, whose answer to question 5 is markup that would run a script if a
+  page showed it unescaped (``hostile``: the review page's test).
 - **Made from them.** An image-only scan (the French report's pages rendered, turned a little,
   noise added, saved as a PDF by PIL), an encrypted PDF (LibreOffice's export with a password), a
   broken one (the French PDF cut short, as an interrupted upload is), one of 45 pages (LibreOffice),
@@ -283,20 +285,54 @@ def english_table_report(out, shots):
     return html('ROS exam report', body)
 
 
+#: A student's answer that runs a script, loads a picture or opens a local file if shown unescaped; one
+#: element a line (no line wraps in the PDF, so its text comes back as typed).
+HOSTILE_LINES = ('<script>document.title="pwned"</script>', '<img src=x onerror="document.title=\'pwned\'">',
+                 '<a href="file:///etc/passwd">x</a>')
+
+
+def hostile_report(out):
+    """Sheet 000 (aerial), in French, question 4 missing; question 5's comment is :data:`HOSTILE_LINES`."""
+    body = ''.join([
+        '<p>Étudiant : Mallory Script. Examen ROS, drone aérien (mydrone).</p>',
+        '<h2>Question 5</h2>', pre('$ rosnode info /mydrone\n' + out['rosnode info /mydrone']),
+        '<p>Voici ce que le nœud affiche, expliqué ci-dessous :</p>', pre('\n'.join(HOSTILE_LINES)),
+        '<h2>Question 6</h2>', pre('$ rostopic list\n' + out['rostopic list']),
+        '<p>Le topic /rosout reçoit les messages de log de tous les nœuds.</p>'])
+    return html('Rapport d\'examen ROS', body)
+
+
 def long_report(pages):
     body = ''.join('<p style="page-break-before: always">Page %d. Annexe : sortie de rostopic echo.</p>' % (n + 1)
                    for n in range(pages))
     return html('Annexes', body)
 
 
+def make_hostile(aerial, out, work, profile):
+    """``out/hostile.pdf``: :func:`hostile_report` of the aerial drone's outputs, through LibreOffice's .odt."""
+    with open(os.path.join(work, 'hostile.html'), 'w') as f:
+        f.write(hostile_report(aerial))
+    _, pdf = convert(os.path.join(work, 'hostile.html'), 'odt', profile)
+    shutil.copyfile(pdf, os.path.join(out, 'hostile.pdf'))
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--out', default=DEFAULT_OUT)
+    parser.add_argument('--only-hostile', action='store_true', help='make hostile.pdf alone, from the drone\'s outputs in '
+                        'outputs.json kept in OUT (no ROS, no X: the other fixtures stay as they are)')
     args = parser.parse_args(argv)
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     work = tempfile.mkdtemp(prefix='reports-make-')
     profile = os.path.join(work, 'lo-profile')
+    if args.only_hostile:
+        try:
+            with open(os.path.join(out, 'outputs.json')) as f:
+                make_hostile(json.load(f)['aerial'], out, work, profile)
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
+        return 0
     try:
         shots = {}
         with Screen() as screen:
@@ -326,6 +362,7 @@ def main(argv=None):
                              (docx, 'en_docx_table.docx'), (long_pdf, 'long_45_pages.pdf')):
             shutil.copyfile(source, os.path.join(out, name))
         shutil.copyfile(encrypted_pdf, os.path.join(out, 'encrypted.pdf'))
+        make_hostile(aerial, out, work, profile)
         with open(fr_pdf, 'rb') as f:
             data = f.read()
         with open(os.path.join(out, 'broken.pdf'), 'wb') as f:

@@ -1,35 +1,80 @@
 """make review's pure parts and its server in-process (issue 47 point 6): answers grouped by their
 normalised text, points written into hand.csv only where decided (nothing typed lost, a re-run keeps
 them), review.json's agreement, nothing read through a link, the data escaped, the token and the Host
-checked. The class is graded by the grader's own code from real kept measurements (make rescore's
-path); its report, code and proposals are the stand-ins of review_stand_ins.py."""
+checked.
+
+The class is what the grader writes: graded by its own code from real kept measurements (make
+rescore's path); each student's report the one its reader kept of a fixture of data/reports
+(data/kept/report-<fixture>/report.json, copied from the OUT of test_review_browser's class, graded
+by make grade's grade.py), its copies kept by root's own code (host/reports.keep_copies: the PDF as
+handed in, each page as the reader renders it with pdftoppm), its code by host/reports.keep_code, its
+proposals written by the desk's publish/proposals.py against the drones' reference records
+(data/answers, captured from the drones). Only the answer groups' own tests build proposals from a
+literal passage, with score/answers.py's proposal (the shape proposals.json holds).
+"""
 import csv
+import html
 import http.client
 import json
 import os
+import shutil
+import subprocess
 import threading
 import urllib.parse
 
 import pytest
 
-import review_stand_ins as stand_ins
-from exam_lab.grader.publish import grades, hand
+from exam_lab.grader.host import reports
+from exam_lab.grader.publish import grades, hand, proposals
 from exam_lab.grader.publish.review import decisions, folder, groups, page, server
+from exam_lab.grader.score import answers
 from exam_lab.grader.score.records import MEASUREMENTS, ReportRecord
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
-from test_grader_kept import kept_copy
+from test_answers import DATA as ANSWERS
+from test_grader_kept import KEPT, kept_copy
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 GOOD = os.path.join(os.path.dirname(HERE), 'grader', 'submissions', 'good_student', 'exam')
+REPORTS = os.path.join(HERE, 'data', 'reports')
 Q4 = '$ rosnode list\n/mydrone\n/rosout\nLes deux nœuds qui tournent: le drone et rosout.'
-HOSTILE = '<script>document.title="pwned"</script><img src=x onerror="document.title=\'pwned\'"> & "quotes"'
+#: Each student's report (a fixture of data/reports, as its reader kept it): ann and bob handed in
+#: the same one, cyd another (sheet 001's, in a table), dan a hostile one (no question 4, markup for
+#: question 5's comment); zoe's report was not read (none kept).
+HANDED_IN = {'ann': 'fr_odt', 'bob': 'fr_odt', 'cyd': 'en_docx_table', 'dan': 'hostile'}
+#: The students whose package's code the grader kept.
+WITH_CODE = ('ann', 'dan')
+#: pdftoppm's options of the reader's page images (boxed/report_reader.py, Pages.render).
+PREVIEW = ['-png', '-scale-to', '1400']
 
 
-def graded_out(root, names=('ann', 'bob', 'cyd', 'dan'), report_only=('zoe',)):
-    """An OUT made by the grader's code from real kept measurements: ``names`` graded (good_student's
+@pytest.fixture(scope='module')
+def boxes(tmp_path_factory):
+    """What the reader's box leaves of each report of :data:`HANDED_IN`, made again once:
+    ``{fixture: (the record it kept, the box's out folder)}``, the folder's report/ holding the PDF as
+    handed in (the record's copy) and each page's PNG as the reader renders it."""
+    root = tmp_path_factory.mktemp('boxes')
+    made = {}
+    for fixture in sorted(set(HANDED_IN.values())):
+        record = ReportRecord.read(os.path.join(KEPT, 'report-' + fixture, ReportRecord.FILE))
+        where = str(root / fixture)
+        os.makedirs(os.path.join(where, 'report'))
+        (copy,) = [f['copy'] for f in record.files]
+        shutil.copyfile(os.path.join(REPORTS, fixture + '.pdf'), os.path.join(where, copy))
+        for number, image in [(p['number'], p['image']) for p in record.pages]:
+            prefix = os.path.join(where, 'page')
+            subprocess.run(['pdftoppm'] + PREVIEW + ['-singlefile', '-f', str(number), '-l', str(number),
+                                                    os.path.join(where, copy), prefix], check=True)
+            os.rename(prefix + '.png', os.path.join(where, image))
+        made[fixture] = record, where
+    return made
+
+
+def graded_out(root, boxes, names=('ann', 'bob', 'cyd', 'dan'), report_only=('zoe',)):
+    """An OUT made by the grader's code: ``names`` graded from real kept measurements (good_student's
     grading, renamed), ``report_only`` not graded (a real no-node grading): grade.json by make rescore's
-    rescore, hand.csv by make grade's writer."""
+    rescore, hand.csv by make grade's writer; the reports of :data:`HANDED_IN` (from ``boxes``) and the
+    code of :data:`WITH_CODE` kept, and the proposals written, as the grader keeps and writes them."""
     out = root / 'out'
     shapes = [(n, 'before-version') for n in names] + [(n, 'no-node-before-records') for n in report_only]
     for index, (name, shape) in enumerate(shapes):
@@ -39,28 +84,29 @@ def graded_out(root, names=('ann', 'bob', 'cyd', 'dan'), report_only=('zoe',)):
                                                  folder='%s_%d_assignsubmission_file_' % (name, number)))
         (out / name).mkdir(parents=True)
         (out / name / MEASUREMENTS).write_text(json.dumps(measured))
+        if name in HANDED_IN:
+            record, where = boxes[HANDED_IN[name]]
+            kept = reports.keep_copies(record, where, str(out / name))
+            assert kept == record, kept.notes  # every file and page kept
+            reports.write(str(out / name), kept)
+        if name in WITH_CODE:
+            assert reports.keep_code(GOOD, str(out / name)) == []
     records, _ = grades.rescore(str(out))
     hand.write(str(out / hand.FILE), records)
+    for sheet in {r.get('sheet') or 'altitude' for r in records}:
+        shutil.copy(os.path.join(ANSWERS, 'reference-%s.json' % sheet), str(out))
+    proposals.write(str(out), records)
     return out, records
 
 
-def class_proposals():
-    """ann and bob wrote one answer to Q4 (spacing, case and a pid aside), cyd another, dan none;
-    dan's Q5 passage is hostile; zoe handed in only a report that was not read."""
-    p = stand_ins.proposal
-    return {
-        'ann': [p('Q4', 1.0, 'proposed', Q4 + '\npid: 4242'), p('Q5', 1.0, 'to check', 'rosnode info /mydrone')],
-        'bob': [p('Q4', 1.0, 'proposed', Q4.upper().replace('\n', '  \n') + '\nPID: 977311'),
-                p('Q5', 2.0, 'proposed', 'rosnode info /mydrone\nPid explained')],
-        'cyd': [p('Q4', 0.5, 'proposed', '$ rosnode list\n/mydrone\n/rosout')],
-        'dan': [p('Q4', None, 'no answer found'), p('Q5', 1.0, 'to check', HOSTILE)],
-    }
+def proposed(out, name):
+    """``{item: proposal}`` of the student's proposals.json, as the desk wrote it."""
+    return {p['item']: p for p in json.loads((out / name / proposals.STUDENT_FILE).read_text())}
 
 
 @pytest.fixture
-def out(tmp_path):
-    out, records = graded_out(tmp_path)
-    stand_ins.write(str(out), class_proposals(), code={'ann': GOOD, 'dan': GOOD})
+def out(tmp_path, boxes):
+    out, records = graded_out(tmp_path, boxes)
     return out
 
 
@@ -73,8 +119,13 @@ def test_normalise_sets_aside_case_spacing_and_what_each_run_changes():
     assert groups.normalise('data: 0.778') != groups.normalise('data: 0.779')
 
 
+def p(item, points, state, passage=''):
+    """A proposal of a literal passage, as score/answers.py makes one (proposals.json's entry)."""
+    return answers.proposal(item, state, points, 'p.1: %s' % passage.split('\n')[0] if passage else 'no passage',
+                            page=1 if passage else None, passage=passage)
+
+
 def test_groups_put_identical_answers_together_every_member_listed():
-    p = stand_ins.proposal
     found = groups.groups('Q4', [
         ('altitude', p('Q4', 1.0, 'proposed', Q4)), ('altitude', p('Q4', 1.0, 'proposed', Q4.upper())),
         ('altitude', p('Q4', 0.5, 'proposed', 'rosnode list')), ('altitude', p('Q4', None, 'no answer found')),
@@ -90,7 +141,6 @@ def test_groups_put_identical_answers_together_every_member_listed():
 
 
 def test_a_group_whose_proposals_differ_has_no_points_to_confirm():
-    p = stand_ins.proposal
     found = groups.groups('Q5', [('altitude', p('Q5', 1.0, 'to check', 'x')), ('altitude', p('Q5', 2.0, 'proposed', 'X'))])
     assert len(found) == 1 and groups.proposed_points(found[0]) is None
 
@@ -155,11 +205,19 @@ def test_a_group_confirmed_then_a_member_changed_then_the_group_changed(out):
     assert hand_rows(out)['ann']['Q4'] == '0' and hand_rows(out)['bob']['Q4'] == '0.5'
     kept_state = decisions.load(str(out / decisions.FILE))
     assert kept_state == json.loads(json.dumps(state)) and len(kept_state['history']) == 4
+    # the agreement against what the desk proposed them (one answer: one proposal)
+    ours = proposed(out, 'ann')['Q4']
+    assert proposed(out, 'bob')['Q4']['points'] == ours['points'] and ours['points'] is not None, ours
+    changed = [(n, ours['points'], given, ours['state']) for n, given in (('ann', 0.0), ('bob', 0.5))
+               if given != ours['points']]
     q4 = decisions.agreement(kept_state)[0]
-    assert (q4.item, q4.decided, q4.agreed) == ('Q4', 2, 0)
-    assert sorted(q4.changed) == [('ann', 1.0, 0.0, 'proposed'), ('bob', 1.0, 0.5, 'proposed')]
+    assert (q4.item, q4.decided, q4.agreed) == ('Q4', 2, 2 - len(changed))
+    assert sorted(q4.changed) == changed
     lines = decisions.agreement_lines(kept_state)
-    assert lines[0].startswith('Q4       2 decided: 0 as proposed (0%), 2 changed') and '  bob: proposed 1 (proposed), given 0.5' in lines
+    assert lines[0].startswith('Q4       2 decided: %d as proposed (%d%%), %d changed' % (
+        2 - len(changed), 50 * (2 - len(changed)), len(changed)))
+    for name, was, given, why in changed:
+        assert '  %s: proposed %s (%s), given %s' % (name, hand.points_cell(was), why, hand.points_cell(given)) in lines
 
 
 def test_review_json_that_is_not_the_pages_is_never_written_over(tmp_path):
@@ -177,24 +235,25 @@ def test_nothing_is_read_through_a_link_or_outside_the_students_folder(out, tmp_
     os.symlink(str(secret), str(out / 'ann' / 'code' / 'planted.py'))
     os.symlink(str(tmp_path), str(out / 'ann' / 'code' / 'outside'))
     os.symlink(str(out / 'ann' / 'code'), str(out / 'ann' / 'linked'))
-    for bad in ('../bob/report.json', '/etc/passwd', 'code/planted.py', 'linked/exam/package.xml', 'code/outside/secret.py',
+    for bad in ('../bob/report.json', '/etc/passwd', 'code/planted.py', 'linked/package.xml', 'code/outside/secret.py',
                 'report/', ''):
         with pytest.raises(folder.Refused):
             folder.read_inside(ann, bad, folder.CODE_FILE_CAP)
-    assert folder.read_inside(ann, 'code/exam/package.xml', folder.CODE_FILE_CAP).startswith(b'<?xml')
+    assert folder.read_inside(ann, 'code/package.xml', folder.CODE_FILE_CAP).startswith(b'<?xml')
     code = {path: (text, why) for path, text, why in folder.code_files(ann)}
     assert code['planted.py'] == (None, 'a link, not followed') and code['outside'] == (None, 'a link, not followed')
-    assert 'SECRET' not in json.dumps(code) and code['exam/package.xml'][0].startswith('<?xml')
+    assert 'SECRET' not in json.dumps(code) and code['package.xml'][0].startswith('<?xml')
 
 
 def test_a_page_image_must_be_a_png_report_json_names(out):
     students, _ = folder.load(str(out))
     ann = [s for s in students if s.name == 'ann'][0]
-    assert folder.page_image(ann, 0).startswith(folder.PNG)
+    assert [folder.page_image(ann, i)[:8] for i in range(len(ann.report['pages']))] == [folder.PNG] * 2
     with pytest.raises(folder.Refused):
-        folder.page_image(ann, 1)
+        folder.page_image(ann, len(ann.report['pages']))
     record = json.loads((out / 'ann' / 'report.json').read_text())
-    record['pages'][0]['image'] = '../bob/report/page-1.png'
+    record['pages'][0]['image'] = '../bob/' + record['pages'][0]['image']
+    assert (out / 'ann' / record['pages'][0]['image']).is_file()  # bob's page is there: refused for its path
     (out / 'ann' / 'report.json').write_text(json.dumps(record))
     students, _ = folder.load(str(out))
     with pytest.raises(folder.Refused):
@@ -231,16 +290,21 @@ def test_fields_of_another_type_are_dropped_with_a_note(out):
 
 
 def test_the_pages_escape_the_students_text_and_run_no_script(out):
+    """dan's report (hostile.pdf) answers question 5 with markup: the passage the desk proposed from it
+    holds it as the student typed it, the pages show it escaped."""
+    hostile = [line for line in proposed(out, 'dan')['Q5']['passage'].split('\n') if '<' in line]
+    assert '<script>document.title="pwned"</script>' in hostile and len(hostile) == 3, hostile
     students, notes = folder.load(str(out))
     dan = [s for s in students if s.name == 'dan'][0]
     cells = decisions.cells_now(str(out / hand.FILE))
     os.chmod(str(out / 'dan' / 'code'), 0o755)
-    (out / 'dan' / 'code' / '<img src=x onerror=alert(1)>.py').write_text('# ' + HOSTILE + '\n')
+    (out / 'dan' / 'code' / '<img src=x onerror=alert(1)>.py').write_text('# ' + hostile[0] + '\n')
     shown = page.student_page('t', '/T', dan, cells, folder.code_files(dan.folder))
     found = groups.groups('Q5', [(s.sheet, s.proposals.get('Q5')) for s in students])
     listed = page.item_page('t', '/T', 'Q5', found, students, cells, {g.id: ([], []) for g in found})
     for text in (shown, listed):
-        assert '<script' not in text and '<img src=x' not in text and 'onerror="' not in text
+        assert '<script' not in text and '<img src=x' not in text and 'onerror="' not in text and '<a href="file' not in text
+        assert all(html.escape(line, quote=True) in text for line in hostile), hostile
         assert '&lt;script&gt;document.title=&quot;pwned&quot;&lt;/script&gt;' in text
     assert '&lt;img src=x onerror=alert(1)&gt;.py' in shown
     assert "script-src" not in page.POLICY and "default-src 'none'" in page.POLICY
