@@ -276,18 +276,6 @@ def test_no_sandbox_no_grading_unless_the_risk_is_named(monkeypatch, tmp_path):
     assert sandbox.sandbox_refusal(unsandboxed=True) is None
 
 
-def test_probe_results_must_belong_to_the_run():
-    from exam_lab.grader.host.run import probe_problem
-    plan = {'kind': 'main', 'delay': 5.0}
-    real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0},
-            'clock': {'use_sim_time': [None, None], 'messages': 0, 'publishers': []}}
-    assert probe_problem(real, 99.0, 131.0, **plan) is None
-    assert 'not within' in probe_problem(real, 200.0, 240.0, **plan)       # an old run's file
-    short = dict(real, schedule=dict(real['schedule'], long_down=121.0))
-    assert 'less than' in probe_problem(short, 99.0, 131.0, **plan)        # the flight did not last
-    assert 'no times' in probe_problem({}, 99.0, 131.0, **plan)
-
-
 def test_a_box_is_another_user_and_sees_only_its_own():
     """A box as root's process tree makes it: not root, no /root, no host /tmp, a read-only package,
     none of the grader's variables (not even in its pid 1's environment); its detached child dies with
