@@ -182,6 +182,8 @@ class Pages(object):
                     and fields[4].isdigit() and fields[2] == 'image':
                 page, num, w, h = int(fields[0]), int(fields[1]), int(fields[3]), int(fields[4])
                 if w * h > MAX_PICTURE_PIXELS:
+                    self.notes.append('page %d: a picture of %d x %d pixels (at most %d million): the page\'s image '
+                                      'read instead' % (page, w, h, MAX_PICTURE_PIXELS // 10 ** 6))
                     too_large.add(page)
                 elif w >= 100 and h >= 30:
                     found.setdefault(page, []).append((w, h, num))
@@ -308,7 +310,7 @@ class Reader(Pages, Ocr, Tools):
             try:
                 size = os.path.getsize(path)
                 if size > FILE_BYTES:
-                    raise ToolFailed('%d MB (the reader reads at most %d MB)' % (size >> 20, FILE_BYTES >> 20))
+                    raise ToolFailed('%d bytes, over the %d the reader reads of one file' % (size, FILE_BYTES))
                 entry['copy'] = self.keep(index, name, path)
                 read = self.read_file(index, entry, path, REPORT_PAGES - len(pages))
             except ToolFailed as err:
