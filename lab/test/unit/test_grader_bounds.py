@@ -394,3 +394,35 @@ def test_a_docx_is_known_by_its_document_whatever_its_entries_before(tmp_path):
         for info in source.infolist():
             target.writestr(info, source.read(info))
     assert report_files.kind_of(crowded) == 'docx'
+
+
+def test_a_document_beyond_the_folders_searched_is_said_as_that_cap(tmp_path):
+    """A report deeper than the reader looks, or in an archive deeper than it opens, was "no report
+    handed in"; a PDF deeper than the facts list went unsaid. Each is said as its cap."""
+    from exam_lab.grader.boxed import documents, report_files, report_reader
+    deep = tmp_path / 'up' / 'a' / 'b' / 'c' / 'd' / 'e'
+    deep.mkdir(parents=True)
+    shutil.copy(os.path.join(REPORTS, 'fr_odt.pdf'), str(deep / 'report.pdf'))
+    notes = []
+    assert documents.documents(str(tmp_path / 'up'), notes) == []
+    assert notes == ["'a/b/c/d/e/report.pdf' is 5 folders deep: PDFs are listed %d folders deep at most"
+                     % (documents.MAX_DEPTH + 1)]
+    deeper = deep / 'f'
+    deeper.mkdir()
+    shutil.move(str(deep / 'report.pdf'), str(deeper / 'report.pdf'))
+    value = report_reader.Reader(str(tmp_path / 'r1')).read(str(tmp_path / 'up'))
+    assert value['why'] == ("'a/b/c/d/e/f/report.pdf' is 6 folders deep (the reader looks for a report %d folders "
+                            "deep at most)" % (report_files.MAX_DEPTH + 1)), value['why']
+    nested = tmp_path / 'nested'
+    nested.mkdir()
+    inner = str(tmp_path / 'l3.zip')
+    with zipfile.ZipFile(inner, 'w') as zf:
+        zf.write(os.path.join(REPORTS, 'fr_odt.pdf'), 'report.pdf')
+    for outer in ('l2.zip', 'l1.zip'):
+        with zipfile.ZipFile(str(tmp_path / outer), 'w') as zf:
+            zf.write(inner, os.path.basename(inner))
+        inner = str(tmp_path / outer)
+    shutil.move(inner, str(nested / 'l1.zip'))
+    value = report_reader.Reader(str(tmp_path / 'r2')).read(str(nested))
+    assert value['why'] == ("'l1.zip/l2.zip/l3.zip' is an archive inside archives, not searched for a report (the "
+                            "reader opens archives %d deep at most)" % report_files.MAX_NESTING), value['why']

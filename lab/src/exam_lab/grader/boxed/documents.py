@@ -112,11 +112,19 @@ def documents(path, notes=None):
         candidates = [path] if path.lower().endswith('.pdf') else []
         base = os.path.dirname(path)
     else:
-        candidates, base = [], path
+        candidates, base, below = [], path, []
         for dirpath, dirnames, filenames in os.walk(path):
             depth = os.path.relpath(dirpath, path).count(os.sep)
-            dirnames[:] = sorted(d for d in dirnames if not d.startswith('.')) if depth < MAX_DEPTH else []
+            dirnames[:] = sorted(d for d in dirnames if not d.startswith('.'))
+            if depth >= MAX_DEPTH:
+                below += [os.path.join(dirpath, d) for d in dirnames]
+                dirnames[:] = []
             candidates += [os.path.join(dirpath, n) for n in sorted(filenames) if n.lower().endswith('.pdf')]
+        deeper = bounds.found_deeper(below, lambda p: p.lower().endswith('.pdf'))
+        if deeper:
+            _said(notes, '%s is %d folders deep: PDFs are listed %d folders deep at most'
+                  % (archives.shown_name(os.path.relpath(deeper, path)), os.path.relpath(deeper, path).count(os.sep),
+                     MAX_DEPTH + 1))
     candidates = [full for full in candidates if not os.path.islink(full)]
     for full in bounds.kept(candidates, 'PDF files', notes if notes is not None else [], MAX_DOCUMENTS,
                             verb='listed', text=None):

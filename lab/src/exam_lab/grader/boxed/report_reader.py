@@ -299,10 +299,11 @@ class Reader(Pages, Ocr, Tools):
 
     def read(self, upload):
         """The record's value of the reports in ``upload``."""
-        files, pages = [], []
-        found = find_reports(upload, self.scratch, self.notes)
+        files, pages, beyond = [], [], []
+        found = find_reports(upload, self.scratch, self.notes, beyond)
         if not found:
-            return self.value('no report handed in (no PDF, no document, no picture among the files)', files, pages)
+            return self.value('; '.join(beyond) or 'no report handed in (no PDF, no document, no picture among the '
+                              'files)', files, pages)
         for index, (name, path) in enumerate(found):
             entry = {'name': bounds.cut(name, 255), 'kind': kind_of(path), 'converted': False, 'pages': 0, 'note': '',
                      'state': 'not read', 'copy': None}
