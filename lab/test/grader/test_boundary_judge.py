@@ -25,7 +25,7 @@ import pytest
 from exam_lab.grader import runner
 from exam_lab.grader.host import limits, uids, underlay
 from exam_lab.grader.host import run as host_run
-from exam_lab.grader.score import rubric
+from exam_lab.grader.score import rubric, runs
 from exam_lab.grader.score.sheets import ITEMS
 from hostile_run import HOSTILE, JOBS, NAMES, VICTIM_NAME
 
@@ -137,7 +137,7 @@ def test_a_death_lost_in_the_cut_log_is_seen_by_the_judge(judged_class):
     watch saw its pid change; it costs the runs point and a hand grade, like any death."""
     assert 'bytes cut by the grader' in logs_of(judged_class, RESPAWNER, 'launch-main.log'), \
         'the chatter did not fill the log: this test proves nothing'
-    main = session_of(judged_class, RESPAWNER)['runs'][0]
+    main = runs.judged_run(session_of(judged_class, RESPAWNER)['runs'][0])  # the deaths as the rubric counts them
     watched = [e for e in main['launch']['ended'] if e['detail'].startswith('seen by the judge')]
     assert [e['node'] for e in watched] == ['/chatter'], main['launch']['ended']
     record = judged_class['records'][RESPAWNER]

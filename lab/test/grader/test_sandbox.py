@@ -144,7 +144,7 @@ def test_reading_student_bytes_is_bounded(tmp_path):
         pytest.skip('boxes need root and bubblewrap: %s' % sandbox.check())
     cases = [('while True: pass', (60.0, 2, 1 << 30), 'killed by signal'),
              ('time.sleep(600)', (3.0, 60, 1 << 30), 'did not finish within 3 s'),
-             ('bytearray(2 << 30)', (60.0, 60, 1 << 30), 'MemoryError'),
+             ('bytearray(2 << 30)', (60.0, 60, 1 << 30), 'it ran out of memory: its bound is 1024 MB of address space'),
              ('os.symlink("/etc/shadow", "inspect.json")', (60.0, 60, 1 << 30), 'a link, not followed')]
     for statement, bounds, words in cases:
         work = staging.new_work('exam-bounds-test-')
@@ -274,18 +274,6 @@ def test_no_sandbox_no_grading_unless_the_risk_is_named(monkeypatch, tmp_path):
     assert '--unsandboxed-student-code-can-read-and-damage-my-files' in str(refused.value)
     assert not os.path.exists(str(tmp_path / 'out'))
     assert sandbox.sandbox_refusal(unsandboxed=True) is None
-
-
-def test_probe_results_must_belong_to_the_run():
-    from exam_lab.grader.host.run import probe_problem
-    plan = {'kind': 'main', 'delay': 5.0}
-    real = {'t0': 100.0, 'schedule': {'rest': 110.0, 'long_up': 120.0, 'long_down': 127.5, 'end': 130.0},
-            'clock': {'use_sim_time': [None, None], 'messages': 0, 'publishers': []}}
-    assert probe_problem(real, 99.0, 131.0, **plan) is None
-    assert 'not within' in probe_problem(real, 200.0, 240.0, **plan)       # an old run's file
-    short = dict(real, schedule=dict(real['schedule'], long_down=121.0))
-    assert 'less than' in probe_problem(short, 99.0, 131.0, **plan)        # the flight did not last
-    assert 'no times' in probe_problem({}, 99.0, 131.0, **plan)
 
 
 def test_a_box_is_another_user_and_sees_only_its_own():

@@ -1,13 +1,17 @@
 """A cap on a box's record is a sentence, and the student is still graded on what fits (issue 36
 point 6): every list and long text a box puts into its record (inspect.json, intake.json,
 similarity.json) is bounded where it is made (:mod:`exam_lab.grader.boxed.bounds`), with a sentence
-naming the cap and the value; the record then passes root's check of its schema and bytes.
+naming the cap and the value; the record then passes root's check of its schema and bytes. Every
+other cap a box meets (files, bytes, depths, archives, pages, pictures, its memory) is said as that cap.
 No ROS: the inspection runs here as a function, the similarity record is made from a detector's result.
 """
 import json
 import os
 import re
 import shutil
+import zipfile
+
+import pytest
 
 from exam_lab.grader.boxed import bounds, inspect, intake, similarity
 from exam_lab.grader.score import records
@@ -186,3 +190,239 @@ def test_the_intake_cuts_a_reason_and_refuses_more_students_than_a_class_holds(t
     monkeypatch.setattr(records.IntakeRecord, 'MAX_STUDENTS', 2)
     assert intake.main(['--class', str(klass), '--out', str(out)]) == 3
     assert 'the class archive holds 3 students (at most 2 for a class)' in capsys.readouterr().err
+
+
+# --- Every other cap a box meets, when hit, is a sentence naming the cap and what was seen (issue 46
+# point 6), never a traceback's tail or a wrong reason. Small caps are lowered here to be hit cheaply.
+
+REPORTS = os.path.join(HERE, 'data', 'reports')
+
+
+def test_the_code_s_functions_and_signals_over_their_caps_are_said(tmp_path, monkeypatch):
+    """The functions and blocks judged for their comments, the signs of bad practice: the first of
+    each kept, said (they were cut without a word)."""
+    from exam_lab.grader.boxed import code_quality
+    monkeypatch.setattr(code_quality, 'MAX_UNITS', 3)
+    monkeypatch.setattr(code_quality, 'MAX_SIGNALS', 1)
+    code = ''.join('def f%d():\n    global g%d\n    g%d = 1\n' % (i, i, i) for i in range(5))
+    record = read_back(InspectRecord, package_with(tmp_path, {'scripts/many.py': code}))
+    assert len(record.comments['units']) == 3 and len(record.comments['quality']) == 1
+    assert [n for n in record.notes if re.match(r'^\d+ functions and blocks of the code \(at most 3\): the first 3 '
+                                                r'are judged for their comments$', n)], record.notes
+    assert [n for n in record.notes if re.match(r'^\d+ signs of bad practice in the code \(at most 1\): the first '
+                                                r'1 is listed$', n)], record.notes
+
+
+def test_pdfs_over_their_caps_are_said(tmp_path, monkeypatch):
+    """PDFs handed in beyond those listed; a PDF over the bytes read to count its pages; one whose
+    streams inflate past the work spent counting: each said, the pages counted on what was read."""
+    from exam_lab.grader.boxed import documents
+    for name in ('en_docx_table.pdf', 'fr_odt.pdf', 'long_45_pages.pdf'):
+        shutil.copy(os.path.join(REPORTS, name), str(tmp_path / name))
+    monkeypatch.setattr(documents, 'MAX_DOCUMENTS', 2)
+    notes = []
+    assert [d['name'] for d in documents.documents(str(tmp_path), notes)] == ['en_docx_table.pdf', 'fr_odt.pdf']
+    assert notes == ['3 PDF files (at most 2): the first 2 are listed']
+    long_pdf = str(tmp_path / 'long_45_pages.pdf')
+    size = os.path.getsize(long_pdf)
+    monkeypatch.setattr(documents, 'PDF_READ_BYTES', 1000)
+    notes = []
+    documents.pdf_pages(long_pdf, notes, 'report/long.pdf')
+    assert notes == ["'report/long.pdf': %d bytes, its pages counted on the first 1000 (the most read of a PDF)" % size]
+    monkeypatch.setattr(documents, 'PDF_READ_BYTES', size + 100)  # all of it read, its streams inflate further
+    notes = []
+    documents.pdf_pages(long_pdf, notes, 'long.pdf')
+    assert notes == ["'long.pdf': its streams inflate past the %d bytes of work spent counting its pages: counted "
+                     "on those read" % (size + 100)]
+    monkeypatch.setattr(documents, 'PDF_READ_BYTES', 50 << 20)
+    notes = []
+    assert documents.pdf_pages(long_pdf, notes) == 46 and notes == []  # 46: its name says 45
+
+
+def test_the_inspection_says_the_pdfs_it_did_not_list(tmp_path, monkeypatch):
+    """The documents' caps reach the teacher's notes of the inspection's record."""
+    from exam_lab.grader.boxed import documents
+    monkeypatch.setattr(documents, 'MAX_DOCUMENTS', 1)
+    found = package_with(tmp_path, {})
+    assert not [n for n in found['notes'] if 'PDF files' in n]
+    for name in ('fr_odt.pdf', 'long_45_pages.pdf'):
+        shutil.copy(os.path.join(REPORTS, name), str(tmp_path / 'upload' / 'exam' / name))
+    ws = tmp_path / 'ws2'
+    (ws / 'src').mkdir(parents=True)
+    record = read_back(InspectRecord, bounds.fit(inspect.inspect(str(tmp_path / 'upload' / 'exam'), str(ws),
+                                                                 str(tmp_path / 'out2'), None, 0.5), InspectRecord))
+    assert '2 PDF files (at most 1): the first 1 is listed' in record.notes
+    assert [d['name'] for d in record.facts['documents']] == ['fr_odt.pdf']
+
+
+def test_a_code_file_over_the_bytes_compared_is_said(tmp_path, monkeypatch):
+    """A file over MAX_FILE_BYTES is data, not compared: said with its name (it was left out silently)."""
+    package = tmp_path / 'up' / 'exam'
+    for relative, size in (('scripts/exam_node.py', 100), ('scripts/table.py', 400), ('package.xml', 100)):
+        os.makedirs(os.path.dirname(str(package / relative)), exist_ok=True)
+        (package / relative).write_text('x' * size)
+    monkeypatch.setattr(similarity, 'MAX_FILE_BYTES', 300)
+    staged, notes = similarity.stage([('dee', str(tmp_path / 'up'))], str(tmp_path / 'staged'))
+    assert sorted(os.listdir(os.path.join(staged['dee'], 'scripts'))) == ['exam_node.py']
+    assert notes == ["dee: 1 code file(s) not compared, each over the 300 bytes the check reads of one file: "
+                     "'scripts/table.py'"]
+
+
+def test_a_package_beyond_the_search_is_said_as_that_cap(tmp_path):
+    """A package deeper than the folders searched, in an archive deeper than the archives opened: the
+    cap that left it out, never "no catkin package"."""
+    from exam_lab.grader.boxed import archives, package
+    deep = tmp_path / 'deep' / 'a' / 'b' / 'c' / 'd' / 'e' / 'exam'
+    deep.mkdir(parents=True)
+    (deep / 'package.xml').write_text('<package><name>exam</name></package>')
+    try:
+        package.open_submission(str(tmp_path / 'deep'), str(tmp_path / 'scratch1'), [])
+        raise AssertionError('a package 6 folders deep was found')
+    except archives.UnpackError as err:
+        assert str(err) == ("'a/b/c/d/e/exam/package.xml' is 6 folders deep (the grader looks for the package %d "
+                            "folders deep at most)" % package.MAX_DEPTH)
+    nested = tmp_path / 'nested'
+    nested.mkdir()
+    inner = str(tmp_path / 'l3.zip')
+    with zipfile.ZipFile(inner, 'w') as zf:
+        zf.writestr('exam/package.xml', '<package><name>exam</name></package>')
+    for outer in ('l2.zip', 'l1.zip'):
+        with zipfile.ZipFile(str(tmp_path / outer), 'w') as zf:
+            zf.write(inner, os.path.basename(inner))
+        inner = str(tmp_path / outer)
+    shutil.move(inner, str(nested / 'l1.zip'))
+    try:
+        package.open_submission(str(nested), str(tmp_path / 'scratch2'), [])
+        raise AssertionError('a package in an archive 3 deep was found')
+    except archives.UnpackError as err:
+        assert str(err) == "'l3.zip' is an archive inside archives (the grader opens archives %d deep at most)" \
+            % package.MAX_NESTING
+
+
+def test_every_cap_of_an_archive_s_entry_names_the_cap_and_what_was_seen(tmp_path):
+    from exam_lab.grader.boxed import archives
+    bomb = str(tmp_path / 'bomb.zip')
+    with zipfile.ZipFile(bomb, 'w', zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr('exam/big', b'\0' * (archives.RATIO_FROM_BYTES + 1))
+    with pytest.raises(archives.UnpackError) as refused:
+        archives.safe_extract(bomb, str(tmp_path / 'out1'))
+    assert re.match(r"^entry 'exam/big' unpacks %d bytes from \d+, more than 200 times its size \(the most an entry "
+                    r"over 16 MB may\): a zip bomb\?$" % (archives.RATIO_FROM_BYTES + 1), str(refused.value))
+    for name, said in (('/'.join(['d'] * 65) + '/f', "is 66 folders deep (at most 64)"),
+                       ('/'.join(['d' * 200] * 25), 'has a path of more than 4096 bytes')):
+        archive = str(tmp_path / 'a.zip')
+        with zipfile.ZipFile(archive, 'w') as zf:
+            zf.writestr(name, 'x')
+        with pytest.raises(archives.UnpackError) as refused:
+            archives.safe_extract(archive, str(tmp_path / 'out2'))
+        assert said in str(refused.value) and str(refused.value).startswith('entry '), str(refused.value)
+
+
+def test_launch_files_beyond_their_caps_are_said(tmp_path):
+    """Includes followed deeper than MAX_INCLUDE_DEPTH ("not found", once), more files read than
+    MAX_FILES: each said as its cap."""
+    from exam_lab.grader.boxed import launch
+    pkg = tmp_path / 'exam'
+    (pkg / 'launch').mkdir(parents=True)
+    (pkg / 'package.xml').write_text('<package><name>exam</name></package>')
+    (pkg / 'launch' / 'self.launch').write_text('<launch><include file="$(dirname)/self.launch"/></launch>')
+    analysis = launch.analyse(str(pkg / 'launch' / 'self.launch'), str(pkg), 'exam')
+    assert analysis.problems == ['include $(dirname)/self.launch not read: it is included %d deep (at most %d)'
+                                 % (launch.MAX_INCLUDE_DEPTH + 1, launch.MAX_INCLUDE_DEPTH)]
+    (pkg / 'launch' / 'leaf.launch').write_text('<launch/>')
+    (pkg / 'launch' / 'wide.launch').write_text(
+        '<launch>%s</launch>' % ('<include file="$(dirname)/leaf.launch"/>' * launch.MAX_FILES))
+    analysis = launch.analyse(str(pkg / 'launch' / 'wide.launch'), str(pkg), 'exam')
+    assert analysis.problems == ['cannot evaluate launch/wide.launch: more than %d launch files read (includes of '
+                                 'includes)' % launch.MAX_FILES]
+
+
+def test_a_box_out_of_memory_is_said_as_its_bound_not_its_traceback(tmp_path):
+    """Python's MemoryError at the box's address space: the bound, without the traceback; another
+    failure keeps its log's tail."""
+    import subprocess
+    import sys
+    from exam_lab.grader.host import boxed_run
+    memory = 256 << 20
+    done = subprocess.run(['prlimit', '--as=%d' % memory, '--', sys.executable, '-c', 'bytearray(1 << 30)'],
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=60)
+    assert done.returncode == 1 and done.stdout.rstrip().endswith('MemoryError'), done.stdout
+    why, tail = boxed_run.bound_hit(done.returncode, boxed_run.session_tail(done.stdout), 60, memory)
+    assert (why, tail) == ('it ran out of memory: its bound is 256 MB of address space', '')
+    assert boxed_run.bound_hit(1, 'ValueError: x', 60, memory) == ('it failed (exit 1)', 'ValueError: x')
+    assert boxed_run.bound_hit(-9, '', 60, memory) == \
+        ('it was killed by signal 9 (its bounds: 60 s of CPU, 256 MB of address space)', '')
+
+
+def test_the_report_reader_says_each_of_its_caps(tmp_path, monkeypatch):
+    """Report files beyond those read, a file over the bytes read, a picture over the pixels decoded:
+    each a sentence naming the cap and what was seen."""
+    from exam_lab.grader.boxed import report_files, report_reader
+    upload = tmp_path / 'upload'
+    upload.mkdir()
+    for name in ('en_docx_table.pdf', 'fr_odt.pdf', 'scan.pdf'):
+        shutil.copy(os.path.join(REPORTS, name), str(upload / name))
+    monkeypatch.setattr(report_files, 'REPORT_FILES', 2)
+    notes = []
+    assert [n for n, _ in report_files.find_reports(str(upload), str(tmp_path / 's1'), notes)] == \
+        ['en_docx_table.pdf', 'fr_odt.pdf']
+    assert notes == ['3 report files (at most 2): the first 2 are read']
+    size = os.path.getsize(str(upload / 'scan.pdf'))
+    monkeypatch.setattr(report_reader, 'FILE_BYTES', size - 1)
+    monkeypatch.setattr(report_files, 'REPORT_FILES', 10)
+    scan_only = tmp_path / 'scan'
+    scan_only.mkdir()
+    shutil.copy(str(upload / 'scan.pdf'), str(scan_only / 'scan.pdf'))
+    value = report_reader.Reader(str(tmp_path / 'r1')).read(str(scan_only))
+    assert value['files'][0]['note'] == "'scan.pdf': %d bytes, over the %d the reader reads of one file" % (size, size - 1)
+    monkeypatch.setattr(report_reader, 'MAX_PICTURE_PIXELS', 1000)
+    reader = report_reader.Reader(str(tmp_path / 'r2'))
+    assert reader.pictures(str(scan_only / 'scan.pdf'), 1) == {}
+    assert [n for n in reader.notes if re.match(r'^page 1: a picture of \d+ x \d+ pixels \(at most 0 million\): the '
+                                                r'page\'s image read instead$', n)], reader.notes
+
+
+def test_a_docx_is_known_by_its_document_whatever_its_entries_before(tmp_path):
+    """A docx whose word/document.xml comes after 1000 other entries was "not a document" (its kind read
+    from the first 1000 names only): a cap said as a wrong reason. Every name is looked up now."""
+    from exam_lab.grader.boxed import report_files
+    crowded = str(tmp_path / 'crowded.docx')
+    with zipfile.ZipFile(os.path.join(REPORTS, 'en_docx_table.docx')) as source, \
+            zipfile.ZipFile(crowded, 'w', zipfile.ZIP_DEFLATED) as target:
+        for i in range(1001):
+            target.writestr('word/media/extra%04d.xml' % i, '<x/>')
+        for info in source.infolist():
+            target.writestr(info, source.read(info))
+    assert report_files.kind_of(crowded) == 'docx'
+
+
+def test_a_document_beyond_the_folders_searched_is_said_as_that_cap(tmp_path):
+    """A report deeper than the reader looks, or in an archive deeper than it opens, was "no report
+    handed in"; a PDF deeper than the facts list went unsaid. Each is said as its cap."""
+    from exam_lab.grader.boxed import documents, report_files, report_reader
+    deep = tmp_path / 'up' / 'a' / 'b' / 'c' / 'd' / 'e'
+    deep.mkdir(parents=True)
+    shutil.copy(os.path.join(REPORTS, 'fr_odt.pdf'), str(deep / 'report.pdf'))
+    notes = []
+    assert documents.documents(str(tmp_path / 'up'), notes) == []
+    assert notes == ["'a/b/c/d/e/report.pdf' is 5 folders deep: PDFs are listed %d folders deep at most"
+                     % (documents.MAX_DEPTH + 1)]
+    deeper = deep / 'f'
+    deeper.mkdir()
+    shutil.move(str(deep / 'report.pdf'), str(deeper / 'report.pdf'))
+    value = report_reader.Reader(str(tmp_path / 'r1')).read(str(tmp_path / 'up'))
+    assert value['why'] == ("'a/b/c/d/e/f/report.pdf' is 6 folders deep (the reader looks for a report %d folders "
+                            "deep at most)" % (report_files.MAX_DEPTH + 1)), value['why']
+    nested = tmp_path / 'nested'
+    nested.mkdir()
+    inner = str(tmp_path / 'l3.zip')
+    with zipfile.ZipFile(inner, 'w') as zf:
+        zf.write(os.path.join(REPORTS, 'fr_odt.pdf'), 'report.pdf')
+    for outer in ('l2.zip', 'l1.zip'):
+        with zipfile.ZipFile(str(tmp_path / outer), 'w') as zf:
+            zf.write(inner, os.path.basename(inner))
+        inner = str(tmp_path / outer)
+    shutil.move(inner, str(nested / 'l1.zip'))
+    value = report_reader.Reader(str(tmp_path / 'r2')).read(str(nested))
+    assert value['why'] == ("'l1.zip/l2.zip/l3.zip' is an archive inside archives, not searched for a report (the "
+                            "reader opens archives %d deep at most)" % report_files.MAX_NESTING), value['why']

@@ -7,10 +7,9 @@ import pytest
 
 from exam_lab.grader.boxed import derive, launch, source
 
-from exam_lab.grader.host import run as host_run
 from exam_lab.grader.judge import legs, pilot
 
-from exam_lab.grader.score import flight, records, rubric, tolerances, verdict
+from exam_lab.grader.score import flight, records, rubric, runs, tolerances, verdict
 
 from exam_lab.grader.publish import report
 
@@ -99,8 +98,8 @@ def test_a_late_warning_costs_the_delay_only():
     assert lost(record) == {'Q14b': 1.5}
     q13 = [i for i in rubric.score('altitude', STATIC, record) if i['id'] == 'Q13'][0]['evidence']
     assert 'the WARNING came late, 50.0 s' in q13
-    assert host_run.warning_latency(main_of(record)) == pytest.approx(50.0)
-    assert host_run.warning_latency({'schedule': schedule, 'calls': []}) is None
+    assert runs.warning_latency(main_of(record)) == pytest.approx(50.0)
+    assert runs.warning_latency({'schedule': schedule, 'calls': []}) is None
 
 
 @pytest.mark.parametrize('kind', ['std_msgs/Float64', 'std_msgs/Int32', 'std_msgs/UInt16'])

@@ -147,14 +147,6 @@ def test_the_session_takes_a_probe_result_that_is_not_one_for_the_runs_crash(tmp
     assert value is None and 'a link, not followed' in why
 
 
-def test_a_refused_result_is_kept_for_the_plot_not_for_the_rubric():
-    run = {'probe': real_probe()}
-    host_run.refuse(run, 'the master ended')
-    assert run['probe'] is None and run['refused_probe'] == real_probe()
-    assert run['probe_error'] == 'result refused: the master ended' and run['probe_refused'] == 'the master ended'
-    assert host_run.watched_deaths(real_probe()) == []
-
-
 def test_the_runner_reads_the_sessions_record_capped_and_checked(tmp_path):
     log_dir = str(tmp_path)
     write(os.path.join(log_dir, 'session.json'), SessionRecord.make(real_session()).to_json())

@@ -11,7 +11,7 @@ from exam_lab.grader.judge.graph import NodeWatch
 from exam_lab.grader.score import rubric
 
 from test_grader_desk import Clock
-from test_grader_rubric import STATIC, measured, points
+from test_grader_rubric import STATIC, measured
 from test_grader_third_class import _Here
 
 DUP = ('<launch><node pkg="mydrone" name="exam" type="mydrone_node.py"/>'
@@ -114,22 +114,6 @@ def test_a_node_gone_or_unreachable_is_a_death_a_slow_one_is_not():
     deaths = {d['node']: d['detail'] for d in watch.stop()['deaths']}
     assert deaths == {'/exam': 'ended during the run (pid 10), then started again (pid 14)',
                       '/helper': 'ended during the run (pid 11)'}
-
-
-def test_a_watched_death_costs_what_a_death_costs():
-    """The session puts the watch's deaths with roslaunch's: runs loses its point, the node "died"."""
-    session_ = measured()
-    probe = session_['runs'][0]['probe']
-    probe['node_watch'] = {'deaths': [{'node': '/chatter', 't': 12.0,
-                                       'detail': 'started again during the run (pid 11, then 12)'}], 'nodes': []}
-    assert points(session_)['runs'] == 2.0  # before the session reads the watch: the attack's 2/2
-    session_['runs'][0]['launch']['ended'].extend(host_run.watched_deaths(probe))
-    assert points(session_)['runs'] == 1.0
-    evidence = [i for i in rubric.score('altitude', STATIC, session_) if i['id'] == 'runs'][0]['evidence']
-    assert 'node /chatter died (seen by the judge: started again during the run (pid 11, then 12))' in evidence
-    status, reason = rubric.status(STATIC, session_)
-    assert status == rubric.HAND_GRADE and 'died' in reason, reason
-    # A watch of another shape never reaches the deaths: the probe's record refuses it (test_grader_probe_record).
 
 
 def test_each_step_gets_its_own_limit_or_what_is_left():

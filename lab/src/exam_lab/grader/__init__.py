@@ -44,7 +44,8 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   and its parts: :mod:`~.score.tolerances` (each tolerance, one constant), :mod:`~.score.measured` (the
   session's runs and probes as the items read them), :mod:`~.score.node_items` (runs, Q10-Q12),
   :mod:`~.score.flight` (the flight's calls, legs and lags; the WARNING's window),
-  :mod:`~.score.timing_items` (Q13, Q14a, Q14b), :mod:`~.score.verdict` (the status, the doubts);
+  :mod:`~.score.timing_items` (Q13, Q14a, Q14b), :mod:`~.score.verdict` (the status, the doubts),
+  :mod:`~.score.runs` (whether a run counts: its result's times, the clock, the master, the judge's deaths);
   :mod:`~.score.fields` (a record read by attributes, following its schema), :mod:`~.score.safe_text`
   (student-derived text without control characters, for every record and output), :mod:`~.score.records`
   (the typed records that cross the boundary, with their schemas), :mod:`~.score.kept` (what a grading

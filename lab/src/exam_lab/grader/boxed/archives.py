@@ -381,8 +381,9 @@ def _plan_zip(zf, label, max_ratio):
         plan.add(*entry)
     for info, _, size in plan.files:
         if size > RATIO_FROM_BYTES and size > max_ratio * max(info.compress_size, 1024):
-            raise UnpackError('entry %s unpacks %d bytes from %d: a zip bomb?'
-                              % (shown_name(zip_name(info)), size, info.compress_size))
+            raise UnpackError('entry %s unpacks %d bytes from %d, more than %d times its size (the most an '
+                              'entry over %d MB may): a zip bomb?' % (shown_name(zip_name(info)), size, info.compress_size,
+                                                                     max_ratio, RATIO_FROM_BYTES >> 20))
     return plan
 
 

@@ -13,6 +13,7 @@ record's own schema and, when the whole is over the record's bytes, cuts its lis
 each cut said in a sentence.
 """
 import json
+import os
 
 from exam_lab.grader.score.records import (MAX_ITEMS, MAX_TEXT, Items, Map, Maybe, OneOf, Optional, Row,
                                            Text)
@@ -113,3 +114,17 @@ def _fit(value, schema, where, cuts, caps):
     if isinstance(schema, OneOf):
         return value
     return value
+
+
+def found_deeper(folders, wanted):
+    """The first file below ``folders`` (those a search left out at its depth) that is ``wanted`` (a
+    predicate on its path), or None: what a cap on depth left out, for its sentence. Links are not
+    followed; the folders are the box's own unpacked upload, bounded by its budget."""
+    for folder in folders:
+        for dirpath, dirnames, filenames in os.walk(folder):
+            dirnames.sort()
+            for name in sorted(filenames):
+                full = os.path.join(dirpath, name)
+                if not os.path.islink(full) and os.path.isfile(full) and wanted(full):
+                    return full
+    return None

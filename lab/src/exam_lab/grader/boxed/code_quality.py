@@ -19,7 +19,8 @@ _BLOCKS = (ast.If, ast.For, ast.While, ast.With, ast.Try)
 BLOCKING = ('sleep', 'wait_for_service', 'wait_for_message', 'input', 'spin', 'join')
 #: Calls that let a loop wait without using a core (what a loop on rospy.is_shutdown() needs).
 _WAITS = ('sleep', 'spin', 'spin_once', 'wait', 'wait_for_message', 'wait_for_service', 'join', 'get', 'select')
-#: Most units and signals kept per package (the record's lists are capped).
+#: Most units and signals kept per package (the record's lists are capped; the inspection cuts them,
+#: saying so: :func:`~exam_lab.grader.boxed.bounds.kept`).
 MAX_UNITS = 300
 MAX_SIGNALS = 100
 
@@ -80,7 +81,7 @@ def comment_units(paths, package_dir):
                 units.append({'file': f.rel, 'line': node.lineno, 'kind': type(node).__name__.lower(),
                               'name': '', 'commented': commented})
     units.sort(key=lambda u: (u['file'], u['line']))
-    return units[:MAX_UNITS]
+    return units
 
 
 def _callbacks(tree):
@@ -217,4 +218,4 @@ def quality_signals(paths, package_dir):
     if missing:
         signals.insert(0, {'file': '', 'line': 0, 'kind': 'note',
                            'detail': 'pyflakes is not installed (tools/install_deps.sh installs python3-pyflakes)'})
-    return signals[:MAX_SIGNALS]
+    return signals

@@ -6,6 +6,7 @@ import os
 import re
 import zlib
 
+from exam_lab.grader.boxed import archives, bounds
 from exam_lab.grader.score.identity import participant_number
 
 #: Bytes of a PDF read to count its pages, and the work spent on its streams, all together: bytes
@@ -26,23 +27,32 @@ MAX_DOCUMENTS = 10
 MAX_DEPTH = 3
 
 
-def pdf_pages(path):
+def pdf_pages(path, notes=None, name=None):
     """The page count of a PDF, or None when the file does not read as one.
 
     The page tree's ``/Count`` (its root holds the total), else the ``/Type /Page`` objects; object
     streams (PDF 1.5) are inflated, within PDF_READ_BYTES of work in all. Linear in the file's size.
+    A file larger, or whose streams inflate to more, is counted on what was read, said in ``notes``
+    (the file named ``name``).
     """
     try:
         with open(path, 'rb') as f:
-            data = f.read(PDF_READ_BYTES)
+            data, size = f.read(PDF_READ_BYTES), os.fstat(f.fileno()).st_size
     except OSError:
         return None
     if not data.startswith(b'%PDF'):
         return None
+    shown = archives.shown_name(name or os.path.basename(path))
+    if size > PDF_READ_BYTES:
+        _said(notes, '%s: %d bytes, its pages counted on the first %d (the most read of a PDF)'
+              % (shown, size, PDF_READ_BYTES))
+        notes = None  # one sentence for the one cap
     texts, budget, view = [data], PDF_READ_BYTES, memoryview(data)
     for match in _STREAM.finditer(data):
-        if budget <= 0:
-            break  # a PDF made to inflate without end: its first pages' worth is counted
+        if budget <= 0:  # a PDF made to inflate without end: its first pages' worth is counted
+            _said(notes, '%s: its streams inflate past the %d bytes of work spent counting its pages: counted '
+                         'on those read' % (shown, PDF_READ_BYTES))
+            break
         text, cost = _inflate(view, match.end(), budget)
         budget -= cost
         if text:
@@ -89,27 +99,43 @@ def _page_tree_counts(text):
     return counts
 
 
-def documents(path):
-    """``[{"name", "pages"}]`` of the PDFs in a submission (a folder; a lone file when it is one)."""
+def _said(notes, sentence):
+    if notes is not None:
+        notes.append(sentence)
+
+
+def documents(path, notes=None):
+    """``[{"name", "pages"}]`` of the PDFs in a submission (a folder; a lone file when it is one), the
+    first MAX_DOCUMENTS of them (said in ``notes``)."""
     found = []
     if os.path.isfile(path):
         candidates = [path] if path.lower().endswith('.pdf') else []
         base = os.path.dirname(path)
     else:
-        candidates, base = [], path
+        candidates, base, below = [], path, []
         for dirpath, dirnames, filenames in os.walk(path):
             depth = os.path.relpath(dirpath, path).count(os.sep)
-            dirnames[:] = sorted(d for d in dirnames if not d.startswith('.')) if depth < MAX_DEPTH else []
+            dirnames[:] = sorted(d for d in dirnames if not d.startswith('.'))
+            if depth >= MAX_DEPTH:
+                below += [os.path.join(dirpath, d) for d in dirnames]
+                dirnames[:] = []
             candidates += [os.path.join(dirpath, n) for n in sorted(filenames) if n.lower().endswith('.pdf')]
-    for full in candidates[:MAX_DOCUMENTS]:
-        if os.path.islink(full):
-            continue
-        found.append({'name': os.path.relpath(full, base), 'pages': pdf_pages(full)})
+        deeper = bounds.found_deeper(below, lambda p: p.lower().endswith('.pdf'))
+        if deeper:
+            _said(notes, '%s is %d folders deep: PDFs are listed %d folders deep at most'
+                  % (archives.shown_name(os.path.relpath(deeper, path)), os.path.relpath(deeper, path).count(os.sep),
+                     MAX_DEPTH + 1))
+    candidates = [full for full in candidates if not os.path.islink(full)]
+    for full in bounds.kept(candidates, 'PDF files', notes if notes is not None else [], MAX_DOCUMENTS,
+                            verb='listed', text=None):
+        name = os.path.relpath(full, base)
+        found.append({'name': name, 'pages': pdf_pages(full, notes, name)})
     return found
 
 
-def submission_facts(path):
+def submission_facts(path, notes=None):
     """What a grade record takes from the submission itself: ``participant`` (Moodle's number in the
-    folder's name, or None), ``folder`` (that name), ``documents`` (the PDFs handed in)."""
+    folder's name, or None), ``folder`` (that name), ``documents`` (the PDFs handed in; their caps
+    said in ``notes``)."""
     name = os.path.basename(os.path.abspath(path).rstrip('/'))
-    return {'participant': participant_number(name), 'folder': name, 'documents': documents(path)}
+    return {'participant': participant_number(name), 'folder': name, 'documents': documents(path, notes)}

@@ -73,12 +73,13 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
               'fixes': fixes, 'static': None, 'threshold_value': SHEETS[wanted_sheet or 'altitude'].threshold,
               'calls_service': False, 'namespace': '/', 'main_launch': None, 'threshold_launch': None,
               'threshold_run_value': None, 'handed_in_launch': None,
-              'comments': None, 'facts': documents.submission_facts(upload)}
+              'comments': None, 'facts': documents.submission_facts(upload, capped)}
     uploads = []
     try:
         pkg_source = package.open_submission(upload, os.path.join(out, 'unpacked'), notes, fixes, uploads=uploads)
     except archives.UnpackError as err:
         record['refused'] = str(err)
+        notes.extend(capped)
         return record
     package.copy_package(pkg_source, os.path.join(out, boxenv.CODE_COPY), [])  # as handed in, for the teacher (code/)
     name = package.package_name(os.path.join(pkg_source, 'package.xml')) or PACKAGE
@@ -115,8 +116,12 @@ def inspect(upload, ws, out, wanted_sheet=None, draw=None):
     if code:
         comments, lines = source.comment_ratio(code)
         record['comments'] = {'comments': comments, 'code': lines, 'files': [os.path.relpath(p, pkg) for p in code],
-                              'units': code_quality.comment_units(code, pkg),
-                              'quality': code_quality.quality_signals(code, pkg)}
+                              'units': bounds.kept(code_quality.comment_units(code, pkg), 'functions and blocks of '
+                                                   'the code', capped, code_quality.MAX_UNITS,
+                                                   verb='judged for their comments', text=None),
+                              'quality': bounds.kept(code_quality.quality_signals(code, pkg), 'signs of bad '
+                                                     'practice in the code', capped, code_quality.MAX_SIGNALS,
+                                                     verb='listed', text=None)}
     if chosen is not None:
         exam = chosen.exam_nodes[0]
         static['launch'] = {'file': os.path.relpath(chosen.path, pkg), 'starts_drone': chosen.starts_drone(sheet),

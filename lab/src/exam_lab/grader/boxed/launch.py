@@ -11,8 +11,8 @@ What it reads is the student's, and only that (issue 26): ``$(env)`` / ``$(opten
 from the ``env`` mapping given (the box's environment), never from the grader's own; every file a
 launch file names is opened only when its real path (links and ``..`` resolved) is inside the package
 folder, else the analysis says "file outside the package: ... not read"; YAML with anchors or aliases
-is refused (a 0.8 KB file of nested aliases expands to millions of parameters); at most
-``MAX_FILES`` launch files are read. ``<param textfile= binfile= command=>`` are never read.
+is refused (a 0.8 KB file of nested aliases expands to millions of parameters); at most ``MAX_FILES``
+launch files are read, ``MAX_INCLUDE_DEPTH`` deep. ``<param textfile= binfile= command=>`` are never read.
 
 Every parameter keeps the place its literal value comes from (an attribute of an element, a key of
 inline YAML or of a YAML file), followed through ``$(arg ...)``, so the grader can change a threshold
@@ -32,9 +32,8 @@ from exam_lab.grader.score.sheets import PACKAGE, SHEETS, sheet_of_drone
 _SUBST = re.compile(r'\$\((\w+)((?:\s+[^)]*)?)\)')
 
 ALIASES_REFUSED = 'YAML anchors and aliases (&name, *name) are refused: a few can expand to millions of values'
-#: Launch files read for one analysis (the top one and its includes, each time it is included).
-MAX_FILES = 50
-
+#: Launch files read for one analysis (the top one and its includes, each time), how deep includes go.
+MAX_FILES, MAX_INCLUDE_DEPTH = 50, 6
 #: A node; ``type_origin`` is where its ``type`` literal lives (an :class:`Origin`), for a fix.
 Node = collections.namedtuple('Node', 'pkg type name ns file type_origin')
 #: A parameter: full name, value, where its literal lives (:class:`Origin` or None), owning node.
@@ -484,8 +483,10 @@ def _read_include(analysis, element, scope, ns, depth):
     if real is None:
         analysis.problems.append(_outside('include %s' % element.get('file')))
         return
-    if depth > 5 or not os.path.isfile(real):
-        analysis.problems.append('include %s not found' % element.get('file'))
+    if depth >= MAX_INCLUDE_DEPTH or not os.path.isfile(real):
+        analysis.problems.append('include %s %s' % (element.get('file'), 'not found' if depth < MAX_INCLUDE_DEPTH else
+                                                    'not read: it is included %d deep (at most %d)'
+                                                    % (depth + 1, MAX_INCLUDE_DEPTH)))
         return
     passed = {}
     all_args = element.get('pass_all_args')

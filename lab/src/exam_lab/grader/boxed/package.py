@@ -9,8 +9,8 @@ import os
 import shutil
 import xml.etree.ElementTree as ET
 
-from exam_lab.grader.boxed.archives import (ARCHIVE_ENDINGS, MAX_LISTED, SKIPPED_DIRS, Budget, UnpackError,
-                                            archive_kind, listed, safe_extract, shown_name, what_it_is)
+from exam_lab.grader.boxed.archives import (ARCHIVE_ENDINGS, MAX_LISTED, MAX_PARTS, SKIPPED_DIRS, Budget,
+                                            UnpackError, archive_kind, listed, safe_extract, shown_name, what_it_is)
 from exam_lab.grader.boxed.uploads import archive_date, choose_upload, version_number
 from exam_lab.grader.score.sheets import PACKAGE, drone_packages
 
@@ -18,6 +18,10 @@ from exam_lab.grader.score.sheets import PACKAGE, drone_packages
 MAX_DEPTH = 4
 #: How many archives deep a package may sit (a zip holding the package's zip, holding ...).
 MAX_NESTING = 2
+#: What is said of a package beyond MAX_DEPTH, of an archive beyond MAX_NESTING: the cap that left it out.
+_TOO_DEEP = 'the grader looks for the package %d folders deep at most' % MAX_DEPTH
+_TOO_NESTED = 'the grader opens archives %d deep at most' % MAX_NESTING
+_BEYOND = (_TOO_DEEP + ')', _TOO_NESTED + ')')
 #: Packages that are the simulators, never a student's answer (a whole workspace holds them too).
 SIMULATORS = ('node_kit', 'drone_sim') + tuple(drone_packages())
 
@@ -50,13 +54,13 @@ def find_packages(root, name=PACKAGE, max_depth=MAX_DEPTH):
     return sorted(found, key=lambda p: (p.count(os.sep), p))
 
 
-def _student_packages(root):
+def _student_packages(root, max_depth=MAX_DEPTH):
     """Packages below ``root`` that may be the answer: ``exam`` first; else any that is no simulator,
     those with ``exam`` in their name first."""
-    exact = find_packages(root)
+    exact = find_packages(root, max_depth=max_depth)
     if exact:
         return exact
-    others = [p for p in find_packages(root, name=None)
+    others = [p for p in find_packages(root, name=None, max_depth=max_depth)
               if package_name(os.path.join(p, 'package.xml')) not in SIMULATORS]
     return sorted(others, key=lambda p: ('exam' not in (package_name(os.path.join(p, 'package.xml')) or ''),
                                          p.count(os.sep), p))
@@ -85,8 +89,8 @@ def open_submission(path, scratch, notes, fixes=None, budget=None, uploads=None)
         root = path
     found = _search(root, scratch, notes, fixes, budget, counter, 0, seen, uploads)
     if not found:
-        refused = [s for s in seen if '(refused: ' in s or 'cannot be opened' in s]
-        if refused:  # the reason is the archive that could not be opened, not a missing package
+        refused = [s for s in seen if '(refused: ' in s or 'cannot be opened' in s or s.endswith(_BEYOND)]
+        if refused:  # the reason is the archive that could not be opened, or a cap, not a missing package
             raise UnpackError(listed(refused))
         raise UnpackError('no catkin package (package.xml) in %s%s' % (
             os.path.basename(path), '; found: %s' % listed(seen) if seen else ' (it is empty)'))
@@ -115,7 +119,14 @@ def _search(root, scratch, notes, fixes, budget, counter, depth, seen, uploads):
     """Packages in ``root``, else in the archives it holds (each unpacked once, nested ones too); of
     several archives holding a package, only the chosen one's (:func:`choose_upload`)."""
     found = _student_packages(root)
+    if not found:  # one deeper than the search goes is said as that cap, not as no package at all
+        seen.extend('%s is %d folders deep (%s)' % (shown_name(os.path.relpath(os.path.join(p, 'package.xml'), root)),
+                                                   os.path.relpath(p, root).count(os.sep) + 1, _TOO_DEEP)
+                    for p in _student_packages(root, MAX_PARTS)[:1])
     if found or depth >= MAX_NESTING:
+        if not found:
+            seen.extend('%s is an archive inside archives (%s)' % (shown_name(os.path.relpath(a, root)), _TOO_NESTED)
+                        for a in sorted(_archives_in(root))[:1])
         return found
     holding = []
     for archive in sorted(_archives_in(root)):

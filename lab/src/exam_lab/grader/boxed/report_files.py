@@ -6,7 +6,7 @@ import os
 import re
 import zipfile
 
-from exam_lab.grader.boxed import archives
+from exam_lab.grader.boxed import archives, bounds
 from exam_lab.grader.score.records import REPORT_FILES
 
 #: Bytes of one file read as a report; how deep in the folder and in archives reports are looked for.
@@ -34,7 +34,9 @@ def kind_of(path):
     if head.startswith(b'PK\x03\x04'):
         try:
             with zipfile.ZipFile(path) as zf:
-                names = set(zf.namelist()[:1000])
+                # Every entry's name (ZipFile read them all with the central directory): a docx whose
+                # document.xml came after the 1000th entry was once "not a document" for a cap of no use.
+                names = set(zf.namelist())
                 if 'word/document.xml' in names:
                     return 'docx'
                 if 'mimetype' in names and zf.read('mimetype')[:100].startswith(b'application/vnd.oasis.opendocument.text'):
@@ -53,12 +55,18 @@ def copy_name(index, name):
     return '%d-%s' % (index + 1, base[-150:])
 
 
-def find_reports(upload, scratch, notes):
+def _document(path):
+    return kind_of(path) in ('pdf', 'odt', 'docx', 'doc', 'rtf') or path.lower().endswith(DOCUMENT_ENDINGS)
+
+
+def find_reports(upload, scratch, notes, beyond=None):
     """``[(name as the teacher knows it, path)]`` of the report files of a submission (a folder, or
     one file: a document, a picture, an archive): its own files first, then the documents of its
-    archives (unpacked below ``scratch``, all within one budget), the same bytes once."""
+    archives (unpacked below ``scratch``, all within one budget), the same bytes once. When there is
+    none, a document beyond MAX_DEPTH folders or an archive beyond MAX_NESTING is said as that cap, in
+    ``notes`` and ``beyond``."""
     budget, found, seen = archives.Budget(), [], {}
-    counter = [0]
+    counter, below, nested = [0], [], []
 
     def look(root, shown, nesting, pictures):
         if os.path.isfile(root):
@@ -68,7 +76,10 @@ def find_reports(upload, scratch, notes):
             for dirpath, dirnames, filenames in os.walk(root):
                 depth = os.path.relpath(dirpath, root).count(os.sep)
                 dirnames[:] = sorted(d for d in dirnames if d not in archives.SKIPPED_DIRS and not d.startswith('.')
-                                     and not os.path.islink(os.path.join(dirpath, d))) if depth < MAX_DEPTH else []
+                                     and not os.path.islink(os.path.join(dirpath, d)))
+                if depth >= MAX_DEPTH:
+                    below.extend((os.path.join(dirpath, d), root, shown) for d in dirnames)
+                    dirnames[:] = []
                 for name in sorted(filenames):
                     full = os.path.join(dirpath, name)
                     if not os.path.islink(full) and os.path.isfile(full) and not name.startswith('.'):
@@ -81,8 +92,8 @@ def find_reports(upload, scratch, notes):
             if kind in ('pdf', 'odt', 'docx', 'doc', 'rtf') or lower.endswith(DOCUMENT_ENDINGS) or \
                     (pictures and (kind == 'image' or lower.endswith(PICTURE_ENDINGS))):
                 found.append((name, full))
-            elif nesting < MAX_NESTING and kind == 'other' and archives.archive_kind(full):
-                inner.append((full, name))
+            elif kind == 'other' and archives.archive_kind(full):
+                (inner if nesting < MAX_NESTING else nested).append((full, name))
         for full, name in inner:
             target = os.path.join(scratch, 'unpacked%d' % counter[0])
             counter[0] += 1
@@ -93,6 +104,19 @@ def find_reports(upload, scratch, notes):
                 continue
             look(target, name, nesting + 1, False)
     look(upload, os.path.basename(upload) if os.path.isfile(upload) else None, 0, True)
+    if not found:
+        said = beyond if beyond is not None else []
+        for folder, root, shown in below:
+            deeper = bounds.found_deeper([folder], _document)
+            if deeper:
+                relative = os.path.relpath(deeper, root)
+                said.append('%s is %d folders deep (the reader looks for a report %d folders deep at most)'
+                            % (archives.shown_name(relative if shown is None else '%s/%s' % (shown, relative)),
+                               relative.count(os.sep), MAX_DEPTH + 1))
+                break
+        said.extend('%s is an archive inside archives, not searched for a report (the reader opens archives %d '
+                    'deep at most)' % (archives.shown_name(name), MAX_NESTING) for _, name in nested[:1])
+        notes.extend(said)
     unique = []
     for name, full in found:
         digest = _digest(full)

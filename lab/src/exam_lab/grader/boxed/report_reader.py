@@ -182,6 +182,8 @@ class Pages(object):
                     and fields[4].isdigit() and fields[2] == 'image':
                 page, num, w, h = int(fields[0]), int(fields[1]), int(fields[3]), int(fields[4])
                 if w * h > MAX_PICTURE_PIXELS:
+                    self.notes.append('page %d: a picture of %d x %d pixels (at most %d million): the page\'s image '
+                                      'read instead' % (page, w, h, MAX_PICTURE_PIXELS // 10 ** 6))
                     too_large.add(page)
                 elif w >= 100 and h >= 30:
                     found.setdefault(page, []).append((w, h, num))
@@ -297,10 +299,11 @@ class Reader(Pages, Ocr, Tools):
 
     def read(self, upload):
         """The record's value of the reports in ``upload``."""
-        files, pages = [], []
-        found = find_reports(upload, self.scratch, self.notes)
+        files, pages, beyond = [], [], []
+        found = find_reports(upload, self.scratch, self.notes, beyond)
         if not found:
-            return self.value('no report handed in (no PDF, no document, no picture among the files)', files, pages)
+            return self.value('; '.join(beyond) or 'no report handed in (no PDF, no document, no picture among the '
+                              'files)', files, pages)
         for index, (name, path) in enumerate(found):
             entry = {'name': bounds.cut(name, 255), 'kind': kind_of(path), 'converted': False, 'pages': 0, 'note': '',
                      'state': 'not read', 'copy': None}
@@ -308,7 +311,7 @@ class Reader(Pages, Ocr, Tools):
             try:
                 size = os.path.getsize(path)
                 if size > FILE_BYTES:
-                    raise ToolFailed('%d MB (the reader reads at most %d MB)' % (size >> 20, FILE_BYTES >> 20))
+                    raise ToolFailed('%d bytes, over the %d the reader reads of one file' % (size, FILE_BYTES))
                 entry['copy'] = self.keep(index, name, path)
                 read = self.read_file(index, entry, path, REPORT_PAGES - len(pages))
             except ToolFailed as err:

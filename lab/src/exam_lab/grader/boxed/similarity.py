@@ -52,25 +52,28 @@ class SimilarityError(Exception):
     """The detector could not be installed or run."""
 
 
-def code_files(package):
-    """The package's files that are compared, relative to it."""
+def code_files(package, large=None):
+    """The package's code files that are compared, relative to it; those over MAX_FILE_BYTES (data,
+    not code a student writes) are not, and go into ``large`` when given."""
     found = []
     for dirpath, dirnames, filenames in os.walk(package):
         dirnames[:] = sorted(d for d in dirnames if not d.startswith('.') and d not in ('build', 'devel'))
         for name in sorted(filenames):
             full = os.path.join(dirpath, name)
-            if (name.endswith(CODE_SUFFIXES) or name in CODE_NAMES) and not os.path.islink(full) \
-                    and os.path.getsize(full) <= MAX_FILE_BYTES:
-                found.append(os.path.relpath(full, package))
+            if (name.endswith(CODE_SUFFIXES) or name in CODE_NAMES) and not os.path.islink(full):
+                if os.path.getsize(full) <= MAX_FILE_BYTES:
+                    found.append(os.path.relpath(full, package))
+                elif large is not None:
+                    large.append(os.path.relpath(full, package))
     return sorted(found)
 
 
-def student_code(package):
+def student_code(package, large=None):
     """``(files compared, files left out)`` of one student's package: its code files, programs
     (Python, C++) before launch files and the build files, within MAX_STUDENT_FILES and
-    MAX_STUDENT_BYTES."""
+    MAX_STUDENT_BYTES (those over MAX_FILE_BYTES into ``large``: :func:`code_files`)."""
     order = {'.launch': 1, '.xml': 2, '.txt': 2}
-    found = sorted(code_files(package), key=lambda r: (order.get(os.path.splitext(r)[1], 0), r))
+    found = sorted(code_files(package, large), key=lambda r: (order.get(os.path.splitext(r)[1], 0), r))
     taken, left, size = [], [], 0
     for relative in found:
         nbytes = os.path.getsize(os.path.join(package, relative))
@@ -95,7 +98,8 @@ def stage(submissions, target):
         scratch = os.path.join(target, 'unpacked-%d' % index)
         try:
             package = open_submission(path, scratch, notes_here)
-            taken, left = student_code(package)
+            large = []
+            taken, left = student_code(package, large)
             folder = os.path.join(target, 'code', str(index))
             for relative in taken:
                 os.makedirs(os.path.dirname(os.path.join(folder, relative)), exist_ok=True)
@@ -109,6 +113,9 @@ def stage(submissions, target):
             notes.append('%s: %d code file(s) compared, %d left out (at most %d files and %d bytes of a student): %s'
                          % (name, len(taken), len(left), MAX_STUDENT_FILES, MAX_STUDENT_BYTES,
                             archives.listed([archives.shown_name(r) for r in left])))
+        if large:
+            notes.append('%s: %d code file(s) not compared, each over the %d bytes the check reads of one file: %s'
+                         % (name, len(large), MAX_FILE_BYTES, archives.listed([archives.shown_name(r) for r in large])))
         if os.path.isdir(folder):
             staged[name] = folder
         else:

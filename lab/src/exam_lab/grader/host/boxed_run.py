@@ -75,12 +75,23 @@ class Boxed(object):
                 return contract.read_record(os.path.join(self.out, record.FILE), record, record.MAX_BYTES)
             except records.RecordError as err:
                 why = 'its record was refused: %s' % err
-        elif why is None:  # bwrap reports its child's death by signal N as exit 128 + N
-            signum = -status if status < 0 else status - 128 if status > 128 else None
-            why = 'it failed (exit %d)' % status if signum is None else \
-                'it was killed by signal %d (its bounds: %d s of CPU, %d MB of address space)' % (signum, cpu, memory >> 20)
         tail = session_tail(contract.read_capped(log, 4096) or '')
+        if status not in (0, None) and why is None:  # bwrap reports its child's death by signal N as exit 128 + N
+            why, tail = bound_hit(status, tail, cpu, memory)
         raise InspectionFailed('%s%s' % (why, ': %s' % tail if tail else ''))
+
+
+def bound_hit(status, tail, cpu, memory):
+    """``(why, tail)`` of a box's module that ended with ``status`` (not 0), its log ending in ``tail``,
+    run within ``cpu`` s and ``memory`` bytes of address space: a bound it hit said as that bound (its
+    traceback left out: Python's MemoryError), else its exit or signal (its bounds named)."""
+    signum = -status if status < 0 else status - 128 if status > 128 else None
+    lines = tail.splitlines()
+    if signum is None and lines and lines[-1].startswith('MemoryError'):
+        return 'it ran out of memory: its bound is %d MB of address space' % (memory >> 20), ''
+    if signum is None:
+        return 'it failed (exit %d)' % status, tail
+    return 'it was killed by signal %d (its bounds: %d s of CPU, %d MB of address space)' % (signum, cpu, memory >> 20), tail
 
 
 

@@ -1,5 +1,5 @@
 """One run of a submission: a master, the student's launch in its box, the probe beside it; what its
-output and the probe's result say (:func:`run_one`), within what is left of the student's budget
+output and the probe's result say (:func:`run_one`: facts, for the rubric to judge), within what is left of the student's budget
 (:class:`Budget`). Root's side: it reads roslaunch's output and the probe's JSON, both capped, and
 parses no byte of the student's. :mod:`~exam_lab.grader.host.session` flies the runs of a session one
 after the other, :mod:`~exam_lab.grader.host.side_by_side` both at once.
@@ -13,8 +13,8 @@ import time
 from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
 from exam_lab.grader.contract import read_capped, read_record
 from exam_lab.grader.score.records import LAUNCH_ENDED, MAX_ENDED, MAX_LOG_TEXT, PlanRecord, ProbeRecord, RecordError
+from exam_lab.grader.score.runs import WATCHED_DEATHS
 from exam_lab.grader.score.safe_text import clean as clean_text
-from exam_lab.grader.score.sheets import request_meaning
 from exam_lab.harness.supervisor import ros_env, workspace_env
 from exam_lab.harness.wait import wait_until
 
@@ -61,79 +61,10 @@ def launch_outcome(output, workspace=None):
         if match:
             ended.append({'node': match.group(1) or required or '?', 'how': match.group(2),
                           'detail': match.group(3) or ''})
-    # A node respawned in a loop is reported ended as often: its first MAX_ENDED ends say it.
+    # A node respawned in a loop is reported ended as often: its first ends say it, room left for the
+    # judge's own (the rubric counts them with these: score/runs.py).
     return {'ended': ended[:MAX_ENDED - WATCHED_DEATHS], 'not_started': [line[:500] for line in _NOT_STARTED.findall(text)[:50]],
             'tail': tail(clean(output))}
-
-
-#: The most deaths of one run the judge's watch reports.
-WATCHED_DEATHS = 20
-
-
-def watched_deaths(probe):
-    """The deaths the probe's :class:`~exam_lab.grader.judge.graph.NodeWatch` saw (a node started again
-    or gone during the run) in its record (a :class:`~exam_lab.grader.score.records.ProbeRecord`'s
-    value: checked, its text clean), as entries of :func:`launch_outcome`'s ``ended``: they cost what a
-    death in roslaunch's words costs, and they are the judge's own, whatever roslaunch's log kept."""
-    return [{'node': d['node'][:100], 'how': 'died', 'detail': 'seen by the judge: %s' % d['detail'][:200]}
-            for d in probe['node_watch']['deaths'][:WATCHED_DEATHS]]
-
-
-def warned_in_long_excursion(probe):
-    """True when the main run saw a WARNING call while the value was above the threshold for long."""
-    schedule = (probe or {}).get('schedule') or {}
-    if 'long_up' not in schedule:
-        return False
-    return any(request_meaning(status) == 'WARNING' and schedule['long_up'] <= t <= schedule['long_down']
-               for t, status in probe.get('calls', []))
-
-
-def clock_problem(clock):
-    """Why a run whose probe saw ``clock`` (its ``ClockWatch``) is not the judge's to measure, or None:
-    someone set ``/use_sim_time`` or published ``/clock`` (the node under test counting on a clock of
-    its own making; the probe times on the wall clock regardless)."""
-    if not isinstance(clock, dict):
-        return 'the probe did not say whether /clock was published'
-    said = []
-    if any(clock.get('use_sim_time') or []):
-        said.append('/use_sim_time was set on the master')
-    if clock.get('messages') or clock.get('publishers'):
-        said.append('/clock was published (%s messages%s)' % (
-            clock.get('messages', 0),
-            ' by %s' % ', '.join(map(str, clock['publishers'])) if clock.get('publishers') else ''))
-    if said:
-        return '%s: the grader times the node on the wall clock only; grade it by hand' % ' and '.join(said)
-    return None
-
-
-def probe_problem(result, started, finished, *, kind, delay):
-    """Why the probe's ``result`` cannot be this run's measurement, or None: it has times, nobody set
-    the time (:func:`clock_problem`), every time it records (wall clock) must lie between the probe's
-    start and the result's arrival, and the flight must have lasted its schedule (in a ``kind``
-    'main' run, the long excursion at least the rule's ``delay``)."""
-    schedule = result.get('schedule') or {}
-    times = [t for t in [result.get('t0')] + list(schedule.values()) if isinstance(t, (int, float))]
-    if not times:
-        return 'the probe\'s result has no times'
-    problem = clock_problem(result.get('clock'))
-    if problem:
-        return problem
-    if min(times) < started - 1.0 or max(times) > finished + 1.0:
-        return 'the probe\'s times (%.1f to %.1f) are not within its run (%.1f to %.1f)' % (
-            min(times), max(times), started, finished)
-    if kind == 'main' and 'long_up' in schedule and 'long_down' in schedule \
-            and schedule['long_down'] - schedule['long_up'] < delay:
-        return 'the long excursion lasted %.1f s, less than the %.1f s delay' % (
-            schedule['long_down'] - schedule['long_up'], delay)
-    return None
-
-
-def warning_latency(probe):
-    """Seconds from the long excursion's start to the main run's first WARNING in it, or None."""
-    schedule = (probe or {}).get('schedule') or {}
-    times = [t for t, status in (probe or {}).get('calls', []) if request_meaning(status) == 'WARNING'
-             and schedule.get('long_up', float('inf')) <= t <= schedule.get('long_down', 0.0)]
-    return min(times) - schedule['long_up'] if times else None
 
 
 def capped_log(sup, name):
@@ -192,22 +123,12 @@ class Budget(object):
         return sentence
 
 
-def master_problem(master, died):
-    """Why a run whose master ended early (``died``) or hit its memory bound (``master``: the cgroup's
-    :func:`~exam_lab.grader.host.cgroups.memory_use`) is not one to score, or None."""
-    memory = master.get('memory') or {}
-    if memory.get('oom_kills'):
-        return ('the master the node talks to went over its memory bound of %d MB (%d process(es) killed): '
-                'the node\'s parameters or messages filled it' % ((memory.get('limit') or 0) >> 20, memory['oom_kills']))
-    if died:
-        return 'the master the node talks to ended during the run'
-    return None
-
-
 def run_one(sup, job, run, base_env, box, budget):
-    """Start a master, the student's launch (in the box) and the probe; return the run's record. The
-    probe is waited for at most the run's limit or what is left of the ``budget``. The judge's folder
-    is the run's own (``run['judge_home']``) when it has one, else the job's."""
+    """Start a master, the student's launch (in the box) and the probe; return the run's record: what
+    happened (the probe's result as read, when it ran, whether its master ended), which the rubric
+    judges (:func:`~exam_lab.grader.score.runs.judged_run`), never the session. The probe is waited
+    for at most the run's limit or what is left of the ``budget``. The judge's folder is the run's own
+    (``run['judge_home']``) when it has one, else the job's."""
     tag = run['tag']
     log_dir, judge_dir = sup.log_dir, run.get('judge_home') or job.judge_home
     reset_memory_peak(box.judge_cgroups.get('master', []))
@@ -255,13 +176,10 @@ def run_one(sup, job, run, base_env, box, budget):
         record['probe'], why = probe_record(result_path)
         if why:
             record['probe_error'] = why
+    record['probe_wall'] = [started_wall, time.time()]  # what the rubric judges its times by (score/runs.py)
     if record['probe'] is not None:
-        record['launch']['ended'].extend(watched_deaths(record['probe']))  # whether or not the run is refused
         with open(os.path.join(log_dir, 'probe-%s.json' % tag), 'w') as f:
             json.dump(record['probe'], f, indent=1, sort_keys=True)
-        problem = probe_problem(record['probe'], started_wall, time.time(), kind=plan.kind, delay=plan.delay)
-        if problem:
-            refuse(record, problem)
     elif 'probe_error' not in record and record.get('budget'):
         record['probe_error'] = record['budget']
     elif 'probe_error' not in record:
@@ -273,9 +191,7 @@ def run_one(sup, job, run, base_env, box, budget):
     record['master']['memory'] = memory_use(box.judge_cgroups.get('master', []))
     if record['master']['memory']:  # this run's kills: the slot's master cgroup serves every run
         record['master']['memory']['oom_kills'] -= killed_before
-    problem = master_problem(record['master'], master_died)
-    if problem:
-        refuse(record, problem)
+    record['master']['died'] = master_died
     return record
 
 
@@ -288,15 +204,6 @@ def probe_record(path):
         return read_record(path, ProbeRecord, ProbeRecord.MAX_BYTES).value, None
     except RecordError as err:
         return None, 'the probe\'s result was refused (a crash of the run): %s' % err
-
-
-def refuse(record, problem):
-    """A run's result that is not its measurement (``problem``: why): the rubric sees no probe; the
-    result stays in the record as ``refused_probe`` (the teacher's flight plot draws it)."""
-    if record['probe'] is not None:
-        record['refused_probe'] = record['probe']
-    record['probe'], record['probe_refused'] = None, problem
-    record['probe_error'] = 'result refused: %s' % problem
 
 
 def judge_environment(judge_dir, box):

@@ -27,13 +27,15 @@ file has a threshold the grader can change, the threshold run: each ``{"tag", "l
 file, as the box sees it), "plan" (for the probe)}`` (and, for the run flown in the submission's second
 box, its ``box`` and ``judge_home``), ``side_by_side`` (the two runs at once:
 :mod:`~exam_lab.grader.host.side_by_side`; otherwise one after the other, here). Writes ``<log_dir>/session.json``: ``{"build":
-{...}, "runs": [{"tag", "probe" (the probe's result or None), "probe_refused" (why a result was
-refused), "master" (its memory, its uid), "probe_uid", "launch": {...}}], "survivors": n, "launch_check",
-"budget_used" (the sentence when the budget stopped a step, else None), "outcome"}``: a
+{...}, "runs": [{"tag", "probe" (the probe's result as read, or None), "probe_wall" (the wall times
+the probe started and its result was in), "master" (its memory, its uid, whether it ended during the
+run), "probe_uid", "launch": {...}}], "survivors": n, "launch_check", "budget_used" (the sentence when
+the budget stopped a step, else None), "outcome"}``: a
 :class:`~exam_lab.grader.score.records.SessionRecord` (checked, every text in it made safe there), and
-each probe's result as ``<log_dir>/probe-<tag>.json`` (its checked record; a result refused for its
-times or the master is kept in the run as ``refused_probe``), and each step's wall and CPU time as
-``<log_dir>/timings.json`` (:mod:`~exam_lab.grader.host.timings`).
+each probe's result as ``<log_dir>/probe-<tag>.json`` (its checked record), and each step's wall and
+CPU time as ``<log_dir>/timings.json`` (:mod:`~exam_lab.grader.host.timings`). Whether a run counts
+(its result's times, the clock, the master) is the rubric's to say (:mod:`~exam_lab.grader.score.runs`),
+from these facts, again at each rescore.
 """
 import json
 import os
@@ -41,11 +43,11 @@ import sys
 
 from exam_lab.grader.host import side_by_side as both
 from exam_lab.grader.host.run import (
-    MIN_RUN_S, RUN_STOP_S, STEP_STOP_S, Budget, base_environment, capped_log, judge_environment,
-    run_one, tail, warned_in_long_excursion, warning_latency)
+    MIN_RUN_S, RUN_STOP_S, STEP_STOP_S, Budget, base_environment, capped_log, judge_environment, run_one, tail)
 from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.host.timings import Stopwatch, boxes_cpu
 from exam_lab.grader.score.records import JobRecord, Outcome, RecordError, SessionRecord
+from exam_lab.grader.score.runs import judged_run, warned_in_long_excursion, warning_latency
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.harness.supervisor import Supervisor
 
@@ -153,11 +155,12 @@ def session(job, job_path=None, watch=None):
 
 def one_after_the_other(sup, job, base_env, box, budget, result):
     """The runs of ``job`` in this process, the threshold run after the main run and only when the node
-    warned in it, waiting for its late WARNING as long as the main run's took; into ``result``."""
+    warned in it (its result counted as the rubric counts it: :func:`judged_run`), waiting for its late
+    WARNING as long as the main run's took; into ``result``."""
     for run in job.runs:
         run = {key: value for key, value in run.items() if key not in ('box', 'judge_home')}  # all in ``box``
         if run['tag'] == 'threshold':
-            main = result['runs'][0]['probe'] if result['runs'] else None
+            main = judged_run(result['runs'][0])['probe'] if result['runs'] else None
             if not warned_in_long_excursion(main):
                 result['threshold_skipped'] = 'the node never warned in the main run'
                 break

@@ -16,12 +16,11 @@ import subprocess
 import sys
 
 from exam_lab.grader.host import bwrap
-from exam_lab.grader.host.run import (
-    STEP_STOP_S, Budget, base_environment, judge_environment, probe_record, run_one, tail, warned_in_long_excursion,
-    warning_latency)
+from exam_lab.grader.host.run import STEP_STOP_S, Budget, base_environment, judge_environment, probe_record, run_one, tail
 from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.host.timings import Stopwatch, boxes_cpu
 from exam_lab.grader.score.records import JobRecord, RecordError
+from exam_lab.grader.score.runs import judged_run, warned_in_long_excursion, warning_latency
 from exam_lab.harness.supervisor import Supervisor, end_pids, marked
 from exam_lab.harness.wait import wait_until
 
@@ -74,8 +73,8 @@ def side_by_side(sup, job, job_path, budget, result):
     of the build, a judge of its own) and its supervisor: a node sees the same in either, and neither
     run can reach the other. Once the main run's result is in (or it ended without one), the threshold
     run is told whether the node warned and how late (:data:`MAIN_WORD`), so it waits for a late WARNING
-    as long as the main run's took; a threshold run whose main run never warned is not kept, as when
-    it is not flown. Which run flies in the copy was drawn by the runner (:func:`~exam_lab.grader.runner.plan_job`):
+    as long as the main run's took; a threshold run whose main run never warned (its result counted as
+    the rubric counts it) is not kept, as when it is not flown. Which run flies in the copy was drawn by the runner (:func:`~exam_lab.grader.runner.plan_job`):
     a node that tells the copy (its uid, its files' times) learns nothing of its run. Into ``result``."""
     main, threshold = job.runs
     word = os.path.join(threshold.get('judge_home') or job.judge_home, MAIN_WORD)
@@ -99,7 +98,7 @@ def side_by_side(sup, job, job_path, budget, result):
     runs = [read_run(job.log_dir, tag, sup) for tag in started]
     result['survivors'] += sum(run['survivors'] for run in runs)
     result['runs'] = runs[:1]
-    if not warned_in_long_excursion(runs[0]['probe']):
+    if not warned_in_long_excursion(judged_run(runs[0])['probe']):
         result['threshold_skipped'] = 'the node never warned in the main run'
     else:
         result['runs'].append(runs[1])

@@ -35,11 +35,12 @@ LIMIT = 1e6
 
 
 def load_runs(folder):
-    """``[(tag, probe result)]`` of the runs whose probe gave a result, a result refused for its times or
-    its master too (``refused_probe``), from the measurements the grading kept in ``folder``
-    (:class:`~exam_lab.grader.score.kept.MeasurementsRecord`, the grader's own file, read as a record:
-    capped, checked): their session is the :class:`~exam_lab.grader.score.records.SessionRecord` made
-    when the student was graded, its text made safe there. ``[]`` without measurements; raises
+    """``[(tag, probe result)]`` of the runs whose probe gave a result, one the rubric refuses (its
+    times, its master) too (kept as ``refused_probe`` by a grader of before 2026-12-02), from the
+    measurements the grading kept in ``folder`` (:class:`~exam_lab.grader.score.kept.MeasurementsRecord`,
+    the grader's own file, read as a record: capped, checked): their session is the
+    :class:`~exam_lab.grader.score.records.SessionRecord` made when the student was graded, its text
+    made safe there. ``[]`` without measurements; raises
     :class:`~exam_lab.grader.score.records.RecordError` (naming the file and the field) when they are
     not a record. Drawn as they are: a value out of range only costs what :class:`Clamp` leaves out."""
     path = os.path.join(folder, MEASUREMENTS)

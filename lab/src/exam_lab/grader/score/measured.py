@@ -6,13 +6,20 @@ Every function here takes the records as they are kept (dicts, from ``measuremen
 or as views, and reads views only.
 """
 from exam_lab.grader.score import fields, records
+from exam_lab.grader.score.runs import judged
 from exam_lab.grader.score.sheets import ITEMS
 
 
 def session_of(session):
-    """The view of a session's record (:class:`~exam_lab.grader.score.records.SessionRecord`); an
-    empty one for None (a session that did not run: every field None)."""
-    return fields.view(session or {}, records.SessionRecord.SCHEMA)
+    """The view of a session's record (:class:`~exam_lab.grader.score.records.SessionRecord`) as the
+    rubric counts its runs (:func:`~exam_lab.grader.score.runs.judged`: a result that is not its run's
+    measurement set aside); an empty one for None (a session that did not run: every field None). A
+    view is one already: given as it is."""
+    if isinstance(session, fields.Fields):
+        return session
+    if isinstance(session, records.Record):
+        session = session.value
+    return fields.view(judged(session or {}), records.SessionRecord.SCHEMA)
 
 
 def static_of(static):

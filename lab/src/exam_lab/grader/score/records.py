@@ -326,7 +326,11 @@ _RUN = {
     'probe_error': Optional(Text(MAX_LOG_TEXT)), 'probe_refused': Optional(Text()),
     'probe_status': Optional(Maybe(Number(-1e6, 1e6, integer=True))),
     'master': {'uid': Maybe(Number(0, 2 ** 32, integer=True)),
-               'memory': Optional(Maybe({'limit': Maybe(_COUNT), 'peak': Maybe(_COUNT), 'oom_kills': Number(integer=True)}))},
+               'memory': Optional(Maybe({'limit': Maybe(_COUNT), 'peak': Maybe(_COUNT), 'oom_kills': Number(integer=True)})),
+               'died': Optional(bool)},
+    # The raw facts the rubric judges the run on (score/runs.py); a run kept without them was judged
+    # by its session (probe_refused, refused_probe).
+    'probe_wall': Optional(Row(_TIME, _TIME)),
     'probe_uid': Optional(Maybe(Number(0, 2 ** 32, integer=True))),
     'launch': {'ended': Items({'node': _NAME, 'how': OneOf('died', 'finished cleanly'), 'detail': Text()}, MAX_ENDED),
                'not_started': Items(Text(), 50), 'tail': Text(MAX_LOG_TEXT)},
@@ -338,7 +342,8 @@ _RUN = {
 class SessionRecord(Record):
     """How one grading's session went (:mod:`exam_lab.grader.host.session`, ``session.json``): roslaunch's
     check of the launch file, the build, each run (its probe's :class:`ProbeRecord` or why there is none,
-    roslaunch's words about the nodes), the processes left, the budget; ``outcome``, an
+    when the probe ran, its master, roslaunch's words about the nodes: facts, which the rubric judges,
+    :mod:`~exam_lab.grader.score.runs`), the processes left, the budget; ``outcome``, an
     :class:`Outcome` (a member, the record made). The runner makes one too when no session ran (``error``, ``refused``,
     ``no_node``): the measurements a rescore reads hold this record."""
     FILE = 'session.json'
