@@ -56,6 +56,8 @@ MAX_PAGE_POINTS = 14400
 #: on A4, 215 dpi: tesseract reads it as well as at 300 and a third faster); a picture handed in (larger ones are not read).
 PREVIEW_PIXELS = 1400
 OCR_PIXELS = 2500
+#: Pages pdftoppm renders at a time for the review page (their PPMs in the box's /tmp: 6 MB each at most).
+RENDER_PAGES = 8
 MAX_PICTURE_PIXELS = 40 * 1000 * 1000
 #: A page whose text layer holds fewer letters and digits than this is read by OCR.
 MIN_TEXT = 20
@@ -125,17 +127,18 @@ class Pages(object):
                                                                                        MAX_PAGE_POINTS // 72))
         layout = self.text(path, count, ['-layout'])
         boxes = self.word_boxes(path, count)
-        pictures = self.pictures(path, count)
+        texts = {number: '\n'.join(line['text'] for line in boxes.get(number, [])) for number in range(1, count + 1)}
+        scanned = {number for number, text in texts.items() if len(re.findall(r'\w', text)) < MIN_TEXT}
+        pictures = self.pictures(path, count, set(texts) - scanned)
         previews = self.render(index, path, count)
         pages, ocr = [], []
         for number in range(1, count + 1):
             lines = boxes.get(number, [])
-            text = '\n'.join(line['text'] for line in lines)
-            page = {'file': index, 'number': number, 'source': 'text', 'text': text,
+            page = {'file': index, 'number': number, 'source': 'text', 'text': texts[number],
                     'layout': layout[number - 1] if number <= len(layout) else '',
                     'confidence': None, 'unsure': [], 'pictures': 0, 'image': previews.get(number)}
             pages.append(page)
-            if len(re.findall(r'\w', text)) < MIN_TEXT:
+            if number in scanned:
                 page.update(source='ocr', layout='', text='')
                 ocr.append((page, None))
             elif pictures.get(number) and page['image']:
@@ -166,8 +169,9 @@ class Pages(object):
                   what='pdftotext')
         return parse_bbox(output)
 
-    def pictures(self, path, count):
-        """``{page: [(width, height, file)]}``: the pictures of each page large enough to hold text,
+    def pictures(self, path, count, wanted):
+        """``{page: [(width, height, file)]}``: the pictures of each page of ``wanted`` (those with a
+        text layer: a page without is read whole from its rendering) large enough to hold text,
         extracted at their own resolution (``pdfimages``: a screenshot is read best as it was taken);
         a page with a picture too large to decode holds none (its page's image is read instead)."""
         try:
@@ -185,7 +189,7 @@ class Pages(object):
                     too_large.add(page)
                 elif w >= 100 and h >= 30:
                     found.setdefault(page, []).append((w, h, num))
-        pages = sorted(set(found) - too_large)
+        pages = sorted(set(found) & set(wanted) - too_large)
         prefix = os.path.join(self.scratch, 'picture')
         extracted = {}
         for page in pages:
@@ -200,21 +204,37 @@ class Pages(object):
         return {page: [p for p in pictures if os.path.isfile(p[2])] for page, pictures in extracted.items()}
 
     def render(self, index, path, count):
-        """``{page: "report/page-<file>-<page>.png"}``: each page's PNG, its longest side PREVIEW_PIXELS."""
+        """``{page: "report/page-<file>-<page>.png"}``: each page's PNG, its longest side PREVIEW_PIXELS.
+        pdftoppm renders RENDER_PAGES pages at a time to PPM (its own PNG encoder takes ten times the
+        rendering: 0.44 s a scanned page) and PIL writes each PNG (0.04 s; zlib's level 1: as small as its
+        default on a scan, twice as fast), its PPM removed at once (the box's /tmp holds a few pages' PPMs,
+        never a file's 40)."""
+        from exam_lab.grader.boxed import report_images
         prefix = os.path.join(self.scratch, 'preview%d' % index)
-        try:
-            self.tool('pdftoppm', ['-png', '-scale-to', str(PREVIEW_PIXELS), '-f', '1', '-l', str(count), path, prefix],
-                      what='rendering its pages')
-        except ToolFailed as err:
-            self.notes.append('%s: pages not rendered: %s' % (os.path.basename(path), err))
         done = {}
-        for name in os.listdir(self.scratch):
-            match = re.match(r'^preview%d-0*(\d+)\.png$' % index, name)
-            if match and int(match.group(1)) <= count:
-                number = int(match.group(1))
-                target = 'page-%d-%d.png' % (index + 1, number)
-                os.rename(os.path.join(self.scratch, name), os.path.join(self.report, target))
-                done[number] = 'report/' + target
+        for first in range(1, count + 1, RENDER_PAGES):
+            last = min(count, first + RENDER_PAGES - 1)
+            failed = None
+            try:
+                self.tool('pdftoppm', ['-scale-to', str(PREVIEW_PIXELS), '-f', str(first), '-l', str(last), path, prefix],
+                          what='rendering its pages')
+            except ToolFailed as err:
+                failed = err
+                self.notes.append('%s: pages not rendered: %s' % (os.path.basename(path), err))
+            for name in sorted(os.listdir(self.scratch)):
+                match = re.match(r'^preview%d-0*(\d+)\.ppm$' % index, name)
+                if match and first <= int(match.group(1)) <= last:
+                    number, source = int(match.group(1)), os.path.join(self.scratch, name)
+                    target = 'page-%d-%d.png' % (index + 1, number)
+                    try:
+                        report_images.open_image(source, MAX_PICTURE_PIXELS).save(os.path.join(self.report, target),
+                                                                                 compress_level=1)
+                        done[number] = 'report/' + target
+                    except report_images.PictureError as err:  # a page pdftoppm cut short as it failed
+                        self.notes.append('%s: page %d not rendered: %s' % (os.path.basename(path), number, err))
+                    os.remove(source)
+            if failed is not None:
+                break
         return done
 
 
@@ -231,10 +251,11 @@ class Ocr(object):
 
         def page_image():
             if not rendered:
-                self.tool('pdftoppm', ['-gray', '-png', '-scale-to', str(OCR_PIXELS), '-f', str(page['number']), '-l',
+                self.tool('pdftoppm', ['-gray', '-scale-to', str(OCR_PIXELS), '-f', str(page['number']), '-l',
                                        str(page['number']), '-singlefile', path, stem],
                           what='rendering page %d' % page['number'])
-                rendered.append(report_images.open_image(stem + '.png', MAX_PICTURE_PIXELS))
+                rendered.append(report_images.open_image(stem + '.pgm', MAX_PICTURE_PIXELS))
+                os.remove(stem + '.pgm')
             return rendered[0]
         try:
             w, h = info['sizes'].get(page['number'], (595.0, 842.0))
@@ -270,8 +291,8 @@ class Ocr(object):
     def tesseract(self, image, stem, psm):
         """The words tesseract reads in the PIL ``image`` (:data:`Word`), underscores it dropped put back."""
         from exam_lab.grader.boxed import report_images
-        image.save(stem + '-in.png')
-        self.tool('tesseract', [stem + '-in.png', stem, '-l', 'fra+eng', '--psm', str(psm),
+        image.save(stem + '-in.pnm')  # not a PNG: its encoding took 0.15 s a page, an eighth of tesseract's time
+        self.tool('tesseract', [stem + '-in.pnm', stem, '-l', 'fra+eng', '--psm', str(psm),
                                 '-c', 'preserve_interword_spaces=1', 'tsv'], what='tesseract')
         with open(stem + '.tsv', 'rb') as f:
             words = parse_tsv(f.read(4 << 20).decode('utf-8', 'replace'))
