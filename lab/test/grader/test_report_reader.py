@@ -4,6 +4,7 @@ the tools students use) read, what was read checked on its page with its source;
 be read is "not read" with why; a class with such students grades the others."""
 import json
 import os
+import re
 import shutil
 import stat
 import zipfile
@@ -88,6 +89,19 @@ def test_an_odt_handed_in_is_converted_in_the_box(tmp_path):
     record, _ = read(tmp_path, 'fr_odt.odt')
     assert [(f['kind'], f['converted'], f['pages']) for f in record.files] == [('odt', True, 2)]
     page_with(record, ['Question 9', 'catkin_create_pkg exam rospy std_msgs mydrone'], 'text')
+
+
+def test_libreoffice_starts_from_the_readers_profile_without_its_graphics_tests(tmp_path):
+    """The reader's LibreOffice profile (report_reader.OFFICE_PROFILE) is made and last used by the installed
+    version: LibreOffice neither makes one nor runs its graphics tests, whose log a new profile gets."""
+    from exam_lab.grader.boxed import report_reader
+    assert re.match(r'^\d+\.\d+$', report_reader.office_version() or ''), report_reader.office_version()
+    reader = report_reader.Reader(str(tmp_path / 'out'))
+    pdf = reader.convert(0, os.path.join(DATA, 'fr_odt.odt'))
+    assert reader.pdf_info(pdf)['pages'] == 2
+    user = os.path.join(reader.scratch, 'lo-profile', 'user')
+    assert os.path.isdir(os.path.join(user, 'extensions'))  # LibreOffice used it
+    assert not os.path.exists(os.path.join(user, 'GraphicsRenderTests.log'))
 
 
 def test_an_image_only_scan_is_read_by_ocr_with_its_confidence(tmp_path):

@@ -7,7 +7,7 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader.boxed import report_files, report_text
+from exam_lab.grader.boxed import report_files, report_reader, report_text
 from exam_lab.grader.score.records import RecordError, ReportRecord
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'data', 'reports')
@@ -180,3 +180,14 @@ def test_a_pictures_place_is_the_ink_no_word_explains():
     assert len(regions) == 1
     x0, y0, x1, y1 = regions[0]
     assert 40 <= x0 <= 50 and 190 <= y0 <= 200 and 500 <= x1 <= 515 and 300 <= y1 <= 315, regions
+
+
+def test_libreoffices_version_is_read_from_its_registry(tmp_path):
+    registry = tmp_path / 'main.xcd'
+    registry.write_text('<oor:component-data oor:name="Setup"><node oor:name="Product">\n<prop oor:name="ooSetupVersion">'
+                        '\n        <value>7.4</value>\n      </prop>\n<prop oor:name="ooSetupVersionAboutBox">\n'
+                        '        <value>7.4.7.2</value></prop></node></oor:component-data>')
+    assert report_reader.office_version(str(registry)) == '7.4'
+    registry.write_text('<prop oor:name="ooSetupVersionAboutBox"><value>7.4.7.2</value></prop>')
+    assert report_reader.office_version(str(registry)) is None
+    assert report_reader.office_version(str(tmp_path / 'none.xcd')) is None
