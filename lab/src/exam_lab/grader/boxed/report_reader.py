@@ -69,13 +69,14 @@ TOOL_BOUNDS = {'pdfinfo': (20, 1 << 30), 'pdftotext': (60, 1 << 30), 'pdfimages'
 MIN_PICTURE_INCHES = (0.8, 0.25)
 MIN_PICTURE_INK = 0.2
 _CELL = 8  # pixels of the page's PNG per cell of the ink grid
-#: The installed LibreOffice's configuration (Debian's libreoffice-writer-nogui): its version.
-OFFICE_REGISTRY = '/usr/lib/libreoffice/share/registry/main.xcd'
-#: The profile LibreOffice starts from, made before its first start (the box's /tmp is new at each
-#: reading, and so would be its profile): made already, and last used by this version. A new profile
-#: costs two starts (it makes the profile, then restarts itself), and a profile a version has not used
-#: yet runs its graphics tests (GraphicsRenderTests: 109 drawings, 16 of them at 4096 x 4096 pixels, 1 GB
-#: of memory touched): a .docx's conversion took 1.2 s of CPU, 0.45 s with this profile, the same PDF.
+#: The installed LibreOffice (Debian's libreoffice-writer-nogui): its version and its build are read there.
+OFFICE = '/usr/lib/libreoffice'
+#: The profile LibreOffice starts from, made as its first start leaves it (the box's /tmp is new at each
+#: reading, and so would be its profile): made already, last used by this version, its extensions synced
+#: by this build. A new profile costs two starts (the first makes it, syncs the extensions and restarts
+#: itself), and a profile a version has not used yet runs its graphics tests (GraphicsRenderTests: 109
+#: drawings, 16 of them at 4096 x 4096 pixels, 1 GB of memory touched): a .docx's conversion took 1.2 s of
+#: CPU, 0.4 s with this profile, the same PDF.
 OFFICE_PROFILE = """<?xml version="1.0" encoding="UTF-8"?>
 <oor:items xmlns:oor="http://openoffice.org/2001/registry" xmlns:xs="http://www.w3.org/2001/XMLSchema" \
 xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance">
@@ -395,10 +396,7 @@ class Reader(Pages, Ocr, Tools):
         """``path`` made a PDF by LibreOffice headless (its profile in the box's /tmp: OFFICE_PROFILE)."""
         profile = os.path.join(self.scratch, 'lo-profile')
         if not os.path.isdir(profile):
-            os.makedirs(os.path.join(profile, 'user'))
-            version = office_version()
-            with open(os.path.join(profile, 'user', 'registrymodifications.xcu'), 'w') as f:
-                f.write(OFFICE_PROFILE % (OFFICE_LAST_VERSION % version if version else ''))
+            office_profile(profile)
         target = os.path.join(self.scratch, 'converted%d' % index)
         os.makedirs(target)
         source = os.path.join(target, 'report%s' % {'odt': '.odt', 'docx': '.docx', 'doc': '.doc', 'rtf': '.rtf'}
@@ -428,15 +426,28 @@ class Reader(Pages, Ocr, Tools):
         return {'pages': int(pages.group(1)), 'sizes': sizes}
 
 
-def office_version(registry=OFFICE_REGISTRY):
-    """The installed LibreOffice's version, ``"7.4"`` (its registry's ``ooSetupVersion``), or None."""
+def office_profile(profile, office=OFFICE):
+    """Make ``profile`` the LibreOffice profile OFFICE_PROFILE says, for the LibreOffice installed in
+    ``office``; what cannot be read of it (its version, its build) is left for LibreOffice to do."""
+    version = _first_match(os.path.join(office, 'share', 'registry', 'main.xcd'),
+                           rb'<prop oor:name="ooSetupVersion">\s*<value>(\d{1,3}\.\d{1,3})</value>')
+    build = _first_match(os.path.join(office, 'program', 'versionrc'), rb'(?m)^buildid=([^\r\n]{1,100})$')
+    os.makedirs(os.path.join(profile, 'user', 'extensions'))
+    with open(os.path.join(profile, 'user', 'registrymodifications.xcu'), 'w') as f:
+        f.write(OFFICE_PROFILE % (OFFICE_LAST_VERSION % version if version else ''))
+    if build:
+        with open(os.path.join(profile, 'user', 'extensions', 'buildid'), 'w') as f:
+            f.write(build)
+
+
+def _first_match(path, pattern):
+    """The first group of ``pattern``'s first match in the file ``path`` (ASCII), or None."""
     try:
-        with open(registry, 'rb') as f:
-            data = f.read(16 << 20)
+        with open(path, 'rb') as f:
+            found = re.search(pattern, f.read(16 << 20))
     except OSError:
         return None
-    found = re.search(rb'<prop oor:name="ooSetupVersion">\s*<value>(\d{1,3}\.\d{1,3})</value>', data)
-    return found.group(1).decode('ascii') if found else None
+    return found.group(1).decode('ascii', 'replace') if found else None
 
 
 def main(argv=None):
