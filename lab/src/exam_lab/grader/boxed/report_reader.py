@@ -13,7 +13,7 @@ the files it names in ``/box/out/report/``. What it reads:
   zip often holds the PDF), each archive unpacked by :func:`~exam_lab.grader.boxed.archives.safe_extract`
   within one budget. A file's kind is read from its bytes, not its name; the same bytes twice are read
   once. A word processor's file is made a PDF by LibreOffice headless, here, its profile in the box's
-  /tmp.
+  /tmp, made for it before it starts (:data:`OFFICE_PROFILE`).
 - **Each page** (poppler's command-line tools, each bounded in time and memory): the text layer
   (``pdftotext -bbox-layout``: the words, their lines and where they stand; ``pdftotext -layout`` for
   the columns of a table). A page without text is rendered (``pdftoppm``, its longest side bounded
@@ -231,12 +231,12 @@ class Pages(object):
         done = {}
         for first in range(1, count + 1, RENDER_PAGES):
             last = min(count, first + RENDER_PAGES - 1)
-            failed = None
+            failed = False
             try:
                 self.tool('pdftoppm', ['-scale-to', str(PREVIEW_PIXELS), '-f', str(first), '-l', str(last), path, prefix],
                           what='rendering its pages')
             except ToolFailed as err:
-                failed = err
+                failed = True
                 self.notes.append('%s: pages not rendered: %s' % (os.path.basename(path), err))
             for name in sorted(os.listdir(self.scratch)):
                 match = re.match(r'^preview%d-0*(\d+)\.ppm$' % index, name)
@@ -250,7 +250,7 @@ class Pages(object):
                     except report_images.PictureError as err:  # a page pdftoppm cut short as it failed
                         self.notes.append('%s: page %d not rendered: %s' % (os.path.basename(path), number, err))
                     os.remove(source)
-            if failed is not None:
+            if failed:
                 break
         return done
 
