@@ -8,8 +8,9 @@ report part (reader47's piece of make bench, beside grader_bench.py).
 lab/test/unit/data/reports (LibreOffice's PDFs, one a .docx converted in the box) and a 10-page scan
 (the French report's pages, made an image-only PDF as make_reports.py makes its scan) are read
 ``--repeat`` times by :func:`exam_lab.grader.host.reports.read_report`, box included; the median and
-the worst of each kind, against the goals (a text report under 5 s, a 10-page scan under 30 s on two
-cores), and what a class of 60 adds at the default JOBS. Prints a Markdown section and writes
+the worst wall clock of each kind, against the goals (a text report under 5 s, a 10-page scan under 30 s
+on two cores), its CPU (user + sys of this process, its children and the box's cgroup: on a shared
+machine the wall clock is also the others' load, shown), and what a class of 60 adds at the default JOBS. Prints a Markdown section and writes
 ``reports_results.json`` in --out; ``--record`` also writes the section to lab/bench/reports.md.
 """
 import argparse
@@ -26,7 +27,7 @@ DATA = os.path.join(HERE, '..', 'test', 'unit', 'data', 'reports')
 sys.path.insert(0, os.path.join(HERE, '..', 'test', 'reports'))
 
 from exam_lab.grader import class_run  # noqa: E402
-from exam_lab.grader.host import reports  # noqa: E402
+from exam_lab.grader.host import reports, timings  # noqa: E402
 import make_reports  # noqa: E402
 
 TEXT = ('fr_odt.pdf', 'en_docx_table.pdf', 'en_docx_table.docx')
@@ -35,19 +36,24 @@ CLASS = 60
 
 
 def measure(path, scratch, repeat):
-    """The seconds of each reading of the report ``path`` (a student's folder holding it)."""
-    seconds = []
+    """``{"seconds": [wall s], "cpu": [CPU s], "load": [1-minute load average before each]}`` of each
+    reading of the report ``path`` (a student's folder holding it)."""
+    row = {'seconds': [], 'cpu': [], 'load': []}
     for n in range(repeat):
         folder = os.path.join(scratch, 'student%d' % n)
         os.makedirs(folder)
         shutil.copyfile(path, os.path.join(folder, os.path.basename(path)))
-        record = reports.read_report(folder, os.path.join(scratch, 'out%d' % n))
+        row['load'].append(round(os.getloadavg()[0], 1))
+        watch = timings.Stopwatch()
+        with watch.stage('report'):
+            record = reports.read_report(folder, os.path.join(scratch, 'out%d' % n), watch=watch)
         if record.state != 'read':
             raise SystemExit('report_bench: %s not read: %s' % (path, record.why))
-        seconds.append(record.seconds)
+        row['seconds'].append(record.seconds)
+        row['cpu'].append(watch.stages['report']['cpu'])
         shutil.rmtree(folder)
         reports.remove_read_only(os.path.join(scratch, 'out%d' % n))
-    return seconds
+    return row
 
 
 def section(results):
@@ -56,13 +62,18 @@ def section(results):
              'Each report read in its own box (`host/reports.read_report`: staged, boxed, read, copied back), '
              '%d times, on %s (%d cores; `lab/bench/report_bench.py`, %s).' % (
                  results['repeat'], results['host'], results['cores'], results['date']), '',
-             '| report | pages | median s | worst s | goal |', '|---|---|---|---|---|']
+             '| report | pages | median s | worst s | goal | CPU s, median | CPU s, worst | load average |',
+             '|---|---|---|---|---|---|---|---|']
     for name, row in results['reports'].items():
-        lines.append('| %s | %d | %.1f | %.1f | under %.0f s%s |' % (
+        lines.append('| %s | %d | %.1f | %.1f | under %.0f s%s | %.1f | %.1f | %.1f-%.1f |' % (
             name, row['pages'], statistics.median(row['seconds']), max(row['seconds']), GOALS[row['kind']],
-            '' if max(row['seconds']) < GOALS[row['kind']] else ' (**missed**)'))
+            '' if max(row['seconds']) < GOALS[row['kind']] else ' (**missed**)', statistics.median(row['cpu']),
+            max(row['cpu']), min(row['load']), max(row['load'])))
     text = [s for row in results['reports'].values() if row['kind'] == 'text' for s in row['seconds']]
-    lines += ['', 'Text reports: median %.1f s, worst %.1f s. A class of %d with a text report each adds about '
+    lines += ['', 'CPU: user + sys of the bench, the tools it waited for and the box\'s cgroup. Load average: the '
+              'machine\'s, over one minute, before each reading (%d cores: above that, the wall clock is also '
+              'what the other processes took).' % results['cores'],
+              '', 'Text reports: median %.1f s, worst %.1f s. A class of %d with a text report each adds about '
               '%.0f s to its grading at the default JOBS=%d (the reports are read side by side as the students '
               'are graded: %d x median / JOBS).' % (statistics.median(text), max(text), CLASS,
                                                      CLASS * statistics.median(text) / jobs, jobs, CLASS), '']
@@ -87,8 +98,9 @@ def main(argv=None):
                 [('scan, 10 pages', scan, 'scan', 10)]:
             work = os.path.join(scratch, kind + str(len(results['reports'])))
             os.makedirs(work)
-            results['reports'][name] = {'kind': kind, 'pages': pages, 'seconds': measure(path, work, args.repeat)}
-            print('report_bench: %s: %s s' % (name, results['reports'][name]['seconds']), flush=True)
+            results['reports'][name] = dict({'kind': kind, 'pages': pages}, **measure(path, work, args.repeat))
+            print('report_bench: %s: %s s, CPU %s s' % (name, results['reports'][name]['seconds'],
+                                                        results['reports'][name]['cpu']), flush=True)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     with open(os.path.join(out, 'reports_results.json'), 'w') as f:

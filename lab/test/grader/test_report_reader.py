@@ -4,8 +4,10 @@ the tools students use) read, what was read checked on its page with its source;
 be read is "not read" with why; a class with such students grades the others."""
 import json
 import os
+import re
 import shutil
 import stat
+import subprocess
 import zipfile
 
 import pytest
@@ -88,6 +90,26 @@ def test_an_odt_handed_in_is_converted_in_the_box(tmp_path):
     record, _ = read(tmp_path, 'fr_odt.odt')
     assert [(f['kind'], f['converted'], f['pages']) for f in record.files] == [('odt', True, 2)]
     page_with(record, ['Question 9', 'catkin_create_pkg exam rospy std_msgs mydrone'], 'text')
+
+
+def test_libreoffice_starts_once_from_the_readers_profile_without_its_graphics_tests(tmp_path):
+    """The reader's LibreOffice profile (report_reader.OFFICE_PROFILE) is as the installed LibreOffice's first
+    start leaves it: LibreOffice converts at its first start, without restarting itself (soffice.bin's exit
+    81, which the soffice script hides) and without its graphics tests, whose log a new profile gets."""
+    from exam_lab.grader.boxed import report_reader
+    profile = str(tmp_path / 'profile')
+    report_reader.office_profile(profile)
+    done = subprocess.run([os.path.join(report_reader.OFFICE, 'program', 'soffice.bin'), '--headless', '--norestore',
+                           '--nolockcheck', '-env:UserInstallation=file://%s' % profile, '--convert-to', 'pdf',
+                           '--outdir', str(tmp_path), os.path.join(DATA, 'fr_odt.odt')],
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=120)
+    assert done.returncode == 0 and (tmp_path / 'fr_odt.pdf').is_file(), done.stdout
+    assert not os.path.exists(os.path.join(profile, 'user', 'GraphicsRenderTests.log'))
+    reader = report_reader.Reader(str(tmp_path / 'out'))  # the reader's own conversion starts from it
+    reader.convert(0, os.path.join(DATA, 'fr_odt.odt'))
+    user = os.path.join(reader.scratch, 'lo-profile', 'user')
+    assert os.path.isdir(os.path.join(user, 'extensions', 'bundled'))  # LibreOffice used it
+    assert not os.path.exists(os.path.join(user, 'GraphicsRenderTests.log'))
 
 
 def test_an_image_only_scan_is_read_by_ocr_with_its_confidence(tmp_path):

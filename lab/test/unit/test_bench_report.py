@@ -1,22 +1,26 @@
 """Unit tests of lab/bench/report.py: docs/benchmarks.md as one `make bench` run renders it, with
-every figure from that run (issue 28: the file was edited by hand after the last run). Fed the raw
-results that docs/benchmarks.md was rendered from; no master, no clock."""
+every figure from that run (issue 28: the file was edited by hand after the last run); and of
+lab/bench/report_bench.py's section (lab/bench/reports.md). Fed the raw results that each was rendered
+from; no master, no clock."""
 
 import copy
 import json
 import os
+import statistics
 import sys
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', '..', 'bench'))
 
 import report  # noqa: E402
+import report_bench  # noqa: E402
 
 RESULTS = os.path.join(HERE, '..', '..', 'bench', 'results.json')
+REPORTS_RESULTS = os.path.join(HERE, '..', '..', 'bench', 'reports_results.json')
 
 
-def results():
-    with open(RESULTS) as f:
+def results(path=RESULTS):
+    with open(path) as f:
         return json.load(f)
 
 
@@ -98,3 +102,21 @@ def test_one_make_bench_run_says_both_stages_and_their_total():
     later = time.strftime('%Y-%m-%d %H:%M', time.gmtime((end + 24 * 60) * 60))
     assert report.render(r, 'f.png', GRADER_HEAD % (later, r['machine']['commit'])).splitlines()[2].startswith(
         '_Two runs')
+
+
+def test_each_report_read_has_its_wall_clock_cpu_and_load_from_the_run():
+    r = results(REPORTS_RESULTS)
+    text = report_bench.section(r)
+    for name, measured in r['reports'].items():
+        cells = row(text, name)
+        assert cells[2:4] == ['%.1f' % statistics.median(measured['seconds']), '%.1f' % max(measured['seconds'])]
+        assert cells[5:8] == ['%.1f' % statistics.median(measured['cpu']), '%.1f' % max(measured['cpu']),
+                              '%.1f-%.1f' % (min(measured['load']), max(measured['load']))]
+
+
+def test_a_reading_goal_is_missed_by_its_worst_reading():
+    r = copy.deepcopy(results(REPORTS_RESULTS))
+    r['reports']['scan, 10 pages']['seconds'] = [10.0, 12.0, 30.0]
+    assert row(report_bench.section(r), 'scan, 10 pages')[4] == 'under 30 s (**missed**)'
+    r['reports']['scan, 10 pages']['seconds'] = [10.0, 12.0, 29.9]
+    assert row(report_bench.section(r), 'scan, 10 pages')[4] == 'under 30 s'

@@ -7,7 +7,7 @@ import zipfile
 
 import pytest
 
-from exam_lab.grader.boxed import report_files, report_text
+from exam_lab.grader.boxed import report_files, report_reader, report_text
 from exam_lab.grader.score.records import RecordError, ReportRecord
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'data', 'reports')
@@ -180,3 +180,23 @@ def test_a_pictures_place_is_the_ink_no_word_explains():
     assert len(regions) == 1
     x0, y0, x1, y1 = regions[0]
     assert 40 <= x0 <= 50 and 190 <= y0 <= 200 and 500 <= x1 <= 515 and 300 <= y1 <= 315, regions
+
+
+def test_libreoffices_profile_is_made_with_its_version_and_build(tmp_path):
+    office = tmp_path / 'libreoffice'
+    (office / 'share' / 'registry').mkdir(parents=True)
+    (office / 'program').mkdir()
+    (office / 'share' / 'registry' / 'main.xcd').write_text(
+        '<node oor:name="Product">\n<prop oor:name="ooSetupVersion">\n        <value>7.4</value>\n      </prop>\n'
+        '<prop oor:name="ooSetupVersionAboutBox">\n        <value>7.4.7.2</value></prop></node>')
+    (office / 'program' / 'versionrc').write_text('[Version]\nAllLanguages=en-US\nbuildid=40(Build:2)\nVendor=Debian\n')
+    report_reader.office_profile(str(tmp_path / 'profile'), str(office))
+    user = tmp_path / 'profile' / 'user'
+    settings = (user / 'registrymodifications.xcu').read_text()
+    assert '<prop oor:name="ooSetupInstCompleted" oor:op="fuse"><value>true</value></prop>' in settings
+    assert '<prop oor:name="ooSetupLastVersion" oor:op="fuse"><value>7.4</value></prop>' in settings
+    assert (user / 'extensions' / 'buildid').read_text() == '40(Build:2)'
+    # an installation whose version and build cannot be read: LibreOffice does the rest itself
+    report_reader.office_profile(str(tmp_path / 'other'), str(tmp_path / 'nowhere'))
+    assert 'ooSetupLastVersion' not in (tmp_path / 'other' / 'user' / 'registrymodifications.xcu').read_text()
+    assert os.listdir(str(tmp_path / 'other' / 'user' / 'extensions')) == []

@@ -159,7 +159,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
         # The report, read after the flights in a box of its own: its time is not the student's budget.
         progress.report(on_step, 'report')
         with watch.stage('report'):
-            reports.read_report(submission, out_dir, jobs=jobs)
+            reports.read_report(submission, out_dir, jobs=jobs, watch=watch)
         measured = {'student': student, 'sheet': chosen_sheet or 'altitude', 'static': static, 'session': session.value,
                     'notes': notes, 'fixes': fixes, 'comments': comments, 'isolate': isolate, 'how_run': how_run,
                     'extra': dict(facts, **dict(extra or {}, seconds=round(time.monotonic() - start, 1)))}

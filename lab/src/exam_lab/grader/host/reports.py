@@ -19,13 +19,13 @@ import stat
 import time
 
 from exam_lab.grader import contract
-from exam_lab.grader.host import limits, sandbox, staging
+from exam_lab.grader.host import cgroups, limits, sandbox, staging
 from exam_lab.grader.host.boxed_run import Boxed, InspectionFailed
 from exam_lab.grader.score.records import ReportRecord
 
-#: Bounds of the reader's box (wall clock s, CPU s, address space bytes): a text report takes about a
-#: second, a 10-page scan about 20 s of OCR (docs/grading.md, "The report"); LibreOffice wants a large
-#: address space. Each of its tools is bounded inside the box too (the reader's own timeouts).
+#: Bounds of the reader's box (wall clock s, CPU s, address space bytes): room for the OCR of a scan's
+#: pages, the reader's own clock stopping first (report_reader.SECONDS; what a reading takes, wall and
+#: CPU: lab/bench/reports.md, make bench); LibreOffice wants a large address space. Each of its tools is bounded inside the box too (the reader's own timeouts).
 REPORT_BOUNDS = (150.0, 150, 4 << 30)
 #: What root copies back of the box's report/ folder: bytes of one file, and of all.
 COPY_FILE_BYTES = 64 << 20
@@ -39,7 +39,7 @@ READER_ETC = ('/etc/fonts', '/etc/libreoffice')
 _PNG = b'\x89PNG\r\n\x1a\n'
 
 
-def read_report(submission, out_dir, *, timeout=None, jobs=1):
+def read_report(submission, out_dir, *, timeout=None, jobs=1, watch=None):
     """Read the report(s) of ``submission`` (a student's folder or file) in a box; write
     ``out_dir/report.json`` and ``out_dir/report/``; return the checked
     :class:`~exam_lab.grader.score.records.ReportRecord`. Never raises for the student's bytes: a
@@ -47,6 +47,8 @@ def read_report(submission, out_dir, *, timeout=None, jobs=1):
 
     :param timeout: the wall clock left for it (REPORT_BOUNDS's when None or larger).
     :param jobs: gradings side by side: the box's part of the CPU.
+    :param watch: a :class:`~exam_lab.grader.host.timings.Stopwatch` whose stage in progress is charged the
+        box's CPU (its cgroup's count: what runs under bubblewrap is never waited for).
     """
     start = time.monotonic()
     wall = min(REPORT_BOUNDS[0], timeout) if timeout else REPORT_BOUNDS[0]
@@ -57,9 +59,13 @@ def read_report(submission, out_dir, *, timeout=None, jobs=1):
             (upload,) = staging.stage_work(work, [(folder, os.path.realpath(submission))])
             with sandbox.Box(work, bwrap=sandbox.check() is None, cpus=limits.box_cpus(jobs)) as box:
                 boxed = Boxed(box, work, [(path, None, False) for path in READER_ETC if os.path.isdir(path)])
-                found = boxed.run('exam_lab.grader.boxed.report_reader',
-                                  ['--upload', boxed.path(upload), '--out', boxed.path(boxed.out)],
-                                  ReportRecord, (wall,) + REPORT_BOUNDS[1:])
+                try:
+                    found = boxed.run('exam_lab.grader.boxed.report_reader',
+                                      ['--upload', boxed.path(upload), '--out', boxed.path(boxed.out)],
+                                      ReportRecord, (wall,) + REPORT_BOUNDS[1:])
+                finally:
+                    if watch is not None:
+                        watch.add_cpu(cgroups.cpu_use(box.cgroups))
                 record = keep_copies(found, boxed.out, out_dir)
         except staging.UploadRefused as err:
             record = ReportRecord.not_read('the submission was not staged for the reader: %s' % err)
