@@ -49,7 +49,7 @@ def keep_runs(folder, runs, checked=True):
         session = SessionRecord.make(session).value
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, records.MEASUREMENTS), 'w') as f:
-        json.dump(dict(kept_copy('before-version'), session=session), f)
+        json.dump(dict(kept_copy('version-1'), session=session), f)
 
 
 def refused(value, record_type=ProbeRecord):
@@ -178,7 +178,7 @@ def test_a_rescore_reads_back_the_session_record_the_run_kept(tmp_path):
     probe = real_probe()
     probe['formula'][1]['published'] = float('nan')
     session_ = SessionRecord.make(real_session(probe)).value
-    kept = {'student': 'Ann', 'sheet': 'altitude', 'static': kept_copy('before-version')['static'], 'session': session_,
+    kept = {'version': 1, 'student': 'Ann', 'sheet': 'altitude', 'static': kept_copy('version-1')['static'], 'session': session_,
             'notes': [], 'fixes': [], 'comments': None, 'isolate': True, 'how_run': 'test', 'extra': {'seconds': 40.0}}
     folder = tmp_path / 'Ann'
     folder.mkdir()

@@ -31,7 +31,7 @@ def graded_out(root, names=('ann', 'bob', 'cyd', 'dan'), report_only=('zoe',)):
     grading, renamed), ``report_only`` not graded (a real no-node grading): grade.json by make rescore's
     rescore, hand.csv by make grade's writer."""
     out = root / 'out'
-    shapes = [(n, 'before-version') for n in names] + [(n, 'no-node-before-records') for n in report_only]
+    shapes = [(n, 'version-1') for n in names] + [(n, 'no-node-version-1') for n in report_only]
     for index, (name, shape) in enumerate(shapes):
         measured = kept_copy(shape)
         number = 201 + index

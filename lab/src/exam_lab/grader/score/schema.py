@@ -279,9 +279,8 @@ class Record(object):
     checked object; two records are equal when their JSON is (NaN included). A record is frozen, as a
     frozen dataclass is and deeper: no attribute can be set, and its objects and lists
     (:class:`Frozen`, :class:`FrozenList`) refuse every change, so what a stage hands on is what the
-    next one reads; :meth:`replaced` makes a new record of changed fields, checked again. A record type whose
-    files outlive the grader that wrote them (:mod:`exam_lab.grader.score.kept`) brings an older
-    shape to its current one in :meth:`upgraded`, before the check. With ``CLEAN``, every string of the record, keys too, is
+    next one reads; :meth:`replaced` makes a new record of changed fields, checked again. With
+    ``CLEAN``, every string of the record, keys too, is
     :func:`~exam_lab.grader.score.safe_text.clean` once it matched its schema: the one place where
     a student's text (node and topic names, log lines, a request) is made safe, whoever reads the
     record later; ``CLEAN`` a tuple of keys cleans those fields only (the others are paths to open,
@@ -343,12 +342,7 @@ class Record(object):
     def make(cls, value):
         """The record of ``value`` (made by the grader itself from what it read): checked as one read
         from a file is; raises :class:`RecordError`."""
-        return cls._made(check(cls.upgraded(value), cls.SCHEMA, cls.FILE))
-
-    @classmethod
-    def upgraded(cls, value):
-        """``value`` in the type's current shape (the same value when it is in it already)."""
-        return value
+        return cls._made(check(value, cls.SCHEMA, cls.FILE))
 
     @classmethod
     def _made(cls, value):
