@@ -16,6 +16,7 @@ import re
 from exam_lab.grader.score.schema import (  # noqa: F401
     MAX_ITEMS, MAX_TEXT, Items, Map, Maybe, Number, OneOf, Optional, Record, RecordError, Row, Text, check, parse,
     relative, shown, write)
+from exam_lab.grader.score.fields import view
 from exam_lab.grader.score.sheets import SHEETS
 
 #: What a grading measured, kept beside grade.json by the runner (:class:`~exam_lab.grader.score.kept.MeasurementsRecord`,
@@ -229,22 +230,15 @@ class ProbeRecord(Record):
 _PATH = Text(4096)
 
 
-class PlanRecord(Record):
-    """One run's plan, the judge's orders (``plan-<tag>.json``, :mod:`exam_lab.grader.judge.probe`):
-    the sheet, the threshold flown and its margin, the rule's delay, how long the node may take to
-    start, the output topic expected, how long a late WARNING is waited for (``late_warning``; 0 when
-    the code calls no service). Made by :func:`exam_lab.grader.runner.plan_job`; for the threshold run
-    the session adds the main run's calibration (``fit``) and the node's WARNING latency
-    (``warn_after``), or, when the two runs fly side by side, the file where it will say what the main
-    run's WARNING took (``main_word``: :class:`~exam_lab.grader.judge.probe.MainWord`)."""
-    FILE = 'plan.json'
-    MAX_BYTES = 1 << 16
-    SCHEMA = {
-        'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
-        'margin': Number(0), 'delay': Number(0), 'start_timeout': Number(0), 'output': _NAME,
-        'late_warning': Number(0), 'fit': Optional(Maybe(Row(_VALUE, _VALUE))), 'warn_after': Optional(Maybe(Number())),
-        'main_word': Optional(_PATH),
-    }
+#: One run's plan, the judge's orders (:mod:`exam_lab.grader.judge.probe`): the sheet, the threshold
+#: flown and its margin, the rule's delay, how long the node may take to start, the output topic
+#: expected, how long a late WARNING is waited for (``late_warning``; 0 when the code calls no
+#: service). Part of the job (:class:`JobRecord`), made once by :func:`exam_lab.grader.runner.plan_job`.
+PLAN = {
+    'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
+    'margin': Number(0), 'delay': Number(0), 'start_timeout': Number(0), 'output': _NAME,
+    'late_warning': Number(0),
+}
 
 
 #: A box as the runner opened it, for the session to make its command lines
@@ -257,18 +251,21 @@ _BOX = {'work': _PATH, 'bwrap': bool, 'cpus': Maybe(Number(0, 4096)), 'binds': [
 
 class JobRecord(Record):
     """The session's job (``job.json``, read by :mod:`exam_lab.grader.host.session`): the runs (each its
-    tag, its launch file, its :class:`PlanRecord`'s value), the student's namespace, the time limits, the
-    launch file as handed in (for roslaunch's check). :func:`~exam_lab.grader.runner.plan_job` makes it
-    from the inspection, the launch files relative to the workspace;
+    tag, its launch file, its :data:`PLAN`), the student's namespace, the time limits, the launch file
+    as handed in (for roslaunch's check). :func:`~exam_lab.grader.runner.plan_job` makes it from the
+    inspection, the launch files relative to the workspace;
     :func:`~exam_lab.grader.runner.run_session` adds where the session runs (``workspace``, the
     ``underlay``, the folders, the ``box``) and the student's ``budget``, the launch files then absolute;
     with ``side_by_side``, the two runs fly at once, the threshold run in a ``box`` and a ``judge_home``
-    of its own."""
+    of its own. The plans are made once, there, and go down to the judge as they are, in the job
+    (:meth:`plan`): nothing on the way changes them. What the threshold run learns of the main run
+    (how late its WARNING came) is the main run's word, not its plan
+    (:class:`~exam_lab.grader.judge.probe.MainWord`)."""
     FILE = 'job.json'
     MAX_BYTES = 1 << 20
     SCHEMA = {
         'namespace': Text(1000), 'build_timeout': Number(0), 'run_timeout': Number(0),
-        'runs': Items({'tag': OneOf('main', 'threshold'), 'launch': _PATH, 'plan': PlanRecord.SCHEMA,
+        'runs': Items({'tag': OneOf('main', 'threshold'), 'launch': _PATH, 'plan': PLAN,
                        'box': Optional(_BOX), 'judge_home': Optional(_PATH)}, 2),
         'handed_in_launch': Maybe(_PATH), 'side_by_side': Optional(bool),
         'workspace': Optional(_PATH), 'underlay': Optional(_PATH), 'log_dir': Optional(_PATH),
@@ -282,6 +279,13 @@ class JobRecord(Record):
         for run in self.runs:
             if run['plan']['kind'] != run['tag']:
                 raise RecordError('job.json.runs: the %s run with a plan of a %s run' % (run['tag'], run['plan']['kind']))
+
+    def plan(self, tag):
+        """The plan of the run ``tag``, read by attributes (``plan.threshold``): the judge's orders."""
+        for run in self.runs:
+            if run['tag'] == tag:
+                return view(run['plan'], PLAN)
+        raise RecordError('job.json.runs: no %s run' % tag)
 
 
 class Outcome(str, enum.Enum):
