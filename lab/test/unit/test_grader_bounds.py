@@ -182,7 +182,7 @@ def test_the_intake_cuts_a_reason_and_refuses_more_students_than_a_class_holds(t
     monkeypatch.setattr(intake.os, 'getuid', lambda: 1000)
     assert intake.main(['--class', str(klass), '--out', str(out)]) == 0
     record = records.IntakeRecord.from_json((out / 'intake.json').read_bytes(), records.IntakeRecord.MAX_BYTES)
-    assert len(record.students[1]['refused']) == intake.MAX_REFUSED and bounds.CUT_MARK in record.students[1]['refused']
+    assert len(record.students[1].refused) == intake.MAX_REFUSED and bounds.CUT_MARK in record.students[1].refused
     monkeypatch.setattr(records.IntakeRecord, 'MAX_STUDENTS', 2)
     assert intake.main(['--class', str(klass), '--out', str(out)]) == 3
     assert 'the class archive holds 3 students (at most 2 for a class)' in capsys.readouterr().err

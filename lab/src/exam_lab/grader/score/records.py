@@ -11,11 +11,13 @@ records too: :mod:`exam_lab.grader.score.kept`.
 import enum
 import os
 import re
+import typing
+from dataclasses import dataclass
 
 # The schema machinery, importable from here as well (records.check, records.Text...).
 from exam_lab.grader.score.schema import (  # noqa: F401
-    MAX_ITEMS, MAX_TEXT, Items, Map, Maybe, Number, OneOf, Optional, Record, RecordError, Row, Text, check, parse,
-    relative, shown, write)
+    MAX_ITEMS, MAX_TEXT, DataRecord, Items, Map, Maybe, Number, OneOf, Optional, Record, RecordError, Row, Text, check,
+    parse, relative, shown, write)
 from exam_lab.grader.score.fields import view
 from exam_lab.grader.score.sheets import SHEETS
 
@@ -98,21 +100,44 @@ class InspectRecord(Record):
             raise RecordError('inspect.json: a threshold run without its value')
 
 
-class IntakeRecord(Record):
-    """A class archive unpacked by :mod:`exam_lab.grader.boxed.intake` (``intake.json``): ``students``,
-    each ``{"name", "path"}`` with ``path`` relative to the intake's output folder, and ``refused``
-    (why) when that student's files were not unpacked. A class may be larger than any other list's cap."""
+@dataclass(frozen=True)
+class IntakeStudent(object):
+    """A student of the class archive as the intake unpacked it: ``name`` (its folder's), ``path``
+    (relative to the intake's output folder), ``refused`` (why its files were not unpacked, or None)."""
+    name: str
+    path: str
+    refused: typing.Optional[str] = None
+
+    @property
+    def value(self):
+        return dict({'name': self.name, 'path': self.path}, **({} if self.refused is None else {'refused': self.refused}))
+
+
+@dataclass(frozen=True)
+class IntakeRecord(DataRecord):
+    """A class archive unpacked by :mod:`exam_lab.grader.boxed.intake` (``intake.json``): the box's
+    ``uid`` and its ``students`` (:class:`IntakeStudent`). A class may be larger than any other list's cap."""
     FILE = 'intake.json'
     MAX_BYTES = 16 << 20
     MAX_STUDENTS = 10000
     SCHEMA = {'uid': Number(0, 2 ** 32, integer=True),
               'students': Items({'name': Text(255), 'path': Text(4096), 'refused': Optional(Text())}, MAX_STUDENTS)}
+    uid: int
+    students: typing.Tuple[IntakeStudent, ...]
+
+    @classmethod
+    def of(cls, value):
+        return cls(value['uid'], tuple(IntakeStudent(**student) for student in value['students']))
+
+    @property
+    def value(self):
+        return {'uid': self.uid, 'students': [student.value for student in self.students]}
 
     def validate(self):
         for index, student in enumerate(self.students):
             where = 'intake.json.students[%d]' % index
-            relative(student['path'], where + '.path')
-            name = student['name']
+            relative(student.path, where + '.path')
+            name = student.name
             if name in ('', '.', '..') or name != name.strip(' .') or \
                     not all(c.isalnum() or c in ' -._' for c in name):
                 raise RecordError('%s.name: %s is not a student\'s name (a folder name of letters, digits, '

@@ -273,7 +273,70 @@ def thawed(value):
     return value
 
 
-class Record(object):
+class _Readable(object):
+    """What every record type shares: its file (``FILE``), its cap (``MAX_BYTES``), its ``SCHEMA``;
+    read from JSON (:meth:`from_json`, :meth:`read`) through the type's own :meth:`make`.
+    ``NON_FINITE``: NaN and Infinity may be read from its JSON (measured values)."""
+    FILE = MAX_BYTES = SCHEMA = None
+    NON_FINITE = False
+    __slots__ = ()
+
+    @classmethod
+    def from_json(cls, raw, max_bytes=None):
+        """The record in ``raw`` (bytes), at most ``max_bytes`` (the type's ``MAX_BYTES`` when None);
+        raises :class:`RecordError` on anything unexpected."""
+        max_bytes = cls.MAX_BYTES if max_bytes is None else max_bytes
+        if len(raw) > max_bytes:
+            raise RecordError('%s: %d bytes (at most %d)' % (cls.FILE, len(raw), max_bytes))
+        return cls.make(load(raw, cls.FILE, constants=cls.NON_FINITE))
+
+    @classmethod
+    def read(cls, path):
+        """The record in the file ``path``, one the grader wrote itself (kept in OUT; for a box's, root
+        uses :func:`exam_lab.grader.contract.read_record`): read up to ``MAX_BYTES``, then as
+        :meth:`from_json`; raises :class:`RecordError` naming the file when it cannot be read."""
+        try:
+            with open(path, 'rb') as f:
+                raw = f.read(cls.MAX_BYTES + 1)
+        except OSError as err:
+            raise RecordError('%s: %s' % (os.path.basename(path), err.strerror or err))
+        return cls.from_json(raw)
+
+    def to_json(self):
+        """The record's JSON text (its ``value``): :meth:`from_json` of it gives an equal record."""
+        return json.dumps(self.value, indent=1, sort_keys=True)
+
+    def validate(self):
+        """Checks across fields, beyond the schema's."""
+
+
+class DataRecord(_Readable):
+    """The base of a record type that is a frozen dataclass (``@dataclass(frozen=True)``): its fields
+    the schema's keys, each a plain value, a tuple or a record of its own, so nothing of it can be
+    changed (``dataclasses.replace`` makes another). :meth:`make` checks a value against ``SCHEMA``,
+    then builds the record from it (the type's :meth:`of`) and checks across fields
+    (:meth:`validate`); :meth:`to_json` writes the type's :attr:`value`, which :meth:`make` reads back
+    to an equal record."""
+
+    @classmethod
+    def make(cls, value):
+        """The record of ``value`` (JSON data), checked; raises :class:`RecordError`."""
+        record = cls.of(check(value, cls.SCHEMA, cls.FILE))
+        record.validate()
+        return record
+
+    @classmethod
+    def of(cls, value):
+        """The record of the checked ``value`` (the type's: its nested objects made records too)."""
+        raise NotImplementedError
+
+    @property
+    def value(self):
+        """The record as JSON data: what :meth:`make` reads back."""
+        raise NotImplementedError
+
+
+class Record(_Readable):
     """A record type: its file's name (``FILE``), its cap (``MAX_BYTES``), its ``SCHEMA``; a record's
     attributes are the schema's keys (None when an optional one is missing), ``value`` the whole
     checked object; two records are equal when their JSON is (NaN included). A record is frozen, as a
@@ -284,9 +347,8 @@ class Record(object):
     :func:`~exam_lab.grader.score.safe_text.clean` once it matched its schema: the one place where
     a student's text (node and topic names, log lines, a request) is made safe, whoever reads the
     record later; ``CLEAN`` a tuple of keys cleans those fields only (the others are paths to open,
-    or names kept exactly). ``NON_FINITE``: NaN and Infinity may be read from its JSON (measured values)."""
-    FILE = MAX_BYTES = SCHEMA = None
-    CLEAN = NON_FINITE = False
+    or names kept exactly)."""
+    CLEAN = False
 
     __slots__ = ('value',)
 
@@ -318,27 +380,6 @@ class Record(object):
     __hash__ = None
 
     @classmethod
-    def from_json(cls, raw, max_bytes=None):
-        """The record in ``raw`` (bytes), at most ``max_bytes`` (the type's ``MAX_BYTES`` when None);
-        raises :class:`RecordError` on anything unexpected."""
-        max_bytes = cls.MAX_BYTES if max_bytes is None else max_bytes
-        if len(raw) > max_bytes:
-            raise RecordError('%s: %d bytes (at most %d)' % (cls.FILE, len(raw), max_bytes))
-        return cls.make(load(raw, cls.FILE, constants=cls.NON_FINITE))
-
-    @classmethod
-    def read(cls, path):
-        """The record in the file ``path``, one the grader wrote itself (kept in OUT; for a box's, root
-        uses :func:`exam_lab.grader.contract.read_record`): read up to ``MAX_BYTES``, then as
-        :meth:`from_json`; raises :class:`RecordError` naming the file when it cannot be read."""
-        try:
-            with open(path, 'rb') as f:
-                raw = f.read(cls.MAX_BYTES + 1)
-        except OSError as err:
-            raise RecordError('%s: %s' % (os.path.basename(path), err.strerror or err))
-        return cls.from_json(raw)
-
-    @classmethod
     def make(cls, value):
         """The record of ``value`` (made by the grader itself from what it read): checked as one read
         from a file is; raises :class:`RecordError`."""
@@ -358,13 +399,6 @@ class Record(object):
     def converted(cls, value):
         """``value``, checked, with a field of its type made its Python type (a string its enum)."""
         return value
-
-    def to_json(self):
-        """The record's JSON text: :meth:`from_json` of it gives the same record."""
-        return json.dumps(self.value, indent=1, sort_keys=True)
-
-    def validate(self):
-        """Checks across fields, beyond the schema's."""
 
 
 def write(folder, record_type, value):
