@@ -126,8 +126,8 @@ def test_similarity_html_holds_only_the_highlight(tmp_path):
     # The students' file names and code are made safe where the record is made; the highlight stays.
     match.update(file_a='a\x1b[2J.py', html_b="w\x07 <span class='highlight-green'>v\u202e</span>")
     read = contract.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
-    assert read.pairs[0]['files'][0]['file_a'] == 'a.py'
-    assert read.pairs[0]['files'][0]['html_b'] == "w <span class='highlight-green'>v</span>"
+    assert read.pairs[0].files[0].file_a == 'a.py'
+    assert read.pairs[0].files[0].html_b == "w <span class='highlight-green'>v</span>"
 
 
 def test_a_cap_hit_is_a_sentence_naming_the_cap_and_the_value(tmp_path):

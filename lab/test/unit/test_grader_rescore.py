@@ -67,7 +67,7 @@ def test_every_similarity_json_the_class_run_writes_is_read_back_as_its_record(t
         monkeypatch.setattr(class_run, 'class_students', fails)
         result = class_run.class_similarity(str(tmp_path / 'class.zip'), str(tmp_path), [])
         kept = SimilarityRecord.read(str(tmp_path / 'similarity.json'))
-        assert isinstance(result, SimilarityRecord) and kept == result and kept.notes == []
+        assert isinstance(result, SimilarityRecord) and kept == result and kept.notes == ()
         assert not [n for n in os.listdir(str(tmp_path)) if n.endswith('.part')]
         errors.append(kept.error)
     assert errors[0] == 'the archive failed on  entry 3'

@@ -108,10 +108,6 @@ class IntakeStudent(object):
     path: str
     refused: typing.Optional[str] = None
 
-    @property
-    def value(self):
-        return dict({'name': self.name, 'path': self.path}, **({} if self.refused is None else {'refused': self.refused}))
-
 
 @dataclass(frozen=True)
 class IntakeRecord(DataRecord):
@@ -124,14 +120,6 @@ class IntakeRecord(DataRecord):
               'students': Items({'name': Text(255), 'path': Text(4096), 'refused': Optional(Text())}, MAX_STUDENTS)}
     uid: int
     students: typing.Tuple[IntakeStudent, ...]
-
-    @classmethod
-    def of(cls, value):
-        return cls(value['uid'], tuple(IntakeStudent(**student) for student in value['students']))
-
-    @property
-    def value(self):
-        return {'uid': self.uid, 'students': [student.value for student in self.students]}
 
     def validate(self):
         for index, student in enumerate(self.students):
@@ -148,10 +136,35 @@ class IntakeRecord(DataRecord):
 _SHARE = Number(0, 10)
 
 
-class SimilarityRecord(Record):
+@dataclass(frozen=True)
+class SimilarFiles(object):
+    """The two files of a flagged pair that are most alike: their names, each one's share alike, and
+    each one's HTML with the detector's highlight spans (escaped by the detector: shown as it is)."""
+    file_a: str
+    file_b: str
+    sim_a: float
+    sim_b: float
+    html_a: str
+    html_b: str
+
+
+@dataclass(frozen=True)
+class SimilarPair(object):
+    """Two students whose code is alike (``a``, ``b``: their names), each one's share alike, and
+    their best ``files`` (:class:`SimilarFiles`)."""
+    a: str
+    b: str
+    score_a: float
+    score_b: float
+    files: typing.Tuple[SimilarFiles, ...]
+
+
+@dataclass(frozen=True)
+class SimilarityRecord(DataRecord):
     """The class's similarity check (:func:`exam_lab.grader.boxed.similarity.check`,
-    ``similarity.json``): flagged ``pairs`` with their best files' highlighted HTML (escaped by the
-    detector; the page escapes nothing more), every pair's ``scores``, ``notes``; or ``error``."""
+    ``similarity.json``): flagged ``pairs`` (:class:`SimilarPair`) with their best files' highlighted
+    HTML (escaped by the detector; the page escapes nothing more), every pair's ``scores`` (``(a, b,
+    score_a, score_b)``), ``notes``; or ``error``."""
     FILE = 'similarity.json'
     MAX_BYTES = 32 << 20
     #: Its file names and the code in its HTML are the students': made safe here (no markup is added).
@@ -164,12 +177,19 @@ class SimilarityRecord(Record):
         'students': Optional(Number(0, 1e5, integer=True)), 'threshold': Optional(_SHARE),
         'detector': Optional(Text(100)), 'scores': Optional(Items(Items((Text(255), _SHARE), 4), 200000)),
     }
+    notes: typing.Tuple[str, ...]
+    error: typing.Optional[str] = None
+    pairs: typing.Optional[typing.Tuple[SimilarPair, ...]] = None
+    students: typing.Optional[int] = None
+    threshold: typing.Optional[float] = None
+    detector: typing.Optional[str] = None
+    scores: typing.Optional[typing.Tuple[tuple, ...]] = None
 
     def validate(self):
-        for index, pair in enumerate(self.pairs or []):
-            for inner, match in enumerate(pair['files']):
+        for index, pair in enumerate(self.pairs or ()):
+            for inner, match in enumerate(pair.files):
                 for key in ('html_a', 'html_b'):
-                    if '<' in _HIGHLIGHT.sub('', match[key]):
+                    if '<' in _HIGHLIGHT.sub('', getattr(match, key)):
                         raise RecordError('similarity.json.pairs[%d].files[%d].%s: markup other than the '
                                           "detector's highlight" % (index, inner, key))
 

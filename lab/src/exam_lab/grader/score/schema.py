@@ -8,10 +8,12 @@ most ``n`` characters), :class:`Number` (finite, within bounds), ``[schema]`` (a
 (None or the schema), :class:`OneOf` (one of fixed values), :class:`Map` (an object whose keys are data),
 :class:`Row` (a list of fixed length, each item its own schema), a tuple of schemas (any one of them).
 """
+import dataclasses
 import json
 import math
 import os
 import re
+import typing
 
 from exam_lab.grader.score.safe_text import cleaned
 
@@ -275,10 +277,14 @@ def thawed(value):
 
 class _Readable(object):
     """What every record type shares: its file (``FILE``), its cap (``MAX_BYTES``), its ``SCHEMA``;
-    read from JSON (:meth:`from_json`, :meth:`read`) through the type's own :meth:`make`.
-    ``NON_FINITE``: NaN and Infinity may be read from its JSON (measured values)."""
+    read from JSON (:meth:`from_json`, :meth:`read`) through the type's own :meth:`make`. With
+    ``CLEAN``, every string of the record, keys too, is :func:`~exam_lab.grader.score.safe_text.clean`
+    once it matched its schema (:meth:`cleaned`): the one place where a student's text (node and topic
+    names, log lines, a request) is made safe, whoever reads the record later; ``CLEAN`` a tuple of keys
+    cleans those fields only (the others are paths to open, or names kept exactly). ``NON_FINITE``:
+    NaN and Infinity may be read from its JSON (measured values)."""
     FILE = MAX_BYTES = SCHEMA = None
-    NON_FINITE = False
+    CLEAN = NON_FINITE = False
     __slots__ = ()
 
     @classmethod
@@ -302,6 +308,16 @@ class _Readable(object):
             raise RecordError('%s: %s' % (os.path.basename(path), err.strerror or err))
         return cls.from_json(raw)
 
+    @classmethod
+    def cleaned(cls, value):
+        """The checked ``value`` with its text made safe as ``CLEAN`` says (True: every string, keys
+        too; a tuple of keys: those fields only)."""
+        if cls.CLEAN is True:
+            return cleaned(value)
+        if cls.CLEAN:
+            return dict(value, **{key: cleaned(value[key]) for key in cls.CLEAN if key in value})
+        return value
+
     def to_json(self):
         """The record's JSON text (its ``value``): :meth:`from_json` of it gives an equal record."""
         return json.dumps(self.value, indent=1, sort_keys=True)
@@ -312,28 +328,51 @@ class _Readable(object):
 
 class DataRecord(_Readable):
     """The base of a record type that is a frozen dataclass (``@dataclass(frozen=True)``): its fields
-    the schema's keys, each a plain value, a tuple or a record of its own, so nothing of it can be
-    changed (``dataclasses.replace`` makes another). :meth:`make` checks a value against ``SCHEMA``,
-    then builds the record from it (the type's :meth:`of`) and checks across fields
-    (:meth:`validate`); :meth:`to_json` writes the type's :attr:`value`, which :meth:`make` reads back
-    to an equal record."""
+    the schema's keys, each a plain value, a tuple or a frozen dataclass of its own, so nothing of it
+    can be changed (``dataclasses.replace`` makes another); a field whose default is None and that is
+    None is a key its JSON leaves out (an :class:`Optional` one). :meth:`make` checks a value against
+    ``SCHEMA``, cleans it (``CLEAN``), builds the record from it by the fields' types (an object their
+    dataclass, a list a tuple) and checks across fields (:meth:`validate`); :attr:`value` is its JSON
+    data, which :meth:`make` reads back to an equal record."""
+    __slots__ = ()
 
     @classmethod
     def make(cls, value):
         """The record of ``value`` (JSON data), checked; raises :class:`RecordError`."""
-        record = cls.of(check(value, cls.SCHEMA, cls.FILE))
+        record = _built(cls, cls.cleaned(check(value, cls.SCHEMA, cls.FILE)))
         record.validate()
         return record
-
-    @classmethod
-    def of(cls, value):
-        """The record of the checked ``value`` (the type's: its nested objects made records too)."""
-        raise NotImplementedError
 
     @property
     def value(self):
         """The record as JSON data: what :meth:`make` reads back."""
-        raise NotImplementedError
+        return _plain(self)
+
+
+def _built(hint, value):
+    """The checked JSON ``value`` as a field of the type ``hint`` holds it: an object its dataclass
+    (``Optional[X]`` an X or None), a list a tuple (``Tuple[X, ...]`` of X)."""
+    origin, args = getattr(hint, '__origin__', None), getattr(hint, '__args__', ())
+    if value is None:
+        return None
+    if origin is typing.Union:
+        return _built(next(arg for arg in args if arg is not type(None)), value)
+    if dataclasses.is_dataclass(hint):
+        hints = typing.get_type_hints(hint)
+        return hint(**{key: _built(hints[key], inner) for key, inner in value.items()})
+    if origin is tuple or hint is tuple:
+        return tuple(_built(args[0] if args[-1:] == (Ellipsis,) else None, item) for item in value)
+    return value
+
+
+def _plain(value):
+    """JSON data of a frozen dataclass record or of one of its fields (a tuple a list)."""
+    if dataclasses.is_dataclass(value):
+        return {field.name: _plain(getattr(value, field.name)) for field in dataclasses.fields(value)
+                if not (field.default is None and getattr(value, field.name) is None)}
+    if isinstance(value, tuple):
+        return [_plain(item) for item in value]
+    return value
 
 
 class Record(_Readable):
@@ -342,14 +381,7 @@ class Record(_Readable):
     checked object; two records are equal when their JSON is (NaN included). A record is frozen, as a
     frozen dataclass is and deeper: no attribute can be set, and its objects and lists
     (:class:`Frozen`, :class:`FrozenList`) refuse every change, so what a stage hands on is what the
-    next one reads; :meth:`replaced` makes a new record of changed fields, checked again. With
-    ``CLEAN``, every string of the record, keys too, is
-    :func:`~exam_lab.grader.score.safe_text.clean` once it matched its schema: the one place where
-    a student's text (node and topic names, log lines, a request) is made safe, whoever reads the
-    record later; ``CLEAN`` a tuple of keys cleans those fields only (the others are paths to open,
-    or names kept exactly)."""
-    CLEAN = False
-
+    next one reads; :meth:`replaced` makes a new record of changed fields, checked again."""
     __slots__ = ('value',)
 
     def __init__(self, value):
@@ -387,11 +419,7 @@ class Record(_Readable):
 
     @classmethod
     def _made(cls, value):
-        if cls.CLEAN is True:
-            value = cleaned(value)
-        elif cls.CLEAN:
-            value = dict(value, **{key: cleaned(value[key]) for key in cls.CLEAN if key in value})
-        record = cls(cls.converted(value))
+        record = cls(cls.converted(cls.cleaned(value)))
         record.validate()
         return record
 
