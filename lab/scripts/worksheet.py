@@ -11,7 +11,9 @@ worksheet is the one given, else the one make grade or an earlier make worksheet
 (worksheet-as-downloaded.csv). A student whose hand points are not all given, or whose status waits
 for the teacher, is left blank and listed; with no whole grade at all, no file is written. A
 student's hand points are the row of hand.csv with its participant number (the name only where the
-class has no numbers): a row that could be another student's stops it, naming both. Exits 0 when the
+class has no numbers): a row that could be another student's stops it, naming both. A student whose
+grade.json an older grader wrote is left out (its row as it was), said: "graded by an older grader:
+grade again"; a grade.json that is no grade at all stops it, named. Exits 0 when the
 worksheet was filled, 1 when it could not be (hand.csv, its rows or the worksheet unusable: every
 problem is printed). No ROS, no sandbox, no root: it reads records only.
 """
@@ -31,16 +33,20 @@ def main(argv=None):
     parser.add_argument('--worksheet', help="Moodle's offline grading worksheet (CSV); default: the one kept in OUT")
     args = parser.parse_args(argv)
     args.out = os.path.realpath(args.out)  # the teacher's path, followed once; nothing below it is
+    older = []
     try:
-        records = grades.records_in(args.out)
+        records = grades.records_in(args.out, older=older)
     except RecordError as err:
         # Filled from a grade that is not one, a row could be wrong: nothing is written until it is
         # graded or rescored again.
         print('worksheet: NOT filled: %s (make rescore, or make grade for that student)'
               % safe_text.clean(str(err)), file=sys.stderr)
         return 1
+    for line in older:  # a grade of an older grader: that student's row is left as it was, the class filled
+        print('worksheet: left out: %s' % safe_text.one_line(line))
     if not records:
-        print('worksheet: no grade.json in %s: run make grade first' % args.out, file=sys.stderr)
+        print('worksheet: no grade.json%s in %s: run make grade first'
+              % (' of today\'s grader' if older else '', args.out), file=sys.stderr)
         return 1
     records, twice = hand.newest(records)  # one participant graded twice: its newest, said; never the class's
     for line in twice:

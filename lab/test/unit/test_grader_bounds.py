@@ -162,12 +162,12 @@ def test_the_similarity_record_keeps_the_most_alike_within_its_caps():
                                  'scores': scores, 'notes': ['s1: not compared (refused)'] * 600})
     result = bounds.fit(result, SimilarityRecord)
     record = read_back(SimilarityRecord, result)
-    assert len(record.pairs) == 3160 and record.pairs[0]['score_b'] > 0.94  # the most alike first
+    assert len(record.pairs) == 3160 and record.pairs[0].score_b > 0.94  # the most alike first
     assert len(record.scores) < len(scores) and len(record.notes) == MAX_ITEMS
     said = ' | '.join(record.notes)
     assert '244650 pairs\' scores' in said and 'highlighted fragments not kept' in said, said[-800:]
-    assert "<span class='highlight-red'>" in record.pairs[0]['files'][0]['html_a']
-    assert '<' not in record.pairs[-1]['files'][0]['html_a']
+    assert "<span class='highlight-red'>" in record.pairs[0].files[0].html_a
+    assert '<' not in record.pairs[-1].files[0].html_a
 
 
 def test_the_intake_cuts_a_reason_and_refuses_more_students_than_a_class_holds(tmp_path, monkeypatch, capsys):
@@ -186,7 +186,7 @@ def test_the_intake_cuts_a_reason_and_refuses_more_students_than_a_class_holds(t
     monkeypatch.setattr(intake.os, 'getuid', lambda: 1000)
     assert intake.main(['--class', str(klass), '--out', str(out)]) == 0
     record = records.IntakeRecord.from_json((out / 'intake.json').read_bytes(), records.IntakeRecord.MAX_BYTES)
-    assert len(record.students[1]['refused']) == intake.MAX_REFUSED and bounds.CUT_MARK in record.students[1]['refused']
+    assert len(record.students[1].refused) == intake.MAX_REFUSED and bounds.CUT_MARK in record.students[1].refused
     monkeypatch.setattr(records.IntakeRecord, 'MAX_STUDENTS', 2)
     assert intake.main(['--class', str(klass), '--out', str(out)]) == 3
     assert 'the class archive holds 3 students (at most 2 for a class)' in capsys.readouterr().err

@@ -23,7 +23,7 @@ from exam_lab.grader.score.records import MEASUREMENTS, SimilarityRecord
 from exam_lab.grader.host import run as host_run
 
 from exam_lab.grader.publish import desk, flightplot, gradescope, hand, moodle, page, progress, report
-from exam_lab.grader.score import safe_text
+from exam_lab.grader.score import kept, safe_text
 from exam_lab.grader.score.kept import GradeRecord
 from exam_lab.grader.score.sheets import HAND_ITEMS, ITEMS
 from test_grader_desk import probe_result
@@ -49,7 +49,7 @@ def hostile_record(student=NAME):
               'evidence': 'values wrong: %s\nmore %s' % (HOSTILE, HOSTILE) if item == 'Q11' else 'ok'}
              for item, (top, _) in ITEMS.items()]
     total = sum(i['points'] for i in items)
-    return {'student': student, 'sheet': 'altitude', 'total': total, 'max': 17.0, 'items': items,
+    return {'version': kept.VERSION, 'student': student, 'sheet': 'altitude', 'total': total, 'max': 17.0, 'items': items,
             'for_the_teacher': ['main run, odd lines in the log: %s' % HOSTILE], 'participant': 101,
             'status': 'needs a hand grade', 'status_reason': 'the node crashed: %s' % HOSTILE,
             'documents': [{'name': 'report%s.pdf' % HOSTILE, 'pages': 2}], 'seconds': 40.0}
@@ -359,9 +359,11 @@ def test_a_name_in_any_bytes_is_kept_exactly_by_a_rescore(tmp_path):
     """The measurements keep the name as it was (surrogate escapes in JSON); a rescore shows it
     escaped, run after run."""
     out = tmp_path / 'out'
-    measured = {'student': 'Cy', 'sheet': 'altitude', 'static': {}, 'notes': ['link %s dropped' % NOT_UTF8],
+    measured = {'version': kept.VERSION, 'student': 'Cy', 'sheet': 'altitude', 'static': {},
+                'notes': ['link %s dropped' % NOT_UTF8],
                 'fixes': [], 'comments': {'comments': 1, 'code': 2, 'files': ['scripts/' + NOT_UTF8]},
-                'isolate': True, 'how_run': None, 'session': {'build': None, 'runs': [], 'error': 'x'},
+                'isolate': True, 'how_run': None,
+                'session': {'outcome': 'session_failed', 'build': None, 'runs': [], 'error': 'x'},
                 'extra': {'participant': 3, 'folder': 'Cy_3_assignsubmission_file_', 'documents': [], 'seconds': 1.0}}
     os.makedirs(str(out / 'Cy'))
     with open(str(out / 'Cy' / MEASUREMENTS), 'w') as f:
@@ -427,7 +429,7 @@ def test_make_rescore_reads_the_runs_similarity_json_as_its_record(tmp_path, cap
     from test_grader_kept import kept_folder
     out = tmp_path / 'out'
     for name in ('Ann', 'Bob'):
-        kept_folder(out, 'before-version', name)
+        kept_folder(out, 'version-1', name)
     match = {'file_a': 'scripts/a.py', 'file_b': 'scripts/b.py', 'sim_a': 0.9, 'sim_b': 0.9,
              'html_a': "<span class='highlight-red'>x = 1</span>", 'html_b': 'x = 1'}
     check = {'pairs': [{'a': 'Ann', 'b': 'Bob', 'score_a': 0.9, 'score_b': 0.9, 'files': [match]}],

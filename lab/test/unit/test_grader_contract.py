@@ -1,5 +1,6 @@
 """What a box hands back is data root checks: one regular file, capped, never followed, of the record's
 schema. No ROS, no box: the records are written here as a hostile box would."""
+import dataclasses
 import json
 import os
 
@@ -97,8 +98,12 @@ def test_links_fifos_and_missing_files_are_refused(tmp_path):
 
 def test_an_intake_names_only_students_inside_its_folder(tmp_path):
     good = {'uid': 61000, 'students': [{'name': 'Jane Doe', 'path': 'class/Jane Doe_1_assignsubmission_file_'}]}
-    assert contract.read_record(write(tmp_path, good, 'intake.json'), records.IntakeRecord).students[0]['name'] == \
-        'Jane Doe'
+    read = contract.read_record(write(tmp_path, good, 'intake.json'), records.IntakeRecord)
+    assert read.students[0].name == 'Jane Doe'
+    # A frozen dataclass: its JSON reads back to an equal record, and nothing of it can be set.
+    assert records.IntakeRecord.from_json(read.to_json().encode()) == read and read.value == good
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        read.students[0].name = 'x'
     for student in ({'name': '../../etc', 'path': 'class/x'}, {'name': 'x/y', 'path': 'class/x'},
                     {'name': '..', 'path': 'class/x'}, {'name': 'Jane', 'path': '/root'},
                     {'name': 'Jane', 'path': 'class/../../x'}):
@@ -121,8 +126,8 @@ def test_similarity_html_holds_only_the_highlight(tmp_path):
     # The students' file names and code are made safe where the record is made; the highlight stays.
     match.update(file_a='a\x1b[2J.py', html_b="w\x07 <span class='highlight-green'>v\u202e</span>")
     read = contract.read_record(write(tmp_path, good, 'similarity.json'), records.SimilarityRecord)
-    assert read.pairs[0]['files'][0]['file_a'] == 'a.py'
-    assert read.pairs[0]['files'][0]['html_b'] == "w <span class='highlight-green'>v</span>"
+    assert read.pairs[0].files[0].file_a == 'a.py'
+    assert read.pairs[0].files[0].html_b == "w <span class='highlight-green'>v</span>"
 
 
 def test_a_cap_hit_is_a_sentence_naming_the_cap_and_the_value(tmp_path):
@@ -145,7 +150,7 @@ def test_a_class_larger_than_a_list_cap_is_one_intake(tmp_path):
     students[7]['refused'] = 'the files of S 7: 5001 more files, beyond the 5000 a submission may unpack'
     got = contract.read_record(write(tmp_path, {'uid': 61000, 'students': students}, 'intake.json'),
                              records.IntakeRecord, records.IntakeRecord.MAX_BYTES)
-    assert len(got.students) == 600 and got.students[7]['refused'].startswith('the files of S 7')
+    assert len(got.students) == 600 and got.students[7].refused.startswith('the files of S 7')
 
 
 def test_the_inspections_text_is_made_safe_where_its_record_is_made(tmp_path):

@@ -9,7 +9,7 @@ from exam_lab.grader.boxed import derive, launch, source
 
 from exam_lab.grader.judge import legs, pilot
 
-from exam_lab.grader.score import flight, records, rubric, runs, tolerances, verdict
+from exam_lab.grader.score import fields, flight, records, rubric, runs, tolerances, verdict
 
 from exam_lab.grader.publish import report
 
@@ -316,6 +316,14 @@ class ScriptedNode(object):
         return list(self.made)
 
 
+def plan(**change):
+    """A run's plan as the judge reads it from its job (:meth:`~exam_lab.grader.score.records.JobRecord.plan`):
+    the main run's of a 1300 m threshold, checked."""
+    value = dict({'kind': 'main', 'sheet': 'altitude', 'threshold': 1300.0, 'margin': 130.0, 'delay': 5.0,
+                  'start_timeout': 20.0, 'output': '/altitude', 'late_warning': 60.0}, **change)
+    return fields.view(records.check(value, records.PLAN, 'plan'), records.PLAN)
+
+
 def synthetic_flight(monkeypatch, node, clock, rates, warned_before=False):
     """The probe's flight (pilot.Flight.fly_legs, unchanged) around a scripted node on the synthetic
     clock; ``warned_before``: its value was above for 6 s just before (the calibration's high point),
@@ -325,9 +333,7 @@ def synthetic_flight(monkeypatch, node, clock, rates, warned_before=False):
     monkeypatch.setattr(wait, 'time', clock)
     drone = type('Drone', (), {'rates': rates, 'service': type('Service', (), {'calls': node.calls})()})()
     graph = type('Graph', (), {'student_nodes': lambda self: ['/exam']})()
-    plan = records.PlanRecord.make({'kind': 'main', 'sheet': 'altitude', 'threshold': 1300.0, 'margin': 130.0, 'delay': 5.0,
-                                    'start_timeout': 20.0, 'output': '/altitude', 'late_warning': 60.0})
-    flying = pilot.Flight(plan, node.fly, node, drone, graph)
+    flying = pilot.Flight(plan(), node.fly, node, drone, graph)
     if warned_before:
         node.fly(1430.0)
         clock.sleep(6.0)

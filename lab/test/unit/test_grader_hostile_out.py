@@ -2,7 +2,7 @@
 make rescore and make worksheet read it through the contract (grader/contract.py) and write in it only
 through its writer. Each hostile entry is that student's line, never a write elsewhere, never a hang
 (each script runs in a child process with a timeout: a regression fails, it cannot hang the suite).
-The kept files are copies of a real grading (data/kept/before-version). No ROS, no box."""
+The kept files are copies of a real grading (data/kept/version-1). No ROS, no box."""
 import json
 import os
 import subprocess
@@ -14,7 +14,7 @@ from exam_lab.grader import contract
 from exam_lab.grader.publish import grades, hand
 from exam_lab.grader.score.records import MEASUREMENTS, RecordError
 
-KEPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'data', 'kept', 'before-version')
+KEPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'data', 'kept', 'version-1')
 SCRIPTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'scripts')
 #: Seconds a script may take on two students (it takes about one): past them it hangs.
 TIMEOUT = 60

@@ -49,7 +49,7 @@ def keep_runs(folder, runs, checked=True):
         session = SessionRecord.make(session).value
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, records.MEASUREMENTS), 'w') as f:
-        json.dump(dict(kept_copy('before-version'), session=session), f)
+        json.dump(dict(kept_copy('version-1'), session=session), f)
 
 
 def refused(value, record_type=ProbeRecord):
@@ -170,7 +170,7 @@ def test_a_rescore_reads_back_the_session_record_the_run_kept(tmp_path):
     probe = real_probe()
     probe['formula'][1]['published'] = float('nan')
     session_ = SessionRecord.make(real_session(probe)).value
-    kept = {'student': 'Ann', 'sheet': 'altitude', 'static': kept_copy('before-version')['static'], 'session': session_,
+    kept = {'version': 1, 'student': 'Ann', 'sheet': 'altitude', 'static': kept_copy('version-1')['static'], 'session': session_,
             'notes': [], 'fixes': [], 'comments': None, 'isolate': True, 'how_run': 'test', 'extra': {'seconds': 40.0}}
     folder = tmp_path / 'Ann'
     folder.mkdir()
@@ -196,10 +196,10 @@ def inspected(**change):
 
 def test_the_job_and_its_plans_are_records_that_round_trip(tmp_path, capsys):
     """The plan (runner), the job as the session reads it (job.json) and each run's plan as the judge
-    reads it (plan-<tag>.json) are checked records: what the runner made is what they read."""
+    reads it (from the same job: JobRecord.plan) are checked records: what the runner made is what they read."""
     job = runner.plan_job(inspected())
     assert isinstance(job, records.JobRecord) and [run['tag'] for run in job.runs] == ['main', 'threshold']
-    main, threshold = (records.PlanRecord.make(run['plan']) for run in job.runs)
+    main, threshold = job.plan('main'), job.plan('threshold')
     assert (main.threshold, threshold.threshold, threshold.margin) == (1300.0, 900.0, 130.0) and main.late_warning > 0
     assert records.JobRecord.from_json(job.to_json().encode()) == job
     assert runner.plan_job(inspected(calls_service=False)).runs[0]['plan']['late_warning'] == 0.0
@@ -209,7 +209,12 @@ def test_the_job_and_its_plans_are_records_that_round_trip(tmp_path, capsys):
     with pytest.raises(RecordError, match='the threshold run with a plan of a main run'):
         job.replaced(runs=[job.runs[0], dict(job.runs[1], plan=job.runs[0]['plan'])])
     with pytest.raises(RecordError, match='late_warning'):
-        main.replaced(late_warning=-1.0)
+        job.replaced(runs=[dict(job.runs[0], plan=dict(job.runs[0]['plan'], late_warning=-1.0)), job.runs[1]])
+    with pytest.raises(RecordError, match='no threshold run'):
+        runner.plan_job(inspected(threshold_launch=None, threshold_run_value=None)).plan('threshold')
+    # The judge's plan is the job's, field for field: what the runner made, nothing added on the way.
+    again = records.JobRecord.from_json(job.to_json().encode()).plan('threshold')
+    assert {key: getattr(again, key) for key in records.PLAN} == job.runs[1]['plan']
     # The session refuses a job that is not one, naming the field, and writes no record.
     bad = tmp_path / 'job.json'
     bad.write_text(json.dumps(dict(json.loads(job.to_json()), run_timeout='90')))

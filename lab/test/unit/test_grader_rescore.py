@@ -10,10 +10,10 @@ from test_grader_kept import kept_copy
 
 
 def late_measurements():
-    """A real grading's measurements (good_student, kept before the version), its main run's second
-    WARNING (and the drone's answer to it) 0.5 s later: 5.41 s after the node's own value stayed
-    above, inside the rubric's window, 0.11 s outside a window of the delay +-0.3 s."""
-    late = kept_copy('before-version')
+    """A real grading's measurements (good_student, version 1), its main run's second WARNING (and the
+    drone's answer to it) 0.5 s later: 5.40 s after the node's own value stayed above, inside the
+    rubric's window, 0.10 s outside a window of the delay +-0.3 s."""
+    late = kept_copy('version-1')
     probe = late['session']['runs'][0]['probe']
     warning = [call for call in probe['calls'] if call[1] == 'WARNING'][1]
     answer = [a for a in probe['answers'] if a[:2] == warning][0]
@@ -24,7 +24,7 @@ def late_measurements():
 def test_rescore_applies_todays_rubric_to_the_kept_measurements(tmp_path, monkeypatch):
     """Two students' measurements (real ones, as a run keeps them): no change with the same rubric; a
     tighter WARNING window moves the late student's Q14b only, with its previous points kept."""
-    for name, kept in (('on_time', dict(kept_copy('before-version'), student='on_time')), ('late', late_measurements())):
+    for name, kept in (('on_time', dict(kept_copy('version-1'), student='on_time')), ('late', late_measurements())):
         folder = tmp_path / name
         folder.mkdir()
         (folder / MEASUREMENTS).write_text(json.dumps(kept))
@@ -67,7 +67,7 @@ def test_every_similarity_json_the_class_run_writes_is_read_back_as_its_record(t
         monkeypatch.setattr(class_run, 'class_students', fails)
         result = class_run.class_similarity(str(tmp_path / 'class.zip'), str(tmp_path), [])
         kept = SimilarityRecord.read(str(tmp_path / 'similarity.json'))
-        assert isinstance(result, SimilarityRecord) and kept == result and kept.notes == []
+        assert isinstance(result, SimilarityRecord) and kept == result and kept.notes == ()
         assert not [n for n in os.listdir(str(tmp_path)) if n.endswith('.part')]
         errors.append(kept.error)
     assert errors[0] == 'the archive failed on  entry 3'
@@ -86,7 +86,7 @@ def test_make_rescore_reads_each_kept_report_as_its_record_never_the_box(tmp_pat
     for name in ('read', 'encrypted', 'garbled', 'none'):
         folder = tmp_path / name
         folder.mkdir()
-        kept = dict(kept_copy('before-version'), student=name)
+        kept = dict(kept_copy('version-1'), student=name)
         (folder / MEASUREMENTS).write_text(json.dumps(kept))
         (folder / 'grade.json').write_text(json.dumps(grades.score(kept)))
     page = {'file': 0, 'number': 1, 'source': 'text', 'text': 'rosnode list', 'layout': '', 'confidence': None,

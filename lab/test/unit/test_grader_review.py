@@ -76,7 +76,7 @@ def graded_out(root, boxes, names=('ann', 'bob', 'cyd', 'dan'), report_only=('zo
     rescore, hand.csv by make grade's writer; the reports of :data:`HANDED_IN` (from ``boxes``) and the
     code of :data:`WITH_CODE` kept, and the proposals written, as the grader keeps and writes them."""
     out = root / 'out'
-    shapes = [(n, 'before-version') for n in names] + [(n, 'no-node-before-records') for n in report_only]
+    shapes = [(n, 'version-1') for n in names] + [(n, 'no-node-version-1') for n in report_only]
     for index, (name, shape) in enumerate(shapes):
         measured = kept_copy(shape)
         number = 201 + index

@@ -13,20 +13,18 @@ from exam_lab.grader.score import records
 from exam_lab.harness.supervisor import Supervisor, alive
 from exam_lab.harness.wait import wait_until
 
-from test_grader_fairness import ALTITUDE_RATES, ScriptedNode, SyntheticClock
+from test_grader_fairness import ALTITUDE_RATES, ScriptedNode, SyntheticClock, plan
 
 
-def threshold_plan(**change):
-    value = {'kind': 'threshold', 'sheet': 'altitude', 'threshold': 1300.0, 'margin': 130.0, 'delay': 5.0,
-             'start_timeout': 20.0, 'output': '/altitude', 'late_warning': 60.0}
-    return records.PlanRecord.make(dict(value, **change))
+def threshold_plan():
+    return plan(kind='threshold')
 
 
 def test_the_threshold_run_waits_as_long_as_the_main_run_says_once_it_says_it(tmp_path):
     """Before the main run's word, a late WARNING is waited for the plan's 60 s; then as long as the
     main run's took (its latency or the delay, and AFTER_S), or not at all when it never warned."""
     word = str(tmp_path / side_by_side.MAIN_WORD)
-    told = probe.MainWord(threshold_plan(main_word=word))
+    told = probe.MainWord(threshold_plan(), word)
     assert told.late_warning() == 60.0
     with open(word, 'w') as f:
         json.dump({'warned': True, 'warn_after': 12.0}, f)
@@ -35,8 +33,8 @@ def test_the_threshold_run_waits_as_long_as_the_main_run_says_once_it_says_it(tm
                         ({'warned': False, 'warn_after': None}, 0.0)):
         with open(word, 'w') as f:
             json.dump(said, f)
-        assert probe.MainWord(threshold_plan(main_word=word)).late_warning() == bound
-    # The main run's word, one after the other: the same bound from the plan's warn_after.
+        assert probe.MainWord(threshold_plan(), word).late_warning() == bound
+    # The main run's latency: the same bound from it (one after the other, the word is there before the run).
     assert probe.late_bound(threshold_plan(), 12.0) == 13.5
 
 

@@ -243,7 +243,8 @@ def test_a_moodle_class_zip_is_graded_as_a_folder_is(tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize('left, why', [
-    ('{"student": "s1", "status": "graded"}', 'grade.json: sheet is missing'),  # of another shape
+    ('{"version": 1, "student": "s1", "status": "graded"}', 'grade.json: sheet is missing'),  # of another shape
+    ('{"student": "s1", "status": "graded"}', 'grade.json: graded by an older grader: grade again'),  # no version
     ('{"student": "s1", "tot', 'grade.json: not JSON'),                          # cut short
     (json.dumps(graded('s0')), "grade.json: the grade of 's0', not of 's1'"),    # another student's
     (json.dumps(dict(graded('s1'), total='17')), 'grade.json.total: a number expected, got str'),

@@ -22,7 +22,7 @@ def student(out, name, report, code='every_cycle'):
     of a real submission's code, and the report's record as the reader keeps it."""
     folder = os.path.join(str(out), name)
     os.makedirs(folder)
-    measured = dict(kept_copy('before-version'), student=name)
+    measured = dict(kept_copy('version-1'), student=name)
     pkg = package(code)
     files = source.student_code(pkg)
     lines = source.comment_ratio(files)

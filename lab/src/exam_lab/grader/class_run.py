@@ -94,12 +94,12 @@ def class_students(class_path, work_dirs, scratch=None, refused=None, out=None):
             raise UnpackError('unpacking it in its box failed: %s' % err)
     students = []
     for student in found.students:
-        path = os.path.join(boxed.out, student['path'])
+        path = os.path.join(boxed.out, student.path)
         if os.path.realpath(path) != os.path.normpath(path) or not os.path.lexists(path):
-            raise UnpackError('the intake named %s, which is a link or missing' % student['path'])
-        if student.get('refused') is not None and refused is not None:
-            refused[path] = student['refused']
-        students.append((student['name'], path))
+            raise UnpackError('the intake named %s, which is a link or missing' % student.path)
+        if student.refused is not None and refused is not None:
+            refused[path] = student.refused
+        students.append((student.name, path))
     return _unique(students, kept_folders(out))
 
 

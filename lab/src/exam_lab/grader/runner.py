@@ -21,7 +21,8 @@ parses the student's bytes. So one grading runs as three kinds of processes:
 What crosses, and how:
 
   - down, into the box: the upload (bytes), and a job root computed from the inspection's record, once
-    (:func:`plan_job`: a :class:`~exam_lab.grader.score.records.JobRecord`, each run's plan in it);
+    (:func:`plan_job`: a :class:`~exam_lab.grader.score.records.JobRecord`, each run's plan in it, which
+    reaches the judge as it was made);
   - up, out of the box: one record per step (the inspection's, the session's
     :class:`~exam_lab.grader.score.records.SessionRecord`), each read through the contract (no link,
     a regular file, capped, checked by its type, its text cleaned once) and the logs, copied as capped

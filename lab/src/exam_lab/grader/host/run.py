@@ -11,8 +11,8 @@ import sys
 import time
 
 from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
-from exam_lab.grader.contract import read_capped, read_record
-from exam_lab.grader.score.records import LAUNCH_ENDED, MAX_ENDED, MAX_LOG_TEXT, PlanRecord, ProbeRecord, RecordError
+from exam_lab.grader.contract import read_capped, read_record, write_record
+from exam_lab.grader.score.records import LAUNCH_ENDED, MAX_ENDED, MAX_LOG_TEXT, JobRecord, ProbeRecord, RecordError
 from exam_lab.grader.score.runs import WATCHED_DEATHS
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.harness.supervisor import ros_env, workspace_env
@@ -65,6 +65,11 @@ def launch_outcome(output, workspace=None):
     # judge's own (the rubric counts them with these: score/runs.py).
     return {'ended': ended[:MAX_ENDED - WATCHED_DEATHS], 'not_started': [line[:500] for line in _NOT_STARTED.findall(text)[:50]],
             'tail': tail(clean(output))}
+
+
+#: What the session tells the threshold run of its main run, in the threshold run's judge folder
+#: (:class:`~exam_lab.grader.judge.probe.MainWord`): whether the node warned, how late.
+MAIN_WORD = 'main-word.json'
 
 
 def capped_log(sup, name):
@@ -128,7 +133,8 @@ def run_one(sup, job, run, base_env, box, budget):
     happened (the probe's result as read, when it ran, whether its master ended), which the rubric
     judges (:func:`~exam_lab.grader.score.runs.judged_run`), never the session. The probe is waited
     for at most the run's limit or what is left of the ``budget``. The judge's folder is the run's own
-    (``run['judge_home']``) when it has one, else the job's."""
+    (``run['judge_home']``) when it has one, else the job's; the threshold run's judge reads the main
+    run's word there (:data:`MAIN_WORD`), once the session wrote it."""
     tag = run['tag']
     log_dir, judge_dir = sup.log_dir, run.get('judge_home') or job.judge_home
     reset_memory_peak(box.judge_cgroups.get('master', []))
@@ -140,17 +146,19 @@ def run_one(sup, job, run, base_env, box, budget):
     launch = sup.start('launch-%s' % tag, box.argv(
         ['bash', '-c', 'source "$1/devel/setup.bash" && exec roslaunch --screen "$2"', 'bash',
          job.workspace, run['launch']], launch_env))
-    plan_path = os.path.join(judge_dir, 'plan-%s.json' % tag)
+    # The job as the session read it, for the judge to take its run's plan from, as it was made; the
+    # plan in the log folder marks the flight's start for the progress and says what was flown.
+    job_path, plan = os.path.join(judge_dir, JobRecord.FILE), run['plan']
+    write_record(job_path, job)
+    with open(os.path.join(log_dir, 'plan-%s.json' % tag), 'w') as f:
+        json.dump(plan, f, indent=1, sort_keys=True)
     result_path = os.path.join(judge_dir, 'probe-%s.json' % tag)
-    plan = PlanRecord.make(run['plan'])
-    for path in (plan_path, os.path.join(log_dir, 'plan-%s.json' % tag)):  # the judge's, and the progress's
-        with open(path, 'w') as f:
-            f.write(plan.to_json())
+    word = [os.path.join(judge_dir, MAIN_WORD)] if tag == 'threshold' else []
     probe_env = ros_env(master.env, master.uri, os.path.join(judge_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')
     probe_env['ROS_NAMESPACE'] = job.namespace or '/'
     started, started_wall = time.monotonic(), time.time()
     probe = sup.start('probe-%s' % tag, box.judge_argv(
-        [sys.executable, '-m', 'exam_lab.grader.judge.probe', plan_path, result_path], 'probe'), probe_env)
+        [sys.executable, '-m', 'exam_lab.grader.judge.probe', job_path, tag, result_path] + word, 'probe'), probe_env)
     # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
     # nothing it does when its drone goes away (a failed service call, a crash) is counted.
     limit, by_budget = budget.limit(job.run_timeout, RUN_STOP_S)

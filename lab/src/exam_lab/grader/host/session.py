@@ -9,7 +9,8 @@ student's: it reads roslaunch's output and the probe's JSON, both capped. The ju
 the probe with its fake drone) runs as the slot's judge uid (:meth:`~exam_lab.grader.host.sandbox.Box.judge_argv`:
 not root, not the box's uid), the master bounded in memory and both weighted above the box for CPU,
 under a :class:`~exam_lab.harness.supervisor.Supervisor` whose log folder the student's code cannot see;
-the judge's own folder (``judge_home``: ROS logs, plans, the probe's results) is the judge's, mode 0700.
+the judge's own folder (``judge_home``: ROS logs, its copy of the job, the main run's word, the probe's results) is
+the judge's, mode 0700.
 Every step that runs the student's code (``catkin_make``, ``roslaunch`` and the nodes) runs in the
 submission's :class:`~exam_lab.grader.host.sandbox.Box`, another user in namespaces of its own that shares
 only this network namespace. The box's environment starts empty: the underlay's, ROS's, a fresh HOME;
@@ -24,7 +25,8 @@ the simulators' workspace), ``log_dir``, ``namespace`` (the drone's), ``build_ti
 ``run_timeout`` (s), ``budget`` (s the session may take, what is left of ``student_budget``, the
 student's whole grading: :class:`~exam_lab.grader.host.run.Budget`), ``judge_home`` (the judge's folder), ``runs``: the main run and, when the launch
 file has a threshold the grader can change, the threshold run: each ``{"tag", "launch" (derived launch
-file, as the box sees it), "plan" (for the probe)}`` (and, for the run flown in the submission's second
+file, as the box sees it), "plan" (the probe's, as the runner made it: the judge reads it from
+this job)}`` (and, for the run flown in the submission's second
 box, its ``box`` and ``judge_home``), ``side_by_side`` (the two runs at once:
 :mod:`~exam_lab.grader.host.side_by_side`; otherwise one after the other, here). Writes ``<log_dir>/session.json``: ``{"build":
 {...}, "runs": [{"tag", "probe" (the probe's result as read, or None), "probe_wall" (the wall times
@@ -43,11 +45,12 @@ import sys
 
 from exam_lab.grader.host import side_by_side as both
 from exam_lab.grader.host.run import (
-    MIN_RUN_S, RUN_STOP_S, STEP_STOP_S, Budget, base_environment, capped_log, judge_environment, run_one, tail)
+    MAIN_WORD, MIN_RUN_S, RUN_STOP_S, STEP_STOP_S, Budget, base_environment, capped_log, judge_environment,
+    run_one, tail)
 from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.host.timings import Stopwatch, boxes_cpu
 from exam_lab.grader.score.records import JobRecord, Outcome, RecordError, SessionRecord
-from exam_lab.grader.score.runs import judged_run, warned_in_long_excursion, warning_latency
+from exam_lab.grader.score.runs import judged_run, warned_in_long_excursion
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.harness.supervisor import Supervisor
 
@@ -156,7 +159,8 @@ def session(job, job_path=None, watch=None):
 def one_after_the_other(sup, job, base_env, box, budget, result):
     """The runs of ``job`` in this process, the threshold run after the main run and only when the node
     warned in it (its result counted as the rubric counts it: :func:`judged_run`), waiting for its late
-    WARNING as long as the main run's took; into ``result``."""
+    WARNING as long as the main run's took (told before it starts, as a run flown beside it is told:
+    :func:`~exam_lab.grader.host.side_by_side.tell_threshold_run`); into ``result``."""
     for run in job.runs:
         run = {key: value for key, value in run.items() if key not in ('box', 'judge_home')}  # all in ``box``
         if run['tag'] == 'threshold':
@@ -164,7 +168,7 @@ def one_after_the_other(sup, job, base_env, box, budget, result):
             if not warned_in_long_excursion(main):
                 result['threshold_skipped'] = 'the node never warned in the main run'
                 break
-            run = dict(run, plan=dict(run['plan'], warn_after=warning_latency(main)))
+            both.tell_threshold_run(main, os.path.join(job.judge_home, MAIN_WORD), box.judge_uid)
         if budget.left(RUN_STOP_S) < MIN_RUN_S:
             budget.spend('the %s run was not started (%.0f s left)' % (run['tag'], budget.left()))
             break

@@ -16,7 +16,8 @@ import subprocess
 import sys
 
 from exam_lab.grader.host import bwrap
-from exam_lab.grader.host.run import STEP_STOP_S, Budget, base_environment, judge_environment, probe_record, run_one, tail
+from exam_lab.grader.host.run import (
+    MAIN_WORD, STEP_STOP_S, Budget, base_environment, judge_environment, probe_record, run_one, tail)
 from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.host.timings import Stopwatch, boxes_cpu
 from exam_lab.grader.score.records import JobRecord, RecordError
@@ -63,19 +64,16 @@ def copy_build(box, runs):
         return False
 
 
-#: What the session tells the threshold run of the main run flown beside it (:class:`~exam_lab.grader.judge.probe.MainWord`).
-MAIN_WORD = 'main-word.json'
-
-
 def side_by_side(sup, job, job_path, budget, result):
     """The two runs at once, each a process of its own (``session JOB --run TAG``) in a network
     namespace of its own with only loopback, its master, its box (the threshold run's: a uid, a copy
     of the build, a judge of its own) and its supervisor: a node sees the same in either, and neither
     run can reach the other. Once the main run's result is in (or it ended without one), the threshold
-    run is told whether the node warned and how late (:data:`MAIN_WORD`), so it waits for a late WARNING
-    as long as the main run's took; a threshold run whose main run never warned (its result counted as
-    the rubric counts it) is not kept, as when it is not flown. Which run flies in the copy was drawn by the runner (:func:`~exam_lab.grader.runner.plan_job`):
-    a node that tells the copy (its uid, its files' times) learns nothing of its run. Into ``result``."""
+    run is told whether the node warned and how late (:data:`~exam_lab.grader.host.run.MAIN_WORD`), so
+    it waits for a late WARNING as long as the main run's took; a threshold run whose main run never
+    warned (its result counted as the rubric counts it) is not kept, as when it is not flown. Which run
+    flies in the copy was drawn by the runner (:func:`~exam_lab.grader.runner.plan_job`): a node that
+    tells the copy (its uid, its files' times) learns nothing of its run. Into ``result``."""
     main, threshold = job.runs
     word = os.path.join(threshold.get('judge_home') or job.judge_home, MAIN_WORD)
     main_result = os.path.join(main.get('judge_home') or job.judge_home, 'probe-main.json')
@@ -87,7 +85,8 @@ def side_by_side(sup, job, job_path, budget, result):
 
     def done():
         if not told and (os.path.isfile(main_result) or started['main'].poll() is not None):
-            tell_threshold_run(main_result, word, Box.attached(threshold.get('box') or job.box).judge_uid)
+            probe = probe_record(main_result)[0] if os.path.isfile(main_result) else None
+            tell_threshold_run(probe, word, Box.attached(threshold.get('box') or job.box).judge_uid)
             told.append(True)
         return all(proc.poll() is not None for proc in started.values())
 
@@ -107,9 +106,9 @@ def side_by_side(sup, job, job_path, budget, result):
             budget.used = budget.used or run['budget']
 
 
-def tell_threshold_run(main_result, word, judge_uid):
-    """Write :data:`MAIN_WORD` from the main run's result (or its absence), for the threshold run's judge."""
-    probe = probe_record(main_result)[0] if os.path.isfile(main_result) else None
+def tell_threshold_run(probe, word, judge_uid):
+    """Write the main run's word (:data:`~exam_lab.grader.host.run.MAIN_WORD`, the file ``word``) from
+    its probe's result (None when there is none), for the threshold run's judge (``judge_uid``)."""
     said = {'warned': warned_in_long_excursion(probe), 'warn_after': warning_latency(probe)}
     with open(word + '.part', 'w') as f:
         json.dump(said, f)
@@ -142,8 +141,6 @@ def run_alone(job, tag, seconds):
     watch = Stopwatch(boxes_cpu(box))
     judge_home = run.get('judge_home') or job.judge_home
     budget = Budget(seconds, job.student_budget)
-    if tag == 'threshold':
-        run = dict(run, plan=dict(run['plan'], main_word=os.path.join(judge_home, MAIN_WORD)))
     with watch.stage(tag):
         with Supervisor(job.log_dir, env=judge_environment(judge_home, box), marker=run_marker(job.log_dir, tag)) as sup:
             record = run_one(sup, job, dict(run, judge_home=judge_home), base_environment(job), box, budget)

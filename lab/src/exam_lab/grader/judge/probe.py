@@ -2,7 +2,7 @@
 
 Run inside its own rospy process, on the master of one submission, by :mod:`exam_lab.grader.host.session`::
 
-    python3 -m exam_lab.grader.judge.probe PLAN.json RESULT.json
+    python3 -m exam_lab.grader.judge.probe JOB.json TAG RESULT.json [WORD.json]
 
 The drone is the harness's :class:`~exam_lab.harness.fake_drone.Drone`, the sheet's own drone (its
 topics, rates, service, answers and LED, from the drone package's SPEC; a new value goes out at the
@@ -10,11 +10,13 @@ sensor's next tick, as the real drone's reading does), driven by a script with n
 the oracle, so the same package gets the same measurements. The probe only
 measures; the points are given by :mod:`exam_lab.grader.score.rubric` from the JSON it writes.
 
-Plan (JSON): ``kind`` ("main": the whole scenario, "threshold": the check of question 14a, the same
-scenario around the threshold drawn for it), ``sheet``, ``threshold`` (student units), ``margin`` (how
-far beyond the threshold to fly), ``delay`` (s), ``start_timeout`` (s to wait for the node),
-``late_warning`` (s a late WARNING is waited for, 0 for none); for "threshold" also ``warn_after``
-(s the main run's WARNING took) or, flown beside the main run, ``main_word`` (:class:`MainWord`).
+The plan is the run ``TAG``'s of the session's job (:class:`~exam_lab.grader.score.records.JobRecord`,
+:data:`~exam_lab.grader.score.records.PLAN`), as the runner made it: ``kind`` ("main": the whole
+scenario, "threshold": the check of question 14a, the same scenario around the threshold drawn for
+it), ``sheet``, ``threshold`` (student units), ``margin`` (how far beyond the threshold to fly),
+``delay`` (s), ``start_timeout`` (s to wait for the node), ``late_warning`` (s a late WARNING is
+waited for, 0 for none). The threshold run also reads the main run's word in ``WORD.json``
+(:class:`MainWord`): how late its WARNING came.
 
 Every time is the wall clock's (``time.time()``), never rospy's ROS time: a student's node can set
 ``/use_sim_time`` on the master before the probe's ``init_node`` and publish ``/clock``, and rospy would
@@ -55,7 +57,7 @@ from exam_lab.grader.judge.pilot import Calibration, Flight, Inputs
 from exam_lab.grader.judge.graph import ClockWatch, Graph, NodeWatch, RefusedConnections, node_pid, node_uri
 from exam_lab.grader.judge.legs import AFTER_S, trace
 from exam_lab.grader.judge.node import NodeFinder
-from exam_lab.grader.score.records import LAUNCH_ENDED, PlanRecord, RecordError
+from exam_lab.grader.score.records import LAUNCH_ENDED, JobRecord, RecordError
 from exam_lab.harness.fake_drone import Drone
 
 
@@ -63,8 +65,8 @@ class Probe(object):
     """One run of the probe: the drone up and the graph watched from its start, then the plan flown
     (:meth:`run`); ``result`` is what it measured."""
 
-    def __init__(self, plan, launch_ended=lambda: False):
-        self.plan, self.launch_ended = plan, launch_ended
+    def __init__(self, plan, word=None, launch_ended=lambda: False):
+        self.plan, self.word, self.launch_ended = plan, word, launch_ended
         self.result = {'kind': plan.kind, 'sheet': plan.sheet, 'threshold': plan.threshold,
                        'margin': plan.margin, 'delay': plan.delay, 'start_timeout': plan.start_timeout}
         self.graph = Graph()
@@ -84,13 +86,10 @@ class Probe(object):
         """Question 14a: the node restarted with its launch file's threshold changed to a value drawn at
         grading time, flown exactly as the main run (issue 36 point 7: a node cannot tell the two runs
         apart but by the threshold its launch file gave it) around that value, whose long excursion
-        stays below the launch file's threshold. A WARNING that came late in the main run
-        (``warn_after``) is waited for that long, no longer: a node that ignores the new value costs
+        stays below the launch file's threshold. A WARNING that came late in the main run (its word,
+        :class:`MainWord`) is waited for that long, no longer: a node that ignores the new value costs
         the long excursion, not the late window."""
-        warn_after = self.plan.warn_after
-        if warn_after is not None:
-            self.plan = self.plan.replaced(late_warning=late_bound(self.plan, warn_after))
-        self.main_flight(MainWord(self.plan).late_warning if self.plan.main_word else None)
+        self.main_flight(MainWord(self.plan, self.word).late_warning if self.word else None)
 
     def main_flight(self, late_warning=None):
         """The scenario's steps 1 to 4: a step whose node, or whose readable output, is missing ends it."""
@@ -140,20 +139,21 @@ def late_bound(plan, warn_after):
 
 
 class MainWord(object):
-    """What the main run, flown beside this threshold run, says of its WARNING: the session writes
-    ``{"warned": whether it warned in its long excursion, "warn_after": its latency (s) or null}`` in
-    the plan's ``main_word`` once the main run's result is in (or the main run ended without one). Until
-    then the threshold run waits for a late WARNING as the main run does (the plan's ``late_warning``);
-    then as long as the main run's took (:func:`late_bound`), or not at all when the main run never
-    warned (the threshold run is then not scored)."""
+    """What the main run says of its WARNING to this threshold run: the session writes ``{"warned":
+    whether it warned in its long excursion, "warn_after": its latency (s) or null}`` in the file
+    ``word`` before the threshold run starts (one after the other), or, flown beside it, once the main
+    run's result is in (or the main run ended without one). Until then the threshold run waits for a
+    late WARNING as the main run does (the plan's ``late_warning``); then as long as the main run's
+    took (:func:`late_bound`), or not at all when the main run never warned (the threshold run is then
+    not scored)."""
 
-    def __init__(self, plan):
-        self.plan, self.said = plan, None
+    def __init__(self, plan, word):
+        self.plan, self.word, self.said = plan, word, None
 
     def late_warning(self):
-        if self.said is None and os.path.isfile(self.plan.main_word):
+        if self.said is None and os.path.isfile(self.word):
             try:
-                with open(self.plan.main_word) as f:
+                with open(self.word) as f:
                     self.said = json.load(f)
             except (OSError, ValueError):
                 pass
@@ -171,21 +171,24 @@ LINGER_S = 60.0
 def main(argv):
     """Measure, write the result (atomically), then keep the fake drone serving until stopped
     (SIGINT) or LINGER_S: the student's node must not lose its drone before the grader stops it."""
-    if len(argv) != 2:
-        sys.stderr.write('usage: python3 -m exam_lab.grader.judge.probe PLAN.json RESULT.json\n')
+    if len(argv) not in (3, 4) or argv[1] not in ('main', 'threshold'):
+        sys.stderr.write('usage: python3 -m exam_lab.grader.judge.probe JOB.json main|threshold RESULT.json '
+                         '[WORD.json]\n')
         return 2
+    job_path, tag, result_path = argv[:3]
     try:
-        plan = PlanRecord.read(argv[0])
+        plan = JobRecord.read(job_path).plan(tag)
     except RecordError as err:  # the grader's own bug: the session says the probe failed, and why
         sys.stderr.write('the plan is not one: %s\n' % err)
         return 2
     rospy.init_node('grader_probe', disable_signals=True)
-    probe = Probe(plan, launch_ended=lambda: os.path.lexists(argv[1] + LAUNCH_ENDED))
+    probe = Probe(plan, argv[3] if len(argv) == 4 else None,
+                  launch_ended=lambda: os.path.lexists(result_path + LAUNCH_ENDED))
     try:
         result = probe.run()
-        with open(argv[1] + '.part', 'w') as f:
+        with open(result_path + '.part', 'w') as f:
             json.dump(result, f, indent=1, sort_keys=True)
-        os.rename(argv[1] + '.part', argv[1])
+        os.rename(result_path + '.part', result_path)
         time.sleep(LINGER_S)
     except KeyboardInterrupt:
         pass  # the session stopped us, after the student's node

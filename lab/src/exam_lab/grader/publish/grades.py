@@ -59,8 +59,9 @@ def rescore(out):
     """Apply today's rubric to the measurements a run kept in ``out``: no ROS, no box, seconds for a
     class. Each grade.json/grade.md is written again, with the points it had (``previous``); a class's
     grades.csv too. Both files are read as records (:mod:`exam_lab.grader.score.kept`: capped, checked,
-    an older version brought to today's): a student whose measurements.json or grade.json does not
-    match is not rescored (its files stay as they were) and the others are.
+    one of an older grader refused: "graded by an older grader: grade again"): a student whose
+    measurements.json or grade.json does not match is not rescored (its files stay as they were) and
+    the others are.
 
     :returns: ``(records, changes)``; ``changes``: one line per student whose points or status moved,
         saying which items moved and from what to what, and one per student not rescored
@@ -153,12 +154,14 @@ def graded_in(out):
     return [out] if contract.exists(os.path.join(out, kept.GradeRecord.FILE)) else []
 
 
-def records_in(out, with_folders=False):
+def records_in(out, with_folders=False, older=None):
     """The grade records of a run's OUT: one per student folder, or the single submission's, each read
     through the contract (:func:`read_grade`: no link, a regular file, capped, checked: its total the
     sum of its items, its status the rubric's, the student of its folder); raises RecordError naming
     the file of one that is not a grade. ``with_folders``: ``(its folder, record)`` each (the
-    student's files beside its grade)."""
+    student's files beside its grade). ``older``: a list that takes, instead of the error, the line
+    of each grade.json of an older grader (:class:`~exam_lab.grader.score.kept.OlderRecord`, whose
+    student is named by its folder: that student's matter, never the class's)."""
     found = []
     for folder in graded_in(out):
         try:
@@ -169,5 +172,7 @@ def records_in(out, with_folders=False):
             for said in (where + ': ', kept.GradeRecord.FILE + ': '):
                 if why.startswith(said):
                     why = why[len(said):]
-            raise records.RecordError('%s: %s' % (where, why))
+            if older is None or not isinstance(err, kept.OlderRecord):
+                raise records.RecordError('%s: %s' % (where, why))
+            older.append('%s: %s' % (where, why))
     return found if with_folders else [record for _, record in found]

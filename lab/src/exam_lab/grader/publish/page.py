@@ -254,15 +254,15 @@ def _similarity(pairs):
         parts.append('<p>No pair above the threshold.</p>')
     for pair in pairs[:SHOWN_PAIRS]:
         parts.append('<h3>%s and %s: %.0f %% / %.0f %% alike</h3>' % (
-            _e(pair['a']), _e(pair['b']), 100 * pair['score_a'], 100 * pair['score_b']))
-        for match in pair['files'][:3]:
+            _e(pair.a), _e(pair.b), 100 * pair.score_a, 100 * pair.score_b))
+        for match in pair.files[:3]:
             parts.append('<p>%s (%.0f %%) and %s (%.0f %%)</p><div class="pair"><pre>%s</pre><pre>%s</pre></div>' % (
-                _e(match['file_a']), 100 * match['sim_a'], _e(match['file_b']), 100 * match['sim_b'],
-                match['html_a'], match['html_b']))
+                _e(match.file_a), 100 * match.sim_a, _e(match.file_b), 100 * match.sim_b,
+                match.html_a, match.html_b))
     if len(pairs) > SHOWN_PAIRS:
         parts.append('<p>%d more pair(s), without their fragments (all in similarity.json): %s</p>' % (
             len(pairs) - SHOWN_PAIRS, '; '.join('%s and %s (%.0f %% / %.0f %%)' % (
-                _e(p['a']), _e(p['b']), 100 * p['score_a'], 100 * p['score_b']) for p in pairs[SHOWN_PAIRS:])))
+                _e(p.a), _e(p.b), 100 * p.score_a, 100 * p.score_b) for p in pairs[SHOWN_PAIRS:])))
     return '\n'.join(parts)
 
 

@@ -5,12 +5,12 @@ no rospy.
 keys (``{key: schema}``) reads as attributes, and a key it lacks reads None (an optional key, or one a
 measurement kept from before did not have); a name the schema does not have raises AttributeError, so
 a misspelt key is an error, never a silent None. An object whose keys are data (a
-:class:`~exam_lab.grader.score.records.Map`: topics, nodes, legs) stays a mapping; a list is a tuple.
+:class:`~exam_lab.grader.score.schema.Map`: topics, nodes, legs) stays a mapping; a list is a tuple.
 Nothing of a view can be set: a reader cannot change what the next one reads.
 """
 from collections.abc import Mapping
 
-from exam_lab.grader.score.records import Items, Map, Maybe, Optional, Record, Row
+from exam_lab.grader.score.schema import Items, Map, Maybe, Optional, Record, Row
 
 
 class Fields(object):
@@ -55,7 +55,7 @@ class Fields(object):
 
 
 class Table(Mapping):
-    """An object whose keys are data (a schema's :class:`~exam_lab.grader.score.records.Map`), read-only."""
+    """An object whose keys are data (a schema's :class:`~exam_lab.grader.score.schema.Map`), read-only."""
     __slots__ = ('_items',)
 
     def __init__(self, items):
@@ -79,7 +79,7 @@ class Table(Mapping):
 
 def view(value, schema=None):
     """The read-only view of ``value``, a record's value (or a part of one) of ``schema``, or a
-    :class:`~exam_lab.grader.score.records.Record` (of its own schema by default); None stays
+    :class:`~exam_lab.grader.score.schema.Record` (of its own schema by default); None stays
     None, and a view is its own view. A value whose shape is not the schema's (an object where a list
     is expected) is given as it is: the schema's check is the record's, not the reader's. The view
     reads ``value`` as it is when a field is first read: nothing is copied before."""
@@ -114,7 +114,7 @@ def view(value, schema=None):
 
 
 def _flat(row):
-    """True when every item of a :class:`~exam_lab.grader.score.records.Row` is a scalar."""
+    """True when every item of a :class:`~exam_lab.grader.score.schema.Row` is a scalar."""
     return all(_shape(inner) == 'scalar' for inner in row.schemas)
 
 

@@ -11,11 +11,14 @@ records too: :mod:`exam_lab.grader.score.kept`.
 import enum
 import os
 import re
+import typing
+from dataclasses import dataclass
 
 # The schema machinery, importable from here as well (records.check, records.Text...).
 from exam_lab.grader.score.schema import (  # noqa: F401
-    MAX_ITEMS, MAX_TEXT, Items, Map, Maybe, Number, OneOf, Optional, Record, RecordError, Row, Text, check, parse,
-    relative, shown, write)
+    MAX_ITEMS, MAX_TEXT, DataRecord, Items, Map, Maybe, Number, OneOf, Optional, Record, RecordError, Row, Text, check,
+    parse, relative, shown, write)
+from exam_lab.grader.score.fields import view
 from exam_lab.grader.score.sheets import SHEETS
 
 #: What a grading measured, kept beside grade.json by the runner (:class:`~exam_lab.grader.score.kept.MeasurementsRecord`,
@@ -97,21 +100,32 @@ class InspectRecord(Record):
             raise RecordError('inspect.json: a threshold run without its value')
 
 
-class IntakeRecord(Record):
-    """A class archive unpacked by :mod:`exam_lab.grader.boxed.intake` (``intake.json``): ``students``,
-    each ``{"name", "path"}`` with ``path`` relative to the intake's output folder, and ``refused``
-    (why) when that student's files were not unpacked. A class may be larger than any other list's cap."""
+@dataclass(frozen=True)
+class IntakeStudent(object):
+    """A student of the class archive as the intake unpacked it: ``name`` (its folder's), ``path``
+    (relative to the intake's output folder), ``refused`` (why its files were not unpacked, or None)."""
+    name: str
+    path: str
+    refused: typing.Optional[str] = None
+
+
+@dataclass(frozen=True)
+class IntakeRecord(DataRecord):
+    """A class archive unpacked by :mod:`exam_lab.grader.boxed.intake` (``intake.json``): the box's
+    ``uid`` and its ``students`` (:class:`IntakeStudent`). A class may be larger than any other list's cap."""
     FILE = 'intake.json'
     MAX_BYTES = 16 << 20
     MAX_STUDENTS = 10000
     SCHEMA = {'uid': Number(0, 2 ** 32, integer=True),
               'students': Items({'name': Text(255), 'path': Text(4096), 'refused': Optional(Text())}, MAX_STUDENTS)}
+    uid: int
+    students: typing.Tuple[IntakeStudent, ...]
 
     def validate(self):
         for index, student in enumerate(self.students):
             where = 'intake.json.students[%d]' % index
-            relative(student['path'], where + '.path')
-            name = student['name']
+            relative(student.path, where + '.path')
+            name = student.name
             if name in ('', '.', '..') or name != name.strip(' .') or \
                     not all(c.isalnum() or c in ' -._' for c in name):
                 raise RecordError('%s.name: %s is not a student\'s name (a folder name of letters, digits, '
@@ -122,10 +136,35 @@ class IntakeRecord(Record):
 _SHARE = Number(0, 10)
 
 
-class SimilarityRecord(Record):
+@dataclass(frozen=True)
+class SimilarFiles(object):
+    """The two files of a flagged pair that are most alike: their names, each one's share alike, and
+    each one's HTML with the detector's highlight spans (escaped by the detector: shown as it is)."""
+    file_a: str
+    file_b: str
+    sim_a: float
+    sim_b: float
+    html_a: str
+    html_b: str
+
+
+@dataclass(frozen=True)
+class SimilarPair(object):
+    """Two students whose code is alike (``a``, ``b``: their names), each one's share alike, and
+    their best ``files`` (:class:`SimilarFiles`)."""
+    a: str
+    b: str
+    score_a: float
+    score_b: float
+    files: typing.Tuple[SimilarFiles, ...]
+
+
+@dataclass(frozen=True)
+class SimilarityRecord(DataRecord):
     """The class's similarity check (:func:`exam_lab.grader.boxed.similarity.check`,
-    ``similarity.json``): flagged ``pairs`` with their best files' highlighted HTML (escaped by the
-    detector; the page escapes nothing more), every pair's ``scores``, ``notes``; or ``error``."""
+    ``similarity.json``): flagged ``pairs`` (:class:`SimilarPair`) with their best files' highlighted
+    HTML (escaped by the detector; the page escapes nothing more), every pair's ``scores`` (``(a, b,
+    score_a, score_b)``), ``notes``; or ``error``."""
     FILE = 'similarity.json'
     MAX_BYTES = 32 << 20
     #: Its file names and the code in its HTML are the students': made safe here (no markup is added).
@@ -138,12 +177,19 @@ class SimilarityRecord(Record):
         'students': Optional(Number(0, 1e5, integer=True)), 'threshold': Optional(_SHARE),
         'detector': Optional(Text(100)), 'scores': Optional(Items(Items((Text(255), _SHARE), 4), 200000)),
     }
+    notes: typing.Tuple[str, ...]
+    error: typing.Optional[str] = None
+    pairs: typing.Optional[typing.Tuple[SimilarPair, ...]] = None
+    students: typing.Optional[int] = None
+    threshold: typing.Optional[float] = None
+    detector: typing.Optional[str] = None
+    scores: typing.Optional[typing.Tuple[tuple, ...]] = None
 
     def validate(self):
-        for index, pair in enumerate(self.pairs or []):
-            for inner, match in enumerate(pair['files']):
+        for index, pair in enumerate(self.pairs or ()):
+            for inner, match in enumerate(pair.files):
                 for key in ('html_a', 'html_b'):
-                    if '<' in _HIGHLIGHT.sub('', match[key]):
+                    if '<' in _HIGHLIGHT.sub('', getattr(match, key)):
                         raise RecordError('similarity.json.pairs[%d].files[%d].%s: markup other than the '
                                           "detector's highlight" % (index, inner, key))
 
@@ -234,22 +280,15 @@ class ProbeRecord(Record):
 _PATH = Text(4096)
 
 
-class PlanRecord(Record):
-    """One run's plan, the judge's orders (``plan-<tag>.json``, :mod:`exam_lab.grader.judge.probe`):
-    the sheet, the threshold flown and its margin, the rule's delay, how long the node may take to
-    start, the output topic expected, how long a late WARNING is waited for (``late_warning``; 0 when
-    the code calls no service). Made by :func:`exam_lab.grader.runner.plan_job`; for the threshold run
-    the session adds the main run's calibration (``fit``) and the node's WARNING latency
-    (``warn_after``), or, when the two runs fly side by side, the file where it will say what the main
-    run's WARNING took (``main_word``: :class:`~exam_lab.grader.judge.probe.MainWord`)."""
-    FILE = 'plan.json'
-    MAX_BYTES = 1 << 16
-    SCHEMA = {
-        'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
-        'margin': Number(0), 'delay': Number(0), 'start_timeout': Number(0), 'output': _NAME,
-        'late_warning': Number(0), 'fit': Optional(Maybe(Row(_VALUE, _VALUE))), 'warn_after': Optional(Maybe(Number())),
-        'main_word': Optional(_PATH),
-    }
+#: One run's plan, the judge's orders (:mod:`exam_lab.grader.judge.probe`): the sheet, the threshold
+#: flown and its margin, the rule's delay, how long the node may take to start, the output topic
+#: expected, how long a late WARNING is waited for (``late_warning``; 0 when the code calls no
+#: service). Part of the job (:class:`JobRecord`), made once by :func:`exam_lab.grader.runner.plan_job`.
+PLAN = {
+    'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
+    'margin': Number(0), 'delay': Number(0), 'start_timeout': Number(0), 'output': _NAME,
+    'late_warning': Number(0),
+}
 
 
 #: A box as the runner opened it, for the session to make its command lines
@@ -262,18 +301,21 @@ _BOX = {'work': _PATH, 'bwrap': bool, 'cpus': Maybe(Number(0, 4096)), 'binds': [
 
 class JobRecord(Record):
     """The session's job (``job.json``, read by :mod:`exam_lab.grader.host.session`): the runs (each its
-    tag, its launch file, its :class:`PlanRecord`'s value), the student's namespace, the time limits, the
-    launch file as handed in (for roslaunch's check). :func:`~exam_lab.grader.runner.plan_job` makes it
-    from the inspection, the launch files relative to the workspace;
+    tag, its launch file, its :data:`PLAN`), the student's namespace, the time limits, the launch file
+    as handed in (for roslaunch's check). :func:`~exam_lab.grader.runner.plan_job` makes it from the
+    inspection, the launch files relative to the workspace;
     :func:`~exam_lab.grader.runner.run_session` adds where the session runs (``workspace``, the
     ``underlay``, the folders, the ``box``) and the student's ``budget``, the launch files then absolute;
     with ``side_by_side``, the two runs fly at once, the threshold run in a ``box`` and a ``judge_home``
-    of its own."""
+    of its own. The plans are made once, there, and go down to the judge as they are, in the job
+    (:meth:`plan`): nothing on the way changes them. What the threshold run learns of the main run
+    (how late its WARNING came) is the main run's word, not its plan
+    (:class:`~exam_lab.grader.judge.probe.MainWord`)."""
     FILE = 'job.json'
     MAX_BYTES = 1 << 20
     SCHEMA = {
         'namespace': Text(1000), 'build_timeout': Number(0), 'run_timeout': Number(0),
-        'runs': Items({'tag': OneOf('main', 'threshold'), 'launch': _PATH, 'plan': PlanRecord.SCHEMA,
+        'runs': Items({'tag': OneOf('main', 'threshold'), 'launch': _PATH, 'plan': PLAN,
                        'box': Optional(_BOX), 'judge_home': Optional(_PATH)}, 2),
         'handed_in_launch': Maybe(_PATH), 'side_by_side': Optional(bool),
         'workspace': Optional(_PATH), 'underlay': Optional(_PATH), 'log_dir': Optional(_PATH),
@@ -287,6 +329,13 @@ class JobRecord(Record):
         for run in self.runs:
             if run['plan']['kind'] != run['tag']:
                 raise RecordError('job.json.runs: the %s run with a plan of a %s run' % (run['tag'], run['plan']['kind']))
+
+    def plan(self, tag):
+        """The plan of the run ``tag``, read by attributes (``plan.threshold``): the judge's orders."""
+        for run in self.runs:
+            if run['tag'] == tag:
+                return view(run['plan'], PLAN)
+        raise RecordError('job.json.runs: no %s run' % tag)
 
 
 class Outcome(str, enum.Enum):

@@ -8,10 +8,12 @@ most ``n`` characters), :class:`Number` (finite, within bounds), ``[schema]`` (a
 (None or the schema), :class:`OneOf` (one of fixed values), :class:`Map` (an object whose keys are data),
 :class:`Row` (a list of fixed length, each item its own schema), a tuple of schemas (any one of them).
 """
+import dataclasses
 import json
 import math
 import os
 import re
+import typing
 
 from exam_lab.grader.score.safe_text import cleaned
 
@@ -273,22 +275,113 @@ def thawed(value):
     return value
 
 
-class Record(object):
+class _Readable(object):
+    """What every record type shares: its file (``FILE``), its cap (``MAX_BYTES``), its ``SCHEMA``;
+    read from JSON (:meth:`from_json`, :meth:`read`) through the type's own :meth:`make`. With
+    ``CLEAN``, every string of the record, keys too, is :func:`~exam_lab.grader.score.safe_text.clean`
+    once it matched its schema (:meth:`cleaned`): the one place where a student's text (node and topic
+    names, log lines, a request) is made safe, whoever reads the record later; ``CLEAN`` a tuple of keys
+    cleans those fields only (the others are paths to open, or names kept exactly). ``NON_FINITE``:
+    NaN and Infinity may be read from its JSON (measured values)."""
+    FILE = MAX_BYTES = SCHEMA = None
+    CLEAN = NON_FINITE = False
+    __slots__ = ()
+
+    @classmethod
+    def from_json(cls, raw, max_bytes=None):
+        """The record in ``raw`` (bytes), at most ``max_bytes`` (the type's ``MAX_BYTES`` when None);
+        raises :class:`RecordError` on anything unexpected."""
+        max_bytes = cls.MAX_BYTES if max_bytes is None else max_bytes
+        if len(raw) > max_bytes:
+            raise RecordError('%s: %d bytes (at most %d)' % (cls.FILE, len(raw), max_bytes))
+        return cls.make(load(raw, cls.FILE, constants=cls.NON_FINITE))
+
+    @classmethod
+    def read(cls, path):
+        """The record in the file ``path``, one the grader wrote itself (kept in OUT; for a box's, root
+        uses :func:`exam_lab.grader.contract.read_record`): read up to ``MAX_BYTES``, then as
+        :meth:`from_json`; raises :class:`RecordError` naming the file when it cannot be read."""
+        try:
+            with open(path, 'rb') as f:
+                raw = f.read(cls.MAX_BYTES + 1)
+        except OSError as err:
+            raise RecordError('%s: %s' % (os.path.basename(path), err.strerror or err))
+        return cls.from_json(raw)
+
+    @classmethod
+    def cleaned(cls, value):
+        """The checked ``value`` with its text made safe as ``CLEAN`` says (True: every string, keys
+        too; a tuple of keys: those fields only)."""
+        if cls.CLEAN is True:
+            return cleaned(value)
+        if cls.CLEAN:
+            return dict(value, **{key: cleaned(value[key]) for key in cls.CLEAN if key in value})
+        return value
+
+    def to_json(self):
+        """The record's JSON text (its ``value``): :meth:`from_json` of it gives an equal record."""
+        return json.dumps(self.value, indent=1, sort_keys=True)
+
+    def validate(self):
+        """Checks across fields, beyond the schema's."""
+
+
+class DataRecord(_Readable):
+    """The base of a record type that is a frozen dataclass (``@dataclass(frozen=True)``): its fields
+    the schema's keys, each a plain value, a tuple or a frozen dataclass of its own, so nothing of it
+    can be changed (``dataclasses.replace`` makes another); a field whose default is None and that is
+    None is a key its JSON leaves out (an :class:`Optional` one). :meth:`make` checks a value against
+    ``SCHEMA``, cleans it (``CLEAN``), builds the record from it by the fields' types (an object their
+    dataclass, a list a tuple) and checks across fields (:meth:`validate`); :attr:`value` is its JSON
+    data, which :meth:`make` reads back to an equal record."""
+    __slots__ = ()
+
+    @classmethod
+    def make(cls, value):
+        """The record of ``value`` (JSON data), checked; raises :class:`RecordError`."""
+        record = _built(cls, cls.cleaned(check(value, cls.SCHEMA, cls.FILE)))
+        record.validate()
+        return record
+
+    @property
+    def value(self):
+        """The record as JSON data: what :meth:`make` reads back."""
+        return _plain(self)
+
+
+def _built(hint, value):
+    """The checked JSON ``value`` as a field of the type ``hint`` holds it: an object its dataclass
+    (``Optional[X]`` an X or None), a list a tuple (``Tuple[X, ...]`` of X)."""
+    origin, args = getattr(hint, '__origin__', None), getattr(hint, '__args__', ())
+    if value is None:
+        return None
+    if origin is typing.Union:
+        return _built(next(arg for arg in args if arg is not type(None)), value)
+    if dataclasses.is_dataclass(hint):
+        hints = typing.get_type_hints(hint)
+        return hint(**{key: _built(hints[key], inner) for key, inner in value.items()})
+    if origin is tuple or hint is tuple:
+        return tuple(_built(args[0] if args[-1:] == (Ellipsis,) else None, item) for item in value)
+    return value
+
+
+def _plain(value):
+    """JSON data of a frozen dataclass record or of one of its fields (a tuple a list)."""
+    if dataclasses.is_dataclass(value):
+        return {field.name: _plain(getattr(value, field.name)) for field in dataclasses.fields(value)
+                if not (field.default is None and getattr(value, field.name) is None)}
+    if isinstance(value, tuple):
+        return [_plain(item) for item in value]
+    return value
+
+
+class Record(_Readable):
     """A record type: its file's name (``FILE``), its cap (``MAX_BYTES``), its ``SCHEMA``; a record's
     attributes are the schema's keys (None when an optional one is missing), ``value`` the whole
     checked object; two records are equal when their JSON is (NaN included). A record is frozen, as a
     frozen dataclass is and deeper: no attribute can be set, and its objects and lists
     (:class:`Frozen`, :class:`FrozenList`) refuse every change, so what a stage hands on is what the
-    next one reads; :meth:`replaced` makes a new record of changed fields, checked again. A record type whose
-    files outlive the grader that wrote them (:mod:`exam_lab.grader.score.kept`) brings an older
-    shape to its current one in :meth:`upgraded`, before the check. With ``CLEAN``, every string of the record, keys too, is
-    :func:`~exam_lab.grader.score.safe_text.clean` once it matched its schema: the one place where
-    a student's text (node and topic names, log lines, a request) is made safe, whoever reads the
-    record later; ``CLEAN`` a tuple of keys cleans those fields only (the others are paths to open,
-    or names kept exactly). ``NON_FINITE``: NaN and Infinity may be read from its JSON (measured values)."""
-    FILE = MAX_BYTES = SCHEMA = None
-    CLEAN = NON_FINITE = False
-
+    next one reads; :meth:`replaced` makes a new record of changed fields, checked again."""
     __slots__ = ('value',)
 
     def __init__(self, value):
@@ -319,44 +412,14 @@ class Record(object):
     __hash__ = None
 
     @classmethod
-    def from_json(cls, raw, max_bytes=None):
-        """The record in ``raw`` (bytes), at most ``max_bytes`` (the type's ``MAX_BYTES`` when None);
-        raises :class:`RecordError` on anything unexpected."""
-        max_bytes = cls.MAX_BYTES if max_bytes is None else max_bytes
-        if len(raw) > max_bytes:
-            raise RecordError('%s: %d bytes (at most %d)' % (cls.FILE, len(raw), max_bytes))
-        return cls.make(load(raw, cls.FILE, constants=cls.NON_FINITE))
-
-    @classmethod
-    def read(cls, path):
-        """The record in the file ``path``, one the grader wrote itself (kept in OUT; for a box's, root
-        uses :func:`exam_lab.grader.contract.read_record`): read up to ``MAX_BYTES``, then as
-        :meth:`from_json`; raises :class:`RecordError` naming the file when it cannot be read."""
-        try:
-            with open(path, 'rb') as f:
-                raw = f.read(cls.MAX_BYTES + 1)
-        except OSError as err:
-            raise RecordError('%s: %s' % (os.path.basename(path), err.strerror or err))
-        return cls.from_json(raw)
-
-    @classmethod
     def make(cls, value):
         """The record of ``value`` (made by the grader itself from what it read): checked as one read
         from a file is; raises :class:`RecordError`."""
-        return cls._made(check(cls.upgraded(value), cls.SCHEMA, cls.FILE))
-
-    @classmethod
-    def upgraded(cls, value):
-        """``value`` in the type's current shape (the same value when it is in it already)."""
-        return value
+        return cls._made(check(value, cls.SCHEMA, cls.FILE))
 
     @classmethod
     def _made(cls, value):
-        if cls.CLEAN is True:
-            value = cleaned(value)
-        elif cls.CLEAN:
-            value = dict(value, **{key: cleaned(value[key]) for key in cls.CLEAN if key in value})
-        record = cls(cls.converted(value))
+        record = cls(cls.converted(cls.cleaned(value)))
         record.validate()
         return record
 
@@ -364,13 +427,6 @@ class Record(object):
     def converted(cls, value):
         """``value``, checked, with a field of its type made its Python type (a string its enum)."""
         return value
-
-    def to_json(self):
-        """The record's JSON text: :meth:`from_json` of it gives the same record."""
-        return json.dumps(self.value, indent=1, sort_keys=True)
-
-    def validate(self):
-        """Checks across fields, beyond the schema's."""
 
 
 def write(folder, record_type, value):
