@@ -377,7 +377,7 @@ def test_the_report_reader_says_each_of_its_caps(tmp_path, monkeypatch):
     assert value['files'][0]['note'] == "'scan.pdf': %d bytes, over the %d the reader reads of one file" % (size, size - 1)
     monkeypatch.setattr(report_reader, 'MAX_PICTURE_PIXELS', 1000)
     reader = report_reader.Reader(str(tmp_path / 'r2'))
-    assert reader.pictures(str(scan_only / 'scan.pdf'), 1) == {}
+    assert reader.pictures(str(scan_only / 'scan.pdf'), 1, {1}) == {}  # page 1's pictures asked for
     assert [n for n in reader.notes if re.match(r'^page 1: a picture of \d+ x \d+ pixels \(at most 0 million\): the '
                                                 r'page\'s image read instead$', n)], reader.notes
 

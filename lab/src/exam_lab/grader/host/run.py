@@ -12,7 +12,7 @@ import time
 
 from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
 from exam_lab.grader.contract import read_capped, read_record, write_record
-from exam_lab.grader.score.records import LAUNCH_ENDED, MAX_ENDED, MAX_LOG_TEXT, JobRecord, ProbeRecord, RecordError
+from exam_lab.grader.score.records import MAX_ENDED, MAX_LOG_TEXT, JobRecord, ProbeRecord, RecordError
 from exam_lab.grader.score.runs import WATCHED_DEATHS
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.harness.supervisor import ros_env, workspace_env
@@ -70,6 +70,9 @@ def launch_outcome(output, workspace=None):
 #: What the session tells the threshold run of its main run, in the threshold run's judge folder
 #: (:class:`~exam_lab.grader.judge.probe.MainWord`): whether the node warned, how late.
 MAIN_WORD = 'main-word.json'
+#: The mark the session leaves there once the student's roslaunch has exited (a launch file it refuses
+#: at once): the probe then waits no longer for a node that cannot come.
+LAUNCH_ENDED = 'launch-ended-%s'
 
 
 def capped_log(sup, name):
@@ -152,13 +155,14 @@ def run_one(sup, job, run, base_env, box, budget):
     write_record(job_path, job)
     with open(os.path.join(log_dir, 'plan-%s.json' % tag), 'w') as f:
         json.dump(plan, f, indent=1, sort_keys=True)
-    result_path = os.path.join(judge_dir, 'probe-%s.json' % tag)
+    result_path, ended = os.path.join(judge_dir, 'probe-%s.json' % tag), os.path.join(judge_dir, LAUNCH_ENDED % tag)
     word = [os.path.join(judge_dir, MAIN_WORD)] if tag == 'threshold' else []
     probe_env = ros_env(master.env, master.uri, os.path.join(judge_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')
     probe_env['ROS_NAMESPACE'] = job.namespace or '/'
     started, started_wall = time.monotonic(), time.time()
     probe = sup.start('probe-%s' % tag, box.judge_argv(
-        [sys.executable, '-m', 'exam_lab.grader.judge.probe', job_path, tag, result_path] + word, 'probe'), probe_env)
+        [sys.executable, '-m', 'exam_lab.grader.judge.probe', job_path, tag, result_path, ended] + word, 'probe'),
+        probe_env)
     # The probe writes its result, then keeps the drone up: the student's node is stopped first, so
     # nothing it does when its drone goes away (a failed service call, a crash) is counted.
     limit, by_budget = budget.limit(job.run_timeout, RUN_STOP_S)
@@ -166,8 +170,8 @@ def run_one(sup, job, run, base_env, box, budget):
     def over():
         """The probe's result, or its end or its master's; roslaunch's exit told to the probe, which then
         waits no longer for a node that cannot come."""
-        if launch.poll() is not None and not os.path.lexists(result_path + LAUNCH_ENDED):
-            open(result_path + LAUNCH_ENDED, 'w').close()
+        if launch.poll() is not None and not os.path.lexists(ended):
+            open(ended, 'w').close()
         return os.path.isfile(result_path) or probe.poll() is not None or master.proc.poll() is not None
     wait_until(over, limit, period=0.1)
     record['seconds'] = time.monotonic() - started

@@ -2,7 +2,7 @@
 
 Run inside its own rospy process, on the master of one submission, by :mod:`exam_lab.grader.host.session`::
 
-    python3 -m exam_lab.grader.judge.probe JOB.json TAG RESULT.json [WORD.json]
+    python3 -m exam_lab.grader.judge.probe JOB.json TAG RESULT.json ENDED [WORD.json]
 
 The drone is the harness's :class:`~exam_lab.harness.fake_drone.Drone`, the sheet's own drone (its
 topics, rates, service, answers and LED, from the drone package's SPEC; a new value goes out at the
@@ -14,8 +14,9 @@ The plan is the run ``TAG``'s of the session's job (:class:`~exam_lab.grader.sco
 :data:`~exam_lab.grader.score.records.PLAN`), as the runner made it: ``kind`` ("main": the whole
 scenario, "threshold": the check of question 14a, the same scenario around the threshold drawn for
 it), ``sheet``, ``threshold`` (student units), ``margin`` (how far beyond the threshold to fly),
-``delay`` (s), ``start_timeout`` (s to wait for the node), ``late_warning`` (s a late WARNING is
-waited for, 0 for none). The threshold run also reads the main run's word in ``WORD.json``
+``delay`` (s), ``start_timeout`` (s to wait for the node once roslaunch is up), ``late_warning`` (s a
+late WARNING is waited for, 0 for none). ``ENDED`` is the mark the session leaves once the student's
+roslaunch has exited. The threshold run also reads the main run's word in ``WORD.json``
 (:class:`MainWord`): how late its WARNING came.
 
 Every time is the wall clock's (``time.time()``), never rospy's ROS time: a student's node can set
@@ -57,7 +58,7 @@ from exam_lab.grader.judge.pilot import Calibration, Flight, Inputs
 from exam_lab.grader.judge.graph import ClockWatch, Graph, NodeWatch, RefusedConnections, node_pid, node_uri
 from exam_lab.grader.judge.legs import AFTER_S, trace
 from exam_lab.grader.judge.node import NodeFinder
-from exam_lab.grader.score.records import LAUNCH_ENDED, JobRecord, RecordError
+from exam_lab.grader.score.records import JobRecord, RecordError
 from exam_lab.harness.fake_drone import Drone
 
 
@@ -171,19 +172,19 @@ LINGER_S = 60.0
 def main(argv):
     """Measure, write the result (atomically), then keep the fake drone serving until stopped
     (SIGINT) or LINGER_S: the student's node must not lose its drone before the grader stops it."""
-    if len(argv) not in (3, 4) or argv[1] not in ('main', 'threshold'):
+    if len(argv) not in (4, 5) or argv[1] not in ('main', 'threshold'):
         sys.stderr.write('usage: python3 -m exam_lab.grader.judge.probe JOB.json main|threshold RESULT.json '
-                         '[WORD.json]\n')
+                         'ENDED [WORD.json]\n')
         return 2
-    job_path, tag, result_path = argv[:3]
+    # ENDED: the mark the session leaves once the student's roslaunch has exited (no node can come then).
+    job_path, tag, result_path, ended = argv[:4]
     try:
         plan = JobRecord.read(job_path).plan(tag)
     except RecordError as err:  # the grader's own bug: the session says the probe failed, and why
         sys.stderr.write('the plan is not one: %s\n' % err)
         return 2
     rospy.init_node('grader_probe', disable_signals=True)
-    probe = Probe(plan, argv[3] if len(argv) == 4 else None,
-                  launch_ended=lambda: os.path.lexists(result_path + LAUNCH_ENDED))
+    probe = Probe(plan, argv[4] if len(argv) == 5 else None, launch_ended=lambda: os.path.lexists(ended))
     try:
         result = probe.run()
         with open(result_path + '.part', 'w') as f:

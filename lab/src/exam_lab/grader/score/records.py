@@ -221,11 +221,6 @@ LEG = {'side': OneOf('above', 'below'), 'reached': Maybe(_TIME), 'stays': Maybe(
        'first': Maybe(_VALUE), 'last': Maybe(_VALUE), 'samples': _COUNT}
 
 
-#: What the session adds to the probe's RESULT.json path for the mark it leaves once the student's
-#: roslaunch has exited: the probe then waits no longer for a node that cannot come.
-LAUNCH_ENDED = '.launch-ended'
-
-
 class ProbeRecord(Record):
     """The probe's result (:mod:`exam_lab.grader.judge.probe`, ``probe-<tag>.json``): what it measured of
     the student's node in one run, as the rubric reads it. Written by the judge's uid, of names and
