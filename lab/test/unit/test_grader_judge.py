@@ -149,6 +149,9 @@ def test_a_node_that_subscribes_to_each_input_in_turn_subscribes_to_both(monkeyp
         def student_nodes(self):
             return ['/exam']
 
+        def launch_started(self):
+            return True
+
         def subscribers(self, topic):
             polls['n'] += 1
             turn = '/temperature' if (polls['n'] // 6) % 2 == 0 else '/pressure'

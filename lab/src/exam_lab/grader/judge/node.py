@@ -39,15 +39,16 @@ class NodeFinder(object):
     def wait_for_node(self):
         """The probe's result's ``nodes`` (none when no node came within the plan's ``start_timeout``
         of roslaunch's start, or roslaunch never came up within LAUNCH_START_S, or ended first),
-        ``launch_seen_s`` (when roslaunch came up, None if never) and ``node_seen_s`` (both s from the
-        probe's start); once a node came, also ``subscribed`` and ``input_types``."""
+        ``launch_seen_s`` (when the probe first saw roslaunch up, at the latest with the node; None if
+        never) and ``node_seen_s`` (both s from the probe's start); once a node came, also
+        ``subscribed`` and ``input_types``."""
         launched = []
 
         def nodes_or_end():
             """``(nodes,)`` once a node came or the wait is over (``([],)``), else None."""
             nodes = self.graph.student_nodes()
             now = time.time()
-            if not nodes and not launched and self.graph.launch_started():
+            if not launched and self.graph.launch_started():
                 launched.append(now)
             over = self.launch_ended() or (now > launched[0] + self.plan.start_timeout if launched
                                            else now > self.t0 + LAUNCH_START_S)
