@@ -37,12 +37,14 @@ try:  # the report reader (issue 47 point 1)
 except ImportError:  # a grader without it: the check says nothing of the report
     reports = None
 from exam_lab.grader.score.sheets import SHEETS
+from exam_lab.harness import supervisor
 
 #: The teacher's choice of what the check shows.
 SETTING = os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), 'check_visibility.ini')
 
 
 def main(argv=None):
+    supervisor.own_processes()  # what the check starts ends with it, however it ends
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--package', required=True, help='your exam package: its folder, or the zip you upload')
     parser.add_argument('--sheet', choices=list(SHEETS), help='default: detected from the package')

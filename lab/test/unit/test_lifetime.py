@@ -1,0 +1,81 @@
+"""Every process a run starts ends with the run's owner, however it ends (harness.supervisor's "Lifetime"),
+on plain processes: an owner (a Python process that calls own_processes, as grade.py does) starts a
+shell through its Supervisor that leaves an orphan behind (``sleep &``: as roscore's rosmaster, no parent
+death signal of its own), then is killed or stopped; no process of its mark may be left."""
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from exam_lab.harness.supervisor import OWNER, marked, owner_mark
+from exam_lab.harness.wait import wait_until
+
+#: The owner: its Supervisor's shell starts an orphan and a child, then says so on stdout.
+OWNER_SCRIPT = textwrap.dedent('''
+    import sys, time
+    from exam_lab.harness.supervisor import Supervisor, own_processes
+    own_processes()
+    with Supervisor(sys.argv[1]) as sup:
+        sup.start('family', ['sh', '-c', 'sleep 300 & echo started; exec sleep 301'])
+        while 'started' not in sup.output('family'):
+            time.sleep(0.02)
+        print('ready', flush=True)
+        time.sleep(300)
+''')
+#: Generous: the watch's round is a SIGINT, then a SIGKILL 2 s later, on a shared machine.
+GONE_S = 30.0
+
+
+def start_owner(tmp_path):
+    """The owner, started as from a terminal (Ctrl-C and SIGHUP not ignored, whatever this process
+    ignores), once its two sleeps and its watch run; ``(its Popen, its mark)``."""
+    owner = subprocess.Popen(['env', '--default-signal=INT,HUP', sys.executable, '-c', OWNER_SCRIPT,
+                              str(tmp_path / 'run')], stdout=subprocess.PIPE, universal_newlines=True)
+    assert owner.stdout.readline().strip() == 'ready'
+    mark = owner_mark(owner.pid)
+    assert wait_until(lambda: _names(marked(mark, OWNER)) == ['python', 'sleep', 'sleep'], 10.0), \
+        _names(marked(mark, OWNER))  # the watch, and the shell's two sleeps
+    return owner, mark
+
+
+def _names(pids):
+    names = []
+    for pid in pids:
+        try:
+            with open('/proc/%d/comm' % pid) as f:
+                name = f.read().strip()
+        except OSError:
+            continue
+        names.append('python' if name.startswith('python') else name)
+    return sorted(names)
+
+
+@pytest.mark.parametrize('sig', [signal.SIGKILL, signal.SIGTERM, signal.SIGINT, signal.SIGHUP])
+def test_every_process_of_the_owner_ends_with_it(tmp_path, sig):
+    owner, mark = start_owner(tmp_path)
+    owner.send_signal(sig)
+    status = owner.wait(GONE_S)
+    left = wait_until(lambda: not marked(mark, OWNER), GONE_S, period=0.1)
+    for pid in marked(mark, OWNER):  # a failure leaves nothing behind either
+        os.kill(pid, signal.SIGKILL)
+    assert left, 'left running after the owner\'s %s' % signal.Signals(sig).name
+    assert status == -signal.SIGKILL if sig == signal.SIGKILL else status != 0
+
+
+def test_a_grading_leftover_is_told_from_a_stranger(tmp_path):
+    """The start sweep of a slot (uids.take_slot) ends only a grading's processes: the supervisor's marks
+    in the environment, or a box's; a process of another uid's owner is passed over."""
+    from exam_lab.grader.host import uids
+    ours = subprocess.Popen(['sleep', '60'], env=dict(os.environ, EXAM_LAB_RUN=str(tmp_path)))
+    stranger = subprocess.Popen(['sleep', '60'], env={k: v for k, v in os.environ.items()
+                                                       if k not in ('EXAM_LAB_RUN', OWNER)})
+    try:
+        assert uids.leftover(ours.pid) and not uids.leftover(stranger.pid)
+    finally:
+        for proc in (ours, stranger):
+            proc.kill()
+            proc.wait()
+    assert not uids.leftover(ours.pid)  # gone
