@@ -34,6 +34,7 @@ from cdp import Browser  # noqa: E402
 from exam_lab.grader import class_run  # noqa: E402
 from exam_lab.grader.publish import grades, hand  # noqa: E402
 from exam_lab.grader.score.sheets import HAND_ITEMS  # noqa: E402
+from exam_lab.harness.supervisor import DIES_WITH_PARENT  # noqa: E402
 
 LAB = os.path.dirname(os.path.dirname(HERE))
 SUBMISSIONS = os.path.join(HERE, 'submissions')
@@ -88,10 +89,14 @@ def codes(records):
 
 
 class Review(object):
-    """lab/scripts/review.py on OUT, as make review runs it; its URL from the line it prints."""
+    """lab/scripts/review.py on OUT, as make review runs it; its URL from the line it prints. The server
+    never outlives the test: stopped when its URL does not come, killed when a stop does not end it
+    (:meth:`stop`, called in a ``finally``), and by the kernel if this process dies first (the
+    supervisor's DIES_WITH_PARENT: a CI runner that kills the test)."""
 
     def __init__(self, out):
-        self.process = subprocess.Popen([sys.executable, os.path.join(LAB, 'scripts', 'review.py'), '--out', out],
+        self.process = subprocess.Popen(DIES_WITH_PARENT + [sys.executable, os.path.join(LAB, 'scripts', 'review.py'),
+                                                            '--out', out],
                                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         self.lines = []
         found = threading.Event()
@@ -104,10 +109,14 @@ class Review(object):
             found.set()
         self.reader = threading.Thread(target=read, daemon=True)
         self.reader.start()
-        assert found.wait(120), self.lines
-        urls = [re.search(r'http://127\.0\.0\.1:(\d+)(/[^/\s]+)/', line) for line in self.lines]
-        url = [u for u in urls if u]
-        assert url, self.lines
+        try:
+            assert found.wait(120), self.lines
+            urls = [re.search(r'http://127\.0\.0\.1:(\d+)(/[^/\s]+)/', line) for line in self.lines]
+            url = [u for u in urls if u]
+            assert url, self.lines
+        except BaseException:
+            self.stop()
+            raise
         self.url, self.port, self.base = url[0].group(0), int(url[0].group(1)), url[0].group(2)
 
     def get(self, path, host=None):
@@ -120,10 +129,15 @@ class Review(object):
             connection.close()
 
     def stop(self):
-        """Ctrl-C: the exit status and what it printed."""
+        """Ctrl-C: the exit status and what it printed; a server that Ctrl-C did not end within 60 s is
+        killed (its status then says so: -9)."""
         if self.process.poll() is None:
             self.process.send_signal(signal.SIGINT)
-        status = self.process.wait(60)
+        try:
+            status = self.process.wait(60)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            status = self.process.wait()
         self.reader.join(30)
         return status, ''.join(self.lines)
 

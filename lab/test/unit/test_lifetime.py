@@ -10,7 +10,7 @@ import textwrap
 
 import pytest
 
-from exam_lab.harness.supervisor import OWNER, marked, owner_mark
+from exam_lab.harness.supervisor import OWNER, alive, marked, owner_mark
 from exam_lab.harness.wait import wait_until
 
 #: The owner: its Supervisor's shell starts an orphan and a child, then says so on stdout.
@@ -79,3 +79,30 @@ def test_a_grading_leftover_is_told_from_a_stranger(tmp_path):
             proc.kill()
             proc.wait()
     assert not uids.leftover(ours.pid)  # gone
+
+
+#: A parent that starts ``sleep`` under DIES_WITH_PARENT (as another uid when it is root, as the judge
+#: and the box are started), says its pid, then waits to be killed.
+PARENT_SCRIPT = textwrap.dedent('''
+    import os, subprocess, sys, time
+    from exam_lab.grader.host import uids
+    from exam_lab.harness.supervisor import DIES_WITH_PARENT
+    other = uids.as_user(65534) if os.geteuid() == 0 else []
+    child = subprocess.Popen(DIES_WITH_PARENT + other + ['sleep', '300'])
+    print(child.pid, flush=True)
+    time.sleep(300)
+''')
+
+
+def test_a_child_dies_with_its_parent_even_as_another_uid():
+    """The parent death signal alone (no owner, no watch): SIGKILL of the parent ends its child, also
+    when the child changed its uid on the way (which clears the signal unless it is kept)."""
+    parent = subprocess.Popen([sys.executable, '-c', PARENT_SCRIPT], stdout=subprocess.PIPE, universal_newlines=True)
+    child = int(parent.stdout.readline())
+    assert wait_until(lambda: _names([child]) == ['sleep'], 10.0)
+    parent.kill()
+    parent.wait()
+    gone = wait_until(lambda: not alive(child), GONE_S, period=0.05)
+    if not gone:
+        os.kill(child, signal.SIGKILL)
+    assert gone
