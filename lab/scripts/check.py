@@ -44,7 +44,6 @@ SETTING = os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__
 
 
 def main(argv=None):
-    supervisor.own_processes()  # what the check starts ends with it, however it ends
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--package', required=True, help='your exam package: its folder, or the zip you upload')
     parser.add_argument('--sheet', choices=list(SHEETS), help='default: detected from the package')
@@ -91,4 +90,5 @@ def main(argv=None):
 
 
 if __name__ == '__main__':
+    supervisor.own_processes()  # what it starts ends with it, however it ends (the supervisor's "Lifetime")
     sys.exit(main())

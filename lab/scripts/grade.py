@@ -42,7 +42,6 @@ def say(line, stream=None):
 
 
 def main(argv=None):
-    supervisor.own_processes()
     try:
         return grade(argv)
     except KeyboardInterrupt as err:
@@ -138,4 +137,5 @@ def grade(argv):
 
 
 if __name__ == '__main__':
+    supervisor.own_processes()  # what it starts ends with it, however it ends (the supervisor's "Lifetime")
     sys.exit(main())

@@ -100,16 +100,16 @@ def left(mark, temp):
     return sorted(found)
 
 
-def grading_of(argv, tmp_path, temp, find_grade):
-    """Start ``argv`` (a session of its own, its TMPDIR ``temp``), wait until its grading's main run flies;
-    ``(process, log, mark)``. ``find_grade``: grade.py's pid from the process started."""
+def grading_of(argv, tmp_path, temp, find_grade, ready=flying):
+    """Start ``argv`` (a session of its own, its TMPDIR ``temp``), wait until its grading's main run flies
+    (``ready(temp)``); ``(process, log, mark)``. ``find_grade``: grade.py's pid from the process started."""
     log = open(str(tmp_path / 'grade.log'), 'w+')
     proc = subprocess.Popen(argv, cwd=REPO, stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
                             env=dict(os.environ, TMPDIR=temp))
     grade = wait_until(lambda: find_grade(proc), 60.0, period=0.1)
     assert grade, 'grade.py did not start'
     mark = owner_mark(grade)
-    if not wait_until(lambda: flying(temp) or proc.poll() is not None, FLYING_S, period=0.2) or not flying(temp):
+    if not wait_until(lambda: ready(temp) or proc.poll() is not None, FLYING_S, period=0.2) or not ready(temp):
         os.killpg(proc.pid, signal.SIGKILL)
         log.seek(0)
         pytest.fail('the main run did not fly (exit %s):\n%s' % (proc.poll(), log.read()[-3000:]))
@@ -132,8 +132,9 @@ def assert_nothing_left(proc, log, mark, temp, why):
     log.seek(0)
     output = log.read()
     assert gone, 'left running %.0f s after %s:\n%s\n%s' % (GONE_S, why, '\n'.join(remaining), output[-2000:])
-    records = glob.glob(os.path.join(temp, 'exam-grade-*', 'logs', 'session.json'))
-    assert not records, 'the session went on after %s: %s' % (why, records)
+    records = glob.glob(os.path.join(temp, 'exam-grade-*', 'logs', 'session.json')) + \
+        glob.glob(os.path.join(temp, 'exam-reference-*', 'reference.json'))
+    assert not records, 'the grading went on after %s: %s' % (why, records)
     return status, output
 
 
@@ -159,3 +160,41 @@ def test_make_grade_stopped_by_ctrl_c_leaves_no_process(tmp_path, temp):
     os.killpg(proc.pid, signal.SIGINT)
     status, output = assert_nothing_left(proc, log, mark, temp, 'Ctrl-C to make grade')
     assert status != 0 and 'grade: stopped' in output, output[-2000:]
+
+
+def test_a_class_stopped_by_ctrl_c_leaves_no_process(tmp_path, temp):
+    """Two students graded side by side (``--jobs 2``, each in a thread of grade.py's pool), Ctrl-C to
+    grade.py once one flies: grade.py does not wait for the gradings going on, and they end with it."""
+    klass = tmp_path / 'class'
+    for name in ('Ann Lee_101_assignsubmission_file_', 'Bob Ray_102_assignsubmission_file_'):
+        shutil.copytree(GOOD, str(klass / name))
+    argv = AS_FROM_A_TERMINAL + [sys.executable, GRADE, '--class', str(klass), '--out', str(tmp_path / 'out'),
+                                 '--jobs', '2', '--no-similarity']
+    proc, log, mark = grading_of(argv, tmp_path, temp, lambda proc: proc.pid)
+    os.kill(proc.pid, signal.SIGINT)
+    status, output = assert_nothing_left(proc, log, mark, temp, 'Ctrl-C to grade.py --class')
+    assert status == 130 and 'grade: stopped' in output, output[-2000:]
+
+
+def capture_master(temp):
+    """Whether the reference capture's master runs (its Supervisor's folder in ``temp``)."""
+    return any('rosmaster' in _cmdline(pid) for pid in run_marked(temp))
+
+
+#: An owner as grade.py is, capturing the reference outputs of the altitude sheet's drone (what
+#: grade.py does after its gradings: host/reference.py), not kept beside the underlay.
+CAPTURE = (
+    'from exam_lab.harness import supervisor\n'
+    'supervisor.own_processes()\n'
+    'from exam_lab.grader.host import reference, underlay\n'
+    'reference.captured("altitude", underlay.ensure_underlay(underlay.default_underlay()))\n')
+
+
+def test_a_reference_capture_killed_leaves_no_process(tmp_path, temp):
+    """The capture runs the real drone on a master of its own, in a process of its own: SIGKILL of its
+    owner once that master is up ends them all, and the capture goes no further."""
+    argv = AS_FROM_A_TERMINAL + [sys.executable, '-c', CAPTURE]
+    proc, log, mark = grading_of(argv, tmp_path, temp, lambda proc: proc.pid, ready=capture_master)
+    os.kill(proc.pid, signal.SIGKILL)
+    status, _ = assert_nothing_left(proc, log, mark, temp, 'its owner got SIGKILL')
+    assert status == -signal.SIGKILL

@@ -22,12 +22,13 @@ Lifetime: every process a run starts ends when the process that owns the run end
   Start processes from a thread that lives as long as they should (the main thread, a pool's worker).
 - **The owner's watch.** A process the started ones start in turn (rosmaster and rosout under
   roscore) gets no such signal, and an orphan is not killed with its parent. So the run's owner (a
-  script's ``main``: grade.py) calls :func:`own_processes` first: from then on every process started
-  carries ``EXAM_LAB_OWNER=<its owner's pid and start time>`` (:data:`OWNER`, inherited down every
-  chain, added by :meth:`Supervisor.start` to environments built from scratch), and a watch process
-  in a session of its own waits for the end of a pipe only the owner holds (any end closes it), then
-  ends whatever still carries that mark. A box's processes, whose environment is emptied, are ended
-  by bubblewrap instead.
+  script as it starts: grade.py, check.py; never a library function, since it changes
+  this process's signals) calls :func:`own_processes`: from then on every process started carries
+  ``EXAM_LAB_OWNER=<its owner's pid and start time>`` (:data:`OWNER`, inherited down every chain,
+  added by :meth:`Supervisor.start` to environments built from scratch), and a watch process in a
+  session of its own waits for the end of a pipe only the owner holds (any end closes it), then ends
+  whatever still carries that mark. A box's processes, whose environment is emptied, are ended by
+  bubblewrap instead.
 - **Signals.** :func:`own_processes` turns SIGTERM and SIGHUP into KeyboardInterrupt, as Ctrl-C is, so
   the owner's ``finally`` blocks and :meth:`Supervisor.close` stop what they started as a user would
   (an ignored SIGHUP, ``nohup``'s, stays ignored).
@@ -414,7 +415,7 @@ _owner = {}
 
 
 def own_processes():
-    """Make this process (a script's ``main``, in its main thread) the owner of every process it starts
+    """Make this process (a script as it starts, in its main thread) the owner of every process it starts
     from now on, of their children and theirs (the module's "Lifetime"): they carry its :data:`OWNER`
     mark, a watch ends them when this process ends, and SIGTERM and SIGHUP raise KeyboardInterrupt here
     as Ctrl-C does (even when started with SIGINT ignored, a background job of a script: it is the

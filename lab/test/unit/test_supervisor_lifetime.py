@@ -1,7 +1,8 @@
 """Every process a run starts ends with the run's owner, however it ends (harness.supervisor's "Lifetime"),
 on plain processes: an owner (a Python process that calls own_processes, as grade.py does) starts a
 shell through its Supervisor that leaves an orphan behind (``sleep &``: as roscore's rosmaster, no parent
-death signal of its own), then is killed or stopped; no process of its mark may be left."""
+death signal of its own), then is killed or stopped; no process of its mark may be left. And the
+parent death signal alone across a change of uid, and a slot's start sweep (host/uids.py)."""
 import os
 import signal
 import subprocess
@@ -53,7 +54,8 @@ def _names(pids):
     return sorted(names)
 
 
-@pytest.mark.parametrize('sig', [signal.SIGKILL, signal.SIGTERM, signal.SIGINT, signal.SIGHUP])
+@pytest.mark.parametrize('sig', [signal.SIGKILL, signal.SIGTERM, signal.SIGINT, signal.SIGHUP],
+                         ids=lambda s: signal.Signals(s).name)
 def test_every_process_of_the_owner_ends_with_it(tmp_path, sig):
     owner, mark = start_owner(tmp_path)
     owner.send_signal(sig)
@@ -106,3 +108,31 @@ def test_a_child_dies_with_its_parent_even_as_another_uid():
     if not gone:
         os.kill(child, signal.SIGKILL)
     assert gone
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason='processes of another uid are started by root')
+def test_a_slot_ends_what_a_killed_grading_left_in_it_and_nothing_else(tmp_path, monkeypatch):
+    """A slot whose lock is free but whose judge uid still runs a marked process (a grader killed
+    before it could end it) is taken, the process ended first; a slot whose uid runs a stranger's
+    process is passed over, the process left alone. Uids of their own, far from the real slots'."""
+    from exam_lab.grader.host import uids
+    monkeypatch.setattr(uids, 'LOCK_DIR', str(tmp_path))
+    monkeypatch.setattr(uids, 'SLOTS', 1)
+    monkeypatch.setattr(uids, 'BOX_UID_BASE', 64100)
+    monkeypatch.setattr(uids, 'JUDGE_UID_BASE', 64200)
+    plain = {k: v for k, v in os.environ.items() if k not in ('EXAM_LAB_RUN', OWNER)}
+    left = subprocess.Popen(uids.as_user(64200) + ['sleep', '60'], env=dict(plain, EXAM_LAB_RUN=str(tmp_path)))
+    stranger = None
+    try:
+        assert wait_until(lambda: uids.pids_of_uid(64200) == [left.pid], 10.0)
+        taken = uids.take_slot()
+        assert taken is not None and taken[0] == 0 and left.wait(10) == -signal.SIGKILL
+        taken[1].close()
+        stranger = subprocess.Popen(uids.as_user(64100) + ['sleep', '60'], env=plain)
+        assert wait_until(lambda: uids.pids_of_uid(64100) == [stranger.pid], 10.0)
+        assert uids.take_slot() is None and stranger.poll() is None
+    finally:
+        for proc in (left, stranger):
+            if proc is not None and proc.poll() is None:
+                proc.kill()
+                proc.wait()
