@@ -1,15 +1,15 @@
 """Every process a grading starts ends when grade.py ends, however it ends (harness.supervisor's
 "Lifetime"): the good student graded alone by grade.py (and by ``make grade``), stopped once its main
 run flies (the judge's master, rosout and probe up as the slot's judge uid, the student's roslaunch
-in its box as the box's uid), by SIGKILL, SIGTERM or SIGINT to grade.py alone, or Ctrl-C to the
-process group of ``make grade``. Then none of the grading's processes may be left, within a generous
-deadline (the watch's rounds, the sessions' grace periods on a shared machine): none carrying
-grade.py's mark, none carrying a Supervisor's mark of a folder of the grading's (its work folders lie
-in a temp folder of the test's own: TMPDIR), none of its boxes (a bubblewrap that binds one of those
-folders, and what runs in its PID namespace). And the session went no further once grade.py was
-gone: it wrote no record (left alone, it would fly its runs to the end, then stop its processes
-itself, within the deadline: the processes' end alone does not tell a grader that ends them from one
-that does not).
+in its box as the box's uid), by SIGKILL, SIGTERM, SIGINT or SIGHUP (a closed terminal) to grade.py
+alone, or Ctrl-C to the process group of ``make grade``; a class; a reference capture. Then none of
+the grading's processes may be left, within a generous deadline (the watch's rounds, the sessions'
+grace periods on a shared machine): none carrying grade.py's mark, none carrying a Supervisor's mark
+of a folder of the grading's (its work folders lie in a temp folder of the test's own: TMPDIR), none
+of its boxes (a bubblewrap that binds one of those folders, and what runs in its PID namespace). And
+the grading went no further once grade.py was gone: no session wrote its record, no capture its
+reference (left alone, they would go to their end, then stop their processes themselves, within the
+deadline: the processes' end alone does not tell a grader that ends them from one that does not).
 """
 import glob
 import os
@@ -138,7 +138,8 @@ def assert_nothing_left(proc, log, mark, temp, why):
     return status, output
 
 
-@pytest.mark.parametrize('sig', [signal.SIGKILL, signal.SIGTERM, signal.SIGINT], ids=lambda s: signal.Signals(s).name)
+@pytest.mark.parametrize('sig', [signal.SIGKILL, signal.SIGTERM, signal.SIGINT, signal.SIGHUP],
+                         ids=lambda s: signal.Signals(s).name)
 def test_a_grading_stopped_by_a_signal_leaves_no_process(tmp_path, temp, sig):
     argv = AS_FROM_A_TERMINAL + [sys.executable, GRADE, '--submission', GOOD, '--out', str(tmp_path / 'out')]
     proc, log, mark = grading_of(argv, tmp_path, temp, lambda proc: proc.pid)
