@@ -37,6 +37,7 @@ try:  # the report reader (issue 47 point 1)
 except ImportError:  # a grader without it: the check says nothing of the report
     reports = None
 from exam_lab.grader.score.sheets import SHEETS
+from exam_lab.harness import supervisor
 
 #: The teacher's choice of what the check shows.
 SETTING = os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), 'check_visibility.ini')
@@ -89,4 +90,5 @@ def main(argv=None):
 
 
 if __name__ == '__main__':
+    supervisor.own_processes()  # what it starts ends with it, however it ends (the supervisor's "Lifetime")
     sys.exit(main())

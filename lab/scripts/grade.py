@@ -16,6 +16,8 @@ Prints the score table (every line cleaned of control characters: it carries stu
 exits 0 whenever grading completed, whatever the scores, and 1 when the
 grader itself could not run (a missing input, the simulators not building, no sandbox: student code
 runs only in its sandbox, unless --unsandboxed-student-code-can-read-and-damage-my-files is given).
+Ctrl-C, SIGTERM and SIGHUP (a closed terminal) stop it, exit 130: every process the grading started
+ends with it, as it does when it is killed (exam_lab.harness.supervisor's "Lifetime").
 """
 import argparse
 import os
@@ -30,6 +32,7 @@ from exam_lab.grader.host import reference
 from exam_lab.grader.publish import desk, moodle, progress, report
 from exam_lab.grader.score import records, safe_text
 from exam_lab.grader.score.sheets import SHEETS
+from exam_lab.harness import supervisor
 
 
 def say(line, stream=None):
@@ -39,6 +42,19 @@ def say(line, stream=None):
 
 
 def main(argv=None):
+    try:
+        return grade(argv)
+    except KeyboardInterrupt as err:
+        say('grade: stopped (%s): nothing more is graded; what was written in OUT stays' % (err or 'Ctrl-C'),
+            sys.stderr)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        # A class's gradings still going on in their threads are not waited for (exit would join them):
+        # their processes end with this one.
+        os._exit(130)
+
+
+def grade(argv):
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     what = parser.add_mutually_exclusive_group(required=True)
     what.add_argument('--submission', help='a folder holding the exam package, or its zip')
@@ -91,25 +107,25 @@ def main(argv=None):
             shown = progress.ClassProgress(jobs)
             try:
                 if args.engine == 'slurm':
-                    records = slurm.grade_class(args.klass, out, sheet=args.sheet, progress=shown,
-                                                unsandboxed=args.unsandboxed, sbatch_args=shlex.split(args.slurm_args))
+                    graded = slurm.grade_class(args.klass, out, sheet=args.sheet, progress=shown,
+                                               unsandboxed=args.unsandboxed, sbatch_args=shlex.split(args.slurm_args))
                 else:
-                    records = class_run.grade_class(args.klass, out, sheet=args.sheet, jobs=jobs, progress=shown,
-                                                 unsandboxed=args.unsandboxed)
+                    graded = class_run.grade_class(args.klass, out, sheet=args.sheet, jobs=jobs, progress=shown,
+                                                   unsandboxed=args.unsandboxed)
             finally:
                 shown.close()
-            say(report.table(records))
-            waiting = report.needing_the_teacher(records)
+            say(report.table(graded))
+            waiting = report.needing_the_teacher(graded)
             if waiting:
                 say('\n%d student(s) need the teacher (their points are not a grade yet):' % len(waiting))
                 for line in waiting:
                     say('  ' + line)
             say('grades.csv and one folder per student in %s' % out)
-            for line in reference.keep_for(out, [r.get('sheet') or 'altitude' for r in records]):
+            for line in reference.keep_for(out, [r.get('sheet') or 'altitude' for r in graded]):
                 say(line)
-            for line in desk.finish(out, records, similar=None if args.no_similarity else
-                                    class_run.class_similarity(args.klass, out, records), worksheet=args.worksheet,
-                                    title=moodle.class_name(args.klass)) + desk.next_commands(out, records):
+            for line in desk.finish(out, graded, similar=None if args.no_similarity else
+                                    class_run.class_similarity(args.klass, out, graded), worksheet=args.worksheet,
+                                    title=moodle.class_name(args.klass)) + desk.next_commands(out, graded):
                 say(line)
     except RuntimeError as err:
         say('grade: %s' % err, sys.stderr)
@@ -121,4 +137,5 @@ def main(argv=None):
 
 
 if __name__ == '__main__':
+    supervisor.own_processes()  # what it starts ends with it, however it ends (the supervisor's "Lifetime")
     sys.exit(main())

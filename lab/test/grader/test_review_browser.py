@@ -35,6 +35,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(HERE), 'reports'))
 from cdp import Browser  # noqa: E402
 from exam_lab.grader.publish import grades, hand  # noqa: E402
 from exam_lab.grader.score.sheets import HAND_ITEMS  # noqa: E402
+from exam_lab.harness.supervisor import DIES_WITH_PARENT  # noqa: E402
 from make_reports import HOSTILE_LINES  # noqa: E402 (lab/test/reports: what hostile.pdf's answer holds)
 
 LAB = os.path.dirname(os.path.dirname(HERE))
@@ -82,10 +83,14 @@ def proposed(out, name):
 
 
 class Review(object):
-    """lab/scripts/review.py on OUT, as make review runs it; its URL from the line it prints."""
+    """lab/scripts/review.py on OUT, as make review runs it; its URL from the line it prints. The server
+    never outlives the test: stopped when its URL does not come, killed when a stop does not end it
+    (:meth:`stop`, called in a ``finally``), and by the kernel if this process dies first (the
+    supervisor's DIES_WITH_PARENT: a CI runner that kills the test)."""
 
     def __init__(self, out):
-        self.process = subprocess.Popen([sys.executable, os.path.join(LAB, 'scripts', 'review.py'), '--out', out],
+        self.process = subprocess.Popen(DIES_WITH_PARENT + [sys.executable, os.path.join(LAB, 'scripts', 'review.py'),
+                                                            '--out', out],
                                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         self.lines = []
         found = threading.Event()

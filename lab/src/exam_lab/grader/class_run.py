@@ -269,7 +269,6 @@ def grade_class(class_path, out_dir, *, sheet=None, jobs=None, isolate=None, pro
         students = class_students(class_path, work_dirs, refused=refused, out=out_dir)
         underlay = ensure_underlay(default_underlay())
         isolate = can_isolate() if isolate is None else isolate
-        records = [None] * len(students)
         if progress:
             progress.begin([name for name, _ in students])
 
@@ -284,9 +283,16 @@ def grade_class(class_path, out_dir, *, sheet=None, jobs=None, isolate=None, pro
                 progress.finished(record)
             return record
 
-        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-            for index, record in zip(range(len(students)), pool.map(one, range(len(students)))):
-                records[index] = record
+        pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs))
+        futures = [pool.submit(one, index) for index in range(len(students))]
+        try:
+            records = [future.result() for future in futures]
+        finally:
+            # Interrupted (grade.py's Ctrl-C, SIGTERM), no student is started any more and the gradings
+            # going on are not waited for: they end with this process (harness.supervisor's "Lifetime").
+            for future in futures:
+                future.cancel()
+            pool.shutdown(wait=False)
         report.write_csv(os.path.join(out_dir, 'grades.csv'), records)
         return records
     finally:

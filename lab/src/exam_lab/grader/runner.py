@@ -279,10 +279,13 @@ def run_session(job, *, work, underlay, isolate, box, twin=None, on_step=None, l
     argv = [sys.executable, '-m', 'exam_lab.grader.host.session', job_path]
     if isolate:
         argv = bwrap.network_namespace(argv)
-    with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
-        status, output, _ = sup.run('session', argv, timeout=left + SESSION_KILL_S, env=dict(os.environ, HOME=judge_home))
-    for marker in markers(log_dir):  # anything the session started and left, whatever happened to it
-        end_pids(marked(marker))
+    try:
+        with progress.watching(log_dir, on_step), Supervisor(os.path.join(work, 'outer')) as sup:
+            status, output, _ = sup.run('session', argv, timeout=left + SESSION_KILL_S,
+                                        env=dict(os.environ, HOME=judge_home))
+    finally:
+        for marker in markers(log_dir):  # anything the session started and left, whatever happened to it (Ctrl-C)
+            end_pids(marked(marker))
     survivors = box.end() + (twin.end() if twin is not None else 0)  # nothing may be left of the boxes' uids
     return session_outcome(log_dir, status, output, left, survivors)
 

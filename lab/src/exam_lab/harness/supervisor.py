@@ -11,6 +11,28 @@ Python process that started them died.
 Stopping is what a user does: Ctrl-C (SIGINT) to the process group, so rospy shuts down cleanly and
 roslaunch stops its nodes; SIGKILL for whatever is left after a grace period.
 
+Lifetime: every process a run starts ends when the process that owns the run ends, however it ends
+(Ctrl-C, SIGTERM, SIGHUP of a closed terminal, SIGKILL, a crash). No one mechanism covers every way:
+
+- **The parent's death.** Every process :meth:`Supervisor.start` starts (and the grader's other
+  children) runs under :data:`DIES_WITH_PARENT`: the kernel SIGKILLs it when the *thread* that started
+  it ends, the whole process with it, SIGKILL included. A change of uid clears that signal: the
+  judge's and the box's ``setpriv --reuid`` set it again (``--pdeathsig keep``), and a box's
+  bubblewrap has ``--die-with-parent``, its PID namespace taking every process of the box with it.
+  Start processes from a thread that lives as long as they should (the main thread, a pool's worker).
+- **The owner's watch.** A process the started ones start in turn (rosmaster and rosout under
+  roscore) gets no such signal, and an orphan is not killed with its parent. So the run's owner (a
+  script as it starts: grade.py, check.py; never a library function, since it changes
+  this process's signals) calls :func:`own_processes`: from then on every process started carries
+  ``EXAM_LAB_OWNER=<its owner's pid and start time>`` (:data:`OWNER`, inherited down every chain,
+  added by :meth:`Supervisor.start` to environments built from scratch), and a watch process in a
+  session of its own waits for the end of a pipe only the owner holds (any end closes it), then ends
+  whatever still carries that mark. A box's processes, whose environment is emptied, are ended by
+  bubblewrap instead.
+- **Signals.** :func:`own_processes` turns SIGTERM and SIGHUP into KeyboardInterrupt, as Ctrl-C is, so
+  the owner's ``finally`` blocks and :meth:`Supervisor.close` stop what they started as a user would
+  (an ignored SIGHUP, ``nohup``'s, stays ignored).
+
 Usage::
 
     with Supervisor(log_dir) as sup:
@@ -35,6 +57,11 @@ MARKER = 'EXAM_LAB_RUN'
 #: child that keeps the default (a ``sleep``, a student's shell script), which would sit out its grace
 #: period and be killed. coreutils' ``env`` resets it and execs the command (same pid).
 DEFAULT_SIGINT = ['env', '--default-signal=INT']
+#: Run before a command so that the kernel SIGKILLs it when the thread that started it ends (util-linux's
+#: setpriv sets the parent death signal, then execs the command: same pid). The module's "Lifetime".
+DIES_WITH_PARENT = ['setpriv', '--pdeathsig', 'KILL', '--']
+#: Environment variable that marks every process a run's owner started (:func:`own_processes`).
+OWNER = 'EXAM_LAB_OWNER'
 
 
 def free_port():
@@ -102,9 +129,10 @@ def descendants(pid):
     return found
 
 
-def marked(run_dir):
-    """Pids of the processes whose environment carries ``EXAM_LAB_RUN=run_dir`` (this one excluded)."""
-    marker = ('\0%s=%s\0' % (MARKER, run_dir)).encode()
+def marked(run_dir, variable=MARKER):
+    """Pids of the processes whose environment carries ``EXAM_LAB_RUN=run_dir`` (``variable=run_dir``:
+    an owner's :data:`OWNER` mark), this one excluded."""
+    marker = ('\0%s=%s\0' % (variable, run_dir)).encode()
     pids = []
     for entry in os.listdir('/proc'):
         if not entry.isdigit() or int(entry) == os.getpid():
@@ -276,9 +304,10 @@ class Supervisor(object):
         """
         env = dict(self.env if env is None else env)
         env[MARKER] = self.marker
+        if OWNER in os.environ:
+            env[OWNER] = os.environ[OWNER]
         ignoring = signal.getsignal(signal.SIGINT) == signal.SIG_IGN
-        if ignoring:
-            argv = DEFAULT_SIGINT + list(argv)
+        argv = DIES_WITH_PARENT + (DEFAULT_SIGINT if ignoring else []) + list(argv)
         with open(self.log(name), 'ab') as out:
             proc = subprocess.Popen(list(argv), env=env, cwd=cwd, stdout=out, stderr=subprocess.STDOUT,
                                     stdin=subprocess.DEVNULL, start_new_session=True)
@@ -371,11 +400,72 @@ def _ignores_sigint(pid):
     return False
 
 
+def owner_mark(pid):
+    """The :data:`OWNER` mark of the processes process ``pid`` owns: its pid and start time (a pid used
+    again later is another owner), or None when ``pid`` is gone."""
+    try:
+        with open('/proc/%d/stat' % pid) as f:
+            return '%d-%s' % (pid, f.read().rsplit(')', 1)[1].split()[19])
+    except (OSError, IndexError):
+        return None
+
+
+#: The write end of the pipe the owner's watch waits on: held open, never written, until this process ends.
+_owner = {}
+
+
+def own_processes():
+    """Make this process (a script as it starts, in its main thread) the owner of every process it starts
+    from now on, of their children and theirs (the module's "Lifetime"): they carry its :data:`OWNER`
+    mark, a watch ends them when this process ends, and SIGTERM and SIGHUP raise KeyboardInterrupt here
+    as Ctrl-C does (even when started with SIGINT ignored, a background job of a script: it is the
+    user's way to stop it). Returns the mark."""
+    if 'mark' not in _owner:
+        mark = owner_mark(os.getpid())
+        os.environ[OWNER] = mark
+        read, write = os.pipe()  # neither end is inherited by the processes started later (PEP 446)
+        subprocess.Popen([sys.executable, '-m', 'exam_lab.harness.supervisor', '--watch', mark], stdin=read,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+        os.close(read)
+        _owner.update(mark=mark, pipe=write)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGTERM, _interrupt)
+        if signal.getsignal(signal.SIGHUP) != signal.SIG_IGN:
+            signal.signal(signal.SIGHUP, _interrupt)
+    return _owner['mark']
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt('signal %d' % signum)
+
+
+#: Seconds the watch goes on ending an owner's processes (each round: SIGINT, then SIGKILL after 2 s).
+WATCH_S = 60.0
+
+
+def watch(mark):
+    """The owner's watch: wait until the owner's pipe (stdin) closes, then end every process that
+    carries its ``mark``, again until none is left (a process may start one while it is stopped)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C to the owner's group, should it be in it
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    while os.read(0, 4096):
+        pass
+    deadline = time.monotonic() + WATCH_S
+    while time.monotonic() < deadline:
+        left = marked(mark, OWNER)
+        if not left:
+            break
+        end_pids(left, grace=2.0)
+
+
 def main(argv):
     if len(argv) == 2 and argv[0] == '--cleanup':
         end_pids(marked(os.path.abspath(argv[1])))
         return 0
-    sys.stderr.write('usage: python3 -m exam_lab.harness.supervisor --cleanup RUN_DIR\n')
+    if len(argv) == 2 and argv[0] == '--watch':
+        watch(argv[1])
+        return 0
+    sys.stderr.write('usage: python3 -m exam_lab.harness.supervisor --cleanup RUN_DIR | --watch OWNER_MARK\n')
     return 2
 
 

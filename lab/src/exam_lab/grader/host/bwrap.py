@@ -56,10 +56,12 @@ def command(binds, mounts, cwd, env, own_network):
 def network_namespace(argv):
     """``argv`` run in a network namespace of its own with only loopback, up. As root ``unshare --net``;
     otherwise bubblewrap makes it, with a user namespace of its own that keeps the grading user's uid
-    and shows every file as it is (the master, the probe and the box's steps run inside)."""
+    and shows every file as it is (the master, the probe and the box's steps run inside). ``argv`` keeps
+    the parent death signal it is started with (unshare and sh exec it; bubblewrap, which runs it as its
+    child, dies with its parent and takes it along: the supervisor's "Lifetime")."""
     if os.geteuid() == 0:
         return ['unshare', '--net', '--', 'sh', '-c', 'ip link set lo up && exec "$@"', 'sh'] + list(argv)
-    return ['bwrap', '--unshare-user', '--unshare-net', '--dev-bind', '/', '/', '--'] + list(argv)
+    return ['bwrap', '--unshare-user', '--unshare-net', '--die-with-parent', '--dev-bind', '/', '/', '--'] + list(argv)
 
 
 _isolation = {}

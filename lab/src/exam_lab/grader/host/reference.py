@@ -28,7 +28,7 @@ from exam_lab.grader.host.bwrap import can_isolate, network_namespace
 from exam_lab.grader.score.reference import ReferenceRecord, reference_file
 from exam_lab.grader.score.records import RecordError
 from exam_lab.grader.score.sheets import SHEETS
-from exam_lab.harness.supervisor import Supervisor, end_pids, marked, ros_env, workspace_env
+from exam_lab.harness.supervisor import DIES_WITH_PARENT, Supervisor, end_pids, marked, ros_env, workspace_env
 from exam_lab.harness.wait import wait_until
 
 #: Seconds ``rostopic hz`` listens (the slowest sensor, 0.778 Hz, gives four periods in 6 s).
@@ -131,8 +131,8 @@ def captured(sheet, underlay, timeout=CAPTURE_TIMEOUT):
         argv = [sys.executable, '-m', 'exam_lab.grader.host.reference', '--sheet', sheet, '--underlay', underlay,
                 '--out', target, '--scratch', scratch]
         try:
-            done = subprocess.run(network_namespace(argv) if can_isolate() else argv, stdout=subprocess.PIPE,
-                                  stderr=subprocess.STDOUT, timeout=timeout)
+            done = subprocess.run(DIES_WITH_PARENT + (network_namespace(argv) if can_isolate() else argv),
+                                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=timeout)
         except subprocess.TimeoutExpired:
             raise RuntimeError('capturing the reference outputs of %s took more than %.0f s'
                                % (SHEETS[sheet].drone_pkg, timeout))

@@ -69,7 +69,7 @@ from exam_lab.grader.host import bwrap, cgroups, staging, uids
 from exam_lab.grader.host.limits import ADDRESS_SPACE_BYTES, BOX_SHARES, FILE_BYTES, MEMORY_BYTES, PROCESSES, \
     WORK_BYTES, prlimit
 from exam_lab.grader.score.boxenv import BOX_HOME, BOX_WS, box_env
-from exam_lab.harness.supervisor import WORKSPACE_VARS
+from exam_lab.harness.supervisor import DIES_WITH_PARENT, OWNER, WORKSPACE_VARS
 
 _check_lock = threading.Lock()
 _checked = {}
@@ -182,7 +182,9 @@ class Box(object):
         env = box_env(env, WORKSPACE_VARS, self.home)
         cwd = cwd or self.workspace
         prefix = cgroups.join(self.cgroups) + prlimit() + (uids.as_user(self.uid) if self.slot is not None else [])
-        if not self.bwrap:  # its HOME is a folder of its work folder (made by open)
+        if not self.bwrap:  # its HOME is a folder of its work folder (made by open); no bubblewrap to end it:
+            if OWNER in os.environ:  # its owner's watch does (harness.supervisor's "Lifetime")
+                env[OWNER] = os.environ[OWNER]
             return prefix + ['env', '-i', '-C', cwd] + ['%s=%s' % item for item in sorted(env.items())] + list(command)
         if mounts is None:
             mounts = [(os.path.join(self.folder, 'ws'), BOX_WS, True),
@@ -233,8 +235,8 @@ def _run_logged(argv, log, timeout):
     """Run ``argv`` in a session of its own, its output in the file ``log``, for at most ``timeout`` s;
     ``(exit status, None)`` or ``(None, why)``. Whatever is left of its session is killed."""
     with open(log, 'wb') as out:
-        child = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
-                                 start_new_session=True)
+        child = subprocess.Popen(DIES_WITH_PARENT + list(argv), stdin=subprocess.DEVNULL, stdout=out,
+                                 stderr=subprocess.STDOUT, start_new_session=True)
         try:
             return child.wait(timeout=timeout), None
         except subprocess.TimeoutExpired:

@@ -9,6 +9,7 @@ import os
 import pwd
 import signal
 
+from exam_lab.harness.supervisor import MARKER, OWNER
 from exam_lab.harness.wait import wait_until
 
 #: First uid of the boxes (isolate uses 60000+); slot N runs as BOX_UID_BASE + N.
@@ -20,8 +21,9 @@ LOCK_DIR = '/run/lock/exam-grader'
 
 
 def take_slot():
-    """``(slot, its lock file, held open)`` of a free slot: locked by no grader, neither uid in use by
-    an account or a process; None when every slot is taken."""
+    """``(slot, its lock file, held open)`` of a free slot: locked by no grader, neither uid an account's
+    nor used by a process other than a grading's; None when every slot is taken. What an earlier
+    grading left in the slot (:func:`leftover`: it was killed before it could end them) is ended first."""
     os.makedirs(LOCK_DIR, mode=0o700, exist_ok=True)
     for slot in range(SLOTS):
         lock = open(os.path.join(LOCK_DIR, 'box-%d' % slot), 'w')
@@ -30,25 +32,49 @@ def take_slot():
         except OSError:
             lock.close()
             continue
-        if _uid_in_use(BOX_UID_BASE + slot) or _uid_in_use(JUDGE_UID_BASE + slot):
+        if any(_uid_in_use(base + slot) for base in (BOX_UID_BASE, JUDGE_UID_BASE)):
             lock.close()
             continue
+        end_uid(BOX_UID_BASE + slot)
+        end_uid(JUDGE_UID_BASE + slot)
         return slot, lock
     return None
 
 
 def as_user(uid):
-    """The command-line prefix that drops root for ``uid`` (its own group, none else, no capabilities)."""
+    """The command-line prefix that drops root for ``uid`` (its own group, none else, no capabilities).
+    The parent death signal a change of uid clears is set again (the supervisor's "Lifetime")."""
     return ['setpriv', '--reuid=%d' % uid, '--regid=%d' % uid, '--clear-groups', '--no-new-privs',
-            '--inh-caps=-all', '--']
+            '--inh-caps=-all', '--pdeathsig', 'keep', '--']
 
 
 def _uid_in_use(uid):
+    """Whether ``uid`` is an account's, or a process not a grading's leftover (:func:`leftover`) runs as it."""
     try:
         pwd.getpwuid(uid)
         return True
     except KeyError:
-        return bool(pids_of_uid(uid))
+        return not all(leftover(pid) for pid in pids_of_uid(uid))
+
+
+#: What marks the processes of a grading: the supervisor's marks in their environment (the judge's).
+_MARKS = tuple(('\0%s=' % name).encode() for name in (MARKER, OWNER))
+
+
+def leftover(pid):
+    """Whether process ``pid`` is one a grading started, so one that may be ended when its slot's lock is
+    free: its environment carries the supervisor's marks (the judge's processes), or it is a box's
+    (bubblewrap, or in a PID namespace below this one: every process of a box is). False once it is gone."""
+    try:
+        with open('/proc/%d/environ' % pid, 'rb') as f:
+            environ = b'\0' + f.read()
+        with open('/proc/%d/cmdline' % pid, 'rb') as f:
+            program = os.path.basename(f.read().split(b'\0')[0])
+        with open('/proc/%d/status' % pid) as f:
+            nspids = next((line.split()[1:] for line in f if line.startswith('NSpid:')), [])
+    except OSError:
+        return False
+    return any(mark in environ for mark in _MARKS) or program == b'bwrap' or len(nspids) > 1
 
 
 def pids_of_uid(uid):
