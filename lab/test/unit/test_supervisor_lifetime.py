@@ -136,3 +136,53 @@ def test_a_slot_ends_what_a_killed_grading_left_in_it_and_nothing_else(tmp_path,
             if proc is not None and proc.poll() is None:
                 proc.kill()
                 proc.wait()
+
+
+def test_the_watch_runs_what_the_owner_asked_once_it_has_ended(tmp_path):
+    """What no mark shows (a box's slot) is ended by what the owner asked its watch to run at its end
+    (supervisor.at_owner_end): run once however often asked, and only after the owner is gone."""
+    ran = tmp_path / 'ran'
+    script = textwrap.dedent('''
+        import sys, time
+        from exam_lab.harness.supervisor import at_owner_end, own_processes
+        own_processes()
+        for _ in range(3):
+            at_owner_end(['sh', '-c', 'echo x >> "$1"', 'sh', sys.argv[1]])
+        print('ready', flush=True)
+        time.sleep(300)
+    ''')
+    owner = subprocess.Popen(['env', '--default-signal=INT,HUP', sys.executable, '-c', script, str(ran)],
+                             stdout=subprocess.PIPE, universal_newlines=True)
+    assert owner.stdout.readline().strip() == 'ready'
+    mark = owner_mark(owner.pid)
+    assert not ran.exists()
+    owner.kill()
+    owner.wait()
+    assert wait_until(lambda: not marked(mark, OWNER), GONE_S, period=0.05)  # the watch too: it has run all
+    assert ran.read_text() == 'x\n'
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason='processes of another uid are started by root')
+def test_the_watch_empties_a_slot_whose_box_lost_its_parent(tmp_path, monkeypatch):
+    """A box whose bubblewrap was still setting up when its grader died never bound itself to its
+    parent: uids.end_slot (what the watch runs for each slot its owner took) ends it, unless a grader
+    holds the slot. The box: a real bubblewrap as the slot's uid, without --die-with-parent."""
+    import fcntl
+    from exam_lab.grader.host import uids
+    monkeypatch.setattr(uids, 'LOCK_DIR', str(tmp_path))
+    monkeypatch.setattr(uids, 'BOX_UID_BASE', 64100)
+    monkeypatch.setattr(uids, 'JUDGE_UID_BASE', 64200)
+    box = subprocess.Popen(uids.as_user(64100) + ['bwrap', '--unshare-user', '--unshare-pid', '--dev-bind', '/', '/',
+                                                  'sleep', '60'])
+    try:
+        assert wait_until(lambda: len(uids.pids_of_uid(64100)) == 3, 10.0)  # bwrap, its pid 1, sleep
+        with open(str(tmp_path / 'box-0'), 'w') as held:  # another grader's slot: left alone
+            fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            uids.end_slot(0)
+            assert len(uids.pids_of_uid(64100)) == 3
+        uids.end_slot(0)
+        assert uids.pids_of_uid(64100) == []
+    finally:
+        if box.poll() is None:
+            box.kill()
+        box.wait()

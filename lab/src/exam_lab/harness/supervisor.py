@@ -28,7 +28,9 @@ Lifetime: every process a run starts ends when the process that owns the run end
   added by :meth:`Supervisor.start` to environments built from scratch), and a watch process in a
   session of its own waits for the end of a pipe only the owner holds (any end closes it), then ends
   whatever still carries that mark. A box's processes, whose environment is emptied, are ended by
-  bubblewrap instead.
+  bubblewrap, and, should its bubblewrap have died while the box was still being set up (before
+  it bound itself to its parent), by the watch again: the owner tells it each box slot it takes
+  (:func:`at_owner_end`), whose uids it empties once no grader holds the slot.
 - **Signals.** :func:`own_processes` turns SIGTERM and SIGHUP into KeyboardInterrupt, as Ctrl-C is, so
   the owner's ``finally`` blocks and :meth:`Supervisor.close` stop what they started as a user would
   (an ignored SIGHUP, ``nohup``'s, stays ignored).
@@ -41,6 +43,7 @@ Usage::
         ...
     # every process of the run is gone here; the logs stay in log_dir
 """
+import json
 import os
 import signal
 import socket
@@ -435,6 +438,14 @@ def own_processes():
     return _owner['mark']
 
 
+def at_owner_end(argv):
+    """Have the owner's watch run ``argv`` once this process, the owner, has ended and its marked
+    processes are gone: for what the owner took that no mark shows (a box's slot, whose processes'
+    environment is emptied). Nothing when this process owns nothing (:func:`own_processes`)."""
+    if 'pipe' in _owner:
+        os.write(_owner['pipe'], (json.dumps(list(argv)) + '\n').encode())  # one write, atomic: threads may call
+
+
 def _interrupt(signum, frame):
     raise KeyboardInterrupt('signal %d' % signum)
 
@@ -445,17 +456,31 @@ WATCH_S = 60.0
 
 def watch(mark):
     """The owner's watch: wait until the owner's pipe (stdin) closes, then end every process that
-    carries its ``mark``, again until none is left (a process may start one while it is stopped)."""
+    carries its ``mark``, again until none is left (a process may start one while it is stopped),
+    then run what the owner asked for on the pipe (:func:`at_owner_end`), each once."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C to the owner's group, should it be in it
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
-    while os.read(0, 4096):
-        pass
+    said = b''
+    while True:
+        chunk = os.read(0, 65536)
+        if not chunk:
+            break
+        said += chunk
     deadline = time.monotonic() + WATCH_S
     while time.monotonic() < deadline:
         left = marked(mark, OWNER)
         if not left:
             break
         end_pids(left, grace=2.0)
+    asked = []
+    for line in said.decode('utf-8', 'replace').splitlines():
+        if line not in asked:
+            asked.append(line)
+    for line in asked:
+        try:
+            subprocess.run(json.loads(line), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=60)
+        except (ValueError, TypeError, OSError, subprocess.SubprocessError):
+            pass
 
 
 def main(argv):

@@ -62,6 +62,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 import tempfile
 import threading
 
@@ -69,7 +70,7 @@ from exam_lab.grader.host import bwrap, cgroups, staging, uids
 from exam_lab.grader.host.limits import ADDRESS_SPACE_BYTES, BOX_SHARES, FILE_BYTES, MEMORY_BYTES, PROCESSES, \
     WORK_BYTES, prlimit
 from exam_lab.grader.score.boxenv import BOX_HOME, BOX_WS, box_env
-from exam_lab.harness.supervisor import DIES_WITH_PARENT, OWNER, WORKSPACE_VARS
+from exam_lab.harness.supervisor import DIES_WITH_PARENT, OWNER, WORKSPACE_VARS, at_owner_end
 
 _check_lock = threading.Lock()
 _checked = {}
@@ -149,6 +150,8 @@ class Box(object):
                 raise SandboxUnavailable('no free box among %d (uids %d-%d taken)'
                                          % (uids.SLOTS, uids.BOX_UID_BASE, uids.BOX_UID_BASE + uids.SLOTS - 1))
             self.slot, self._lock = taken
+            # Emptied again once the grading has ended, however it ended (the supervisor's "Lifetime").
+            at_owner_end([sys.executable, '-m', 'exam_lab.grader.host.uids', '--end-slot', str(self.slot)])
         elif self.bwrap:
             self.rootless, self.owner, self.netns = True, os.geteuid(), os.readlink('/proc/self/ns/net')
         self.mounted = staging.work_folder(self.folder, os.path.join(self.work, 'ws', 'src'), not self.bwrap,
