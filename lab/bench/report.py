@@ -203,7 +203,8 @@ def render(r, figure_rel, grader_section=None):
     out += ['## Machine', '',
             '- %s, %d cores (`nproc`), %.1f GiB memory; %s; Python %s, rospy %s.'
             % (m['cpu_model'], m['nproc'], m['mem_gb'], m['kernel'], m['python'], m['rospy']),
-            '- Load average (1, 5, 15 min) at start %s, at end %s. The machine is shared: other '
+            '- Load average (1, 5, 15 min) at the start of the node\'s stages %s, at their end %s (the '
+            'grader\'s stage says its own). The machine is shared: other '
             'engineers ran builds and tests meanwhile, so CPU figures include their interference.'
             % (m['loadavg_start'], m['loadavg_end']), '']
     out += ['## Summary', '',
