@@ -381,7 +381,7 @@ def test_the_setting_is_make_checks_file(tmp_path, monkeypatch):
 def test_make_grade_rescore_and_worksheet_write_the_zip(tmp_path, capsys):
     """make grade and make rescore write it through the desk; make worksheet with the hand points merged."""
     from exam_lab.grader.publish import desk
-    from test_grader_hand import WORKSHEET, worksheet_script
+    from test_grader_hand import WORKSHEET, write_worksheet, worksheet_script
     out = tmp_path / 'out'
     records = [record('Jane Doe', folder='Jane Doe_101_assignsubmission_file_'),
                record('Paul Martin', {'Q11': 1.5}, folder='Paul Martin_102_assignsubmission_file_')]
@@ -397,7 +397,7 @@ def test_make_grade_rescore_and_worksheet_write_the_zip(tmp_path, capsys):
     rows[3] = rows[3].replace(',' * (len(HAND_ITEMS) + 1), ',1' + ',' * len(HAND_ITEMS))
     with open(str(out / hand.FILE), 'w') as f:
         f.write('\n'.join(rows) + '\n')
-    (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8', newline='')
+    write_worksheet(tmp_path / 'ws.csv', WORKSHEET)
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 0
     printed = capsys.readouterr().out
     assert '  Paul Martin: hand points not all given in hand.csv (Q5, Q6, Q7, Q8, Q9, comments, quality)' in printed

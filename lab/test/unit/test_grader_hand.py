@@ -130,6 +130,13 @@ def worksheet_script():
     return module
 
 
+def write_worksheet(path, text):
+    """``text`` into ``path`` as Moodle's download holds it: its CRLFs kept as they are (Path.write_text
+    takes ``newline`` from Python 3.10 only)."""
+    with open(str(path), 'w', encoding='utf-8', newline='') as f:
+        f.write(text)
+
+
 WORKSHEET = '\ufeff' + '\r\n'.join([
     'Identifier,"Full name",Status,Grade,"Maximum grade","Grade can be changed","Last modified (grade)",'
     '"Feedback comments"',
@@ -146,7 +153,7 @@ def test_the_whole_grade_on_the_worksheets_scale_and_nothing_missing_taken_as_ze
     cells[('Jane Doe', 'quality')] = '1'
     cells[('Paul Martin', 'Q4')] = '1'
     fill(str(out / hand.FILE), cells)
-    (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8', newline='')
+    write_worksheet(tmp_path / 'ws.csv', WORKSHEET)
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 0
     printed = capsys.readouterr().out
     filled = (out / moodle.UPLOAD).read_text(encoding='utf-8-sig')
@@ -182,7 +189,7 @@ def test_a_grade_json_that_is_no_grade_stops_the_worksheet_naming_it(tmp_path, c
     out = tmp_path / 'out'
     jane, paul = record('Jane Doe', 17.0, 101), record('Paul Martin', 15.5, 102)
     write_run(out, [jane, paul])
-    (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8', newline='')
+    write_worksheet(tmp_path / 'ws.csv', WORKSHEET)
     (out / 'Paul Martin' / 'grade.json').write_text(json.dumps(dict(paul, total='15.5 points')))
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
     err = capsys.readouterr().err
@@ -246,7 +253,7 @@ def test_a_name_differing_by_a_trailing_dot_never_takes_a_classmates_hand_points
     hands = hand.read(str(out / hand.FILE))
     assert hands[1002].remark == 'a clear report' and hands[1002].points['comments'] == 4.0
     assert hands[1002].student == 'Jane Doe_2' and all(v is None for v in hands[1001].points.values())
-    (tmp_path / 'ws.csv').write_text(WORKSHEET_TWO_JANES, encoding='utf-8', newline='')
+    write_worksheet(tmp_path / 'ws.csv', WORKSHEET_TWO_JANES)
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 0
     filled = (out / moodle.UPLOAD).read_text(encoding='utf-8-sig')
     rows = {r['Identifier']: r for r in csv.DictReader(filled.splitlines())}
@@ -265,7 +272,7 @@ def test_a_kept_row_whose_participant_no_longer_matches_stops_the_worksheet(tmp_
     import shutil
     shutil.rmtree(str(out / 'Jane Doe'))
     write_run(out, [moodle_record('Jane Doe._1001_assignsubmission_file_', 11.0)])
-    (tmp_path / 'ws.csv').write_text(WORKSHEET_TWO_JANES, encoding='utf-8', newline='')
+    write_worksheet(tmp_path / 'ws.csv', WORKSHEET_TWO_JANES)
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 1
     err = capsys.readouterr().err
     assert 'hand.csv line 3 (Jane Doe, participant 1002)' in err

@@ -107,7 +107,7 @@ def test_make_worksheet_leaves_out_a_grade_of_an_older_grader_and_fills_the_othe
     sentence; Jane's whole grade is written."""
     from exam_lab.grader.publish import hand, moodle
     from exam_lab.grader.score.sheets import HAND_ITEMS
-    from test_grader_hand import WORKSHEET, fill, worksheet_script
+    from test_grader_hand import WORKSHEET, fill, worksheet_script, write_worksheet
     out = tmp_path / 'out'
     for name, shape, number in (('Jane Doe', 'version-1', 101), ('Paul Martin', 'before-version', 102)):
         folder = kept_folder(out, shape, name)
@@ -116,7 +116,7 @@ def test_make_worksheet_leaves_out_a_grade_of_an_older_grader_and_fills_the_othe
             json.dump(grade, f)
     hand.write(str(out / hand.FILE), [GradeRecord.read(str(out / 'Jane Doe' / 'grade.json')).value])
     fill(str(out / hand.FILE), {('Jane Doe', item): str(top) for item, (top, _) in HAND_ITEMS.items()})
-    (tmp_path / 'ws.csv').write_text(WORKSHEET, encoding='utf-8', newline='')
+    write_worksheet(tmp_path / 'ws.csv', WORKSHEET)
     assert worksheet_script().main(['--out', str(out), '--worksheet', str(tmp_path / 'ws.csv')]) == 0
     printed = capsys.readouterr().out
     assert 'worksheet: left out: Paul Martin/grade.json: graded by an older grader: grade again' in printed, printed
