@@ -216,3 +216,30 @@ def test_the_nodes_start_counts_from_roslaunchs(monkeypatch):
     monkeypatch.setattr(node, 'LAUNCH_START_S', 3600.0)
     ended = found(Graph(launch_after=None, node_after=None), start_timeout=3600.0, launch_ended=lambda: True)
     assert ended['nodes'] == [] and ended['launch_seen_s'] is None
+
+
+def test_the_calibration_never_flies_an_input_the_drone_cannot_give(monkeypatch):
+    """A fit to the node's wild values (1.7e308, or a slope just above the 'hardly depends' bound) asked
+    the drone for 586 km, a pressure of 0: the probe died with ZeroDivisionError. Such an input is never
+    flown; the oracle's values are, and the calibration says so."""
+    pytest.importorskip('rospy')
+    import time
+    import types
+    from exam_lab.grader.judge import pilot
+    flown = []
+
+    class Inputs(object):
+        settle = 0.0
+
+        def fly(self, x):
+            flown.append(x)
+            return time.time() - 1.0
+
+    class Recorder(object):
+        def samples(self, since):
+            return [(time.time(), 0.002 * flown[-1])] if flown else []
+
+    plan = types.SimpleNamespace(threshold=1300.0, margin=130.0)
+    calibration, xs = pilot.Calibration(Inputs(), Recorder(), plan).calibrate([(1000.0, 2.0), (1100.0, 2.2)])
+    assert flown == [] or all(abs(x - 1300.0) <= pilot.WILD_MARGINS * 130.0 for x in flown), flown
+    assert calibration['by'] == 'oracle' and xs == (1170.0, 1430.0, 1300.0 - pilot.NEAR_M), (calibration, xs)
