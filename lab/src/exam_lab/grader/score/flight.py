@@ -135,10 +135,31 @@ def warning_window(probe):
     the delay less WARNING_EARLY_S; the delay and the larger of WARNING_LATE_S, one period of the
     slowest input and one tick of the node's 10 Hz (a node that checks at each reading), and the node's
     own period (:func:`own_period`: one that publishes slowly checks as slowly, its rate question 11's
-    loss alone, issue 45)."""
+    loss alone, issue 45), or later for a slow node, :func:`paced_late`."""
     delay = otherwise(probe_of(probe).delay, DELAY)
-    return delay - WARNING_EARLY_S, delay + max(WARNING_LATE_S, slowest_period(probe) + 1.0 / RATE_HZ,
-                                                own_period(probe))
+    return delay - WARNING_EARLY_S, max(delay + max(WARNING_LATE_S, slowest_period(probe) + 1.0 / RATE_HZ,
+                                                    own_period(probe)), paced_late(probe))
+
+
+def paced_late(probe):
+    """The latest WARNING on time of a slow node (:func:`own_period`), timed at its own ticks as the
+    judge received its values: before its second value published more than a tick after the delay, s
+    after its own value went beyond and stayed; 0 for a node at the sheet's rate or when not recorded.
+
+    A node that checks its delay once a loop warns in the loop whose check first sees the delay
+    elapsed: the first of its values after the delay (a tick later when its check fell a few ms short
+    of it, transport and a loaded machine), its call following its value by the service's own latency.
+    Its longest gap (:func:`own_period`) bounds that only for a steady pace; measured on its ticks, the
+    window is the node's own, however its pace and the machine's load vary (issue 45: 0.01 s outside
+    under load). A node whose delay is longer than the sheet's by more than one of its periods is
+    still outside."""
+    probe = probe_of(probe)
+    published = probe.trace.published if probe.trace else None
+    if not own_period(probe) or not published or silent(probe) or 'long_up' not in (probe.schedule or {}):
+        return 0.0
+    since = timed_from(probe, 'long_up', stays=True)[0]
+    after = [t for t, _ in published if t > since + otherwise(probe.delay, DELAY) + 1.0 / RATE_HZ]
+    return after[1] - since if len(after) > 1 else 0.0
 
 
 def leg_lag(probe, name):

@@ -186,8 +186,9 @@ def score_q14b(sheet, session):
     normal_late = NORMAL_LATE_S + (flight.slowest_period(probe) if flight.silent(probe) else 0.0)
     normal_ok = normal_judged and normal_latency is not None and normal_latency <= normal_late
     points = 1.5 * warn_ok + 1.0 * short_ok + (0.5 * normal_ok if (warn_ok or short_ok) else 0.0)
-    notes = ['WARNING %.2f s after %s went above the threshold and stayed (%s: %.2f-%.2f s) (%s/1.5)' % (
-        latency, up_words, 'ok' if warn_ok else 'outside', early, late, 1.5 if warn_ok else 0)]
+    notes = ['WARNING %.2f s after %s went above the threshold and stayed (%s: %.2f-%.2f s%s) (%s/1.5)' % (
+        latency, up_words, 'ok' if warn_ok else 'outside', early, late,
+        ', at its own pace' if flight.own_period(probe) else '', 1.5 if warn_ok else 0)]
     if not short_judged:
         notes.append('short excursion: %s (0/1)' % flight.leg_words(probe, 'short_up'))
     else:
