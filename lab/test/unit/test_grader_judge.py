@@ -218,18 +218,22 @@ def test_the_nodes_start_counts_from_roslaunchs(monkeypatch):
     assert ended['nodes'] == [] and ended['launch_seen_s'] is None
 
 
-def test_the_calibration_never_flies_an_input_the_drone_cannot_give(monkeypatch):
-    """A fit to the node's wild values (1.7e308, or a slope just above the 'hardly depends' bound) asked
-    the drone for 586 km, a pressure of 0: the probe died with ZeroDivisionError. Such an input is never
-    flown; the oracle's values are, and the calibration says so."""
-    pytest.importorskip('rospy')
+def _calibrated(slope):
+    """The calibration of a node whose own value is ``slope`` times the oracle's: ``(flown, calibration,
+    xs)``, flown the oracle values asked of the drone (the real drone's check of what it can give)."""
     import time
     import types
     from exam_lab.grader.judge import pilot
+    from exam_lab.harness.fake_drone import Drone
     flown = []
+    drone = Drone.__new__(Drone)
+    drone.mode, drone.fixed_value = 'altitude', 15.0
 
     class Inputs(object):
         settle = 0.0
+
+        def __init__(self):
+            self.drone = drone
 
         def fly(self, x):
             flown.append(x)
@@ -237,9 +241,36 @@ def test_the_calibration_never_flies_an_input_the_drone_cannot_give(monkeypatch)
 
     class Recorder(object):
         def samples(self, since):
-            return [(time.time(), 0.002 * flown[-1])] if flown else []
+            return [(time.time(), slope * flown[-1])] if flown else []
 
     plan = types.SimpleNamespace(threshold=1300.0, margin=130.0)
-    calibration, xs = pilot.Calibration(Inputs(), Recorder(), plan).calibrate([(1000.0, 2.0), (1100.0, 2.2)])
-    assert flown == [] or all(abs(x - 1300.0) <= pilot.WILD_MARGINS * 130.0 for x in flown), flown
-    assert calibration['by'] == 'oracle' and xs == (1170.0, 1430.0, 1300.0 - pilot.NEAR_M), (calibration, xs)
+    points = [(1000.0, slope * 1000.0), (1100.0, slope * 1100.0)]
+    return (flown,) + pilot.Calibration(Inputs(), Recorder(), plan).calibrate(points)
+
+
+def test_the_calibration_never_flies_an_input_the_drone_cannot_give():
+    """A fit to the node's wild values (1.7e308, or a slope just above the 'hardly depends' bound) asked
+    the drone for 1160 km, a pressure a Float32 carries as 0 (1e-55 Pa): the probe died with ZeroDivisionError. Such
+    an input is never flown; the oracle's values are, and the calibration says so."""
+    pytest.importorskip('rospy')
+    flown, calibration, xs = _calibrated(1.01e-3)
+    assert flown == [], flown
+    assert calibration['by'] == 'oracle' and xs == (1170.0, 1430.0, 1300.0 - 0.1), (calibration, xs)
+    assert 'did not come out on both sides' in calibration['reason'], calibration
+
+
+def test_a_node_off_by_a_factor_is_flown_where_its_own_value_crosses():
+    """Degrees Celsius for kelvin: its values are 19 times too small, its 1300 m is the oracle's 25 km
+    (5.2 kPa), far beyond the sheet's flights but a pressure the drone gives: flown there, so its mistake
+    is question 11's only (the CI run where a bound of 20 margins took Q13 and Q14 from it)."""
+    pytest.importorskip('rospy')
+    flown, calibration, xs = _calibrated(15.0 / 288.15)
+    assert calibration['by'] == 'own', calibration
+    assert xs[1] == pytest.approx(1430.0 * 288.15 / 15.0, rel=1e-6) and min(flown) > 20000.0, (xs, flown)
+    from exam_lab.harness.fake_drone import Drone
+    drone = Drone.__new__(Drone)
+    drone.mode, drone.fixed_value = 'depth', 101325.0
+    assert drone.can_give(50.0) and drone.can_give(-9.0) and not drone.can_give(-20.0)  # robot above water
+    assert not drone.can_give(float('nan')) and not drone.can_give(1e40)
+
+

@@ -26,6 +26,8 @@ Used in-process, after ``rospy.init_node`` (a rostest test node, the bench drive
 
 or as a node of its own: ``rosrun exam_lab fake_drone_node.py`` (a drone process a test can kill).
 """
+import math
+import struct
 import threading
 import time
 import unittest
@@ -40,6 +42,9 @@ from submarinedrone.simulator import SPEC as SUBMARINEDRONE
 
 from exam_lab.harness import oracle
 from exam_lab.harness.wait import wait_until
+
+#: The smallest positive normal number a std_msgs/Float32 carries: a pressure below it is none.
+FLOAT32_TINY = 1.1754943508222875e-38
 
 #: Temperature the fake aerial drone flies in, degC (any valid value would do).
 AIR_TEMPERATURE = 15.0
@@ -445,6 +450,19 @@ class Drone(object):
         if self.mode == 'altitude':
             return oracle.pressure_at(value, self.fixed_value)
         return oracle.pressure_robot_at(value, self.fixed_value)
+
+    def can_give(self, value):
+        """Whether the drone can be put at ``value`` m: its moving input a positive pressure a
+        std_msgs/Float32 carries (a normal number, neither 0 nor infinite), turned back by the oracle
+        into a finite value. Any such pressure is flown, however far from the sheet's flights: a node
+        whose own values are off by a factor (degrees Celsius for kelvin) is timed where its own value
+        crosses the threshold. A fit to a wild value may ask for 586 km (a pressure of 0): never flown."""
+        try:
+            carried = struct.unpack('f', struct.pack('f', self.input_for(value)))[0]
+            back = self.expected(self.fixed_value, carried)
+        except (ArithmeticError, ValueError, struct.error):
+            return False
+        return math.isfinite(carried) and carried >= FLOAT32_TINY and math.isfinite(back)
 
     def expected(self, fixed, moving):
         """What the exam node must publish for these two input values."""

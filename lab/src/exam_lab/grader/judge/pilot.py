@@ -19,9 +19,6 @@ SETTLE_SLACK_S = 0.5
 #: alone moves the altitude by about 0.45 m).
 NEAR_M = 0.1
 NEAR_MAX_M = 0.2
-#: How many margins from its target an input asked by the node's own fit may lie: beyond, the fit came
-#: from a wild value and the oracle's values are flown (issue 45: one such input stopped the probe).
-WILD_MARGINS = 20
 #: The most values of a question 11 row's window kept (its last ones): 6 s at 10 Hz.
 MAX_ROW_VALUES = 60
 #: The most seconds a leg waits for the node's own value to reach the side of the threshold it is
@@ -136,7 +133,7 @@ class Calibration(object):
                 x = (target - b) / a
             value = None
             for _ in range(4 if side == 'near' else 3):
-                if not abs(x - target) <= WILD_MARGINS * margin:  # never flown: the oracle's values instead
+                if not self.inputs.drone.can_give(x):  # a fit to a wild value: the oracle's values instead
                     value = None
                     break
                 previous = last_value(self.recorder, 0.0)[0] if self.recorder is not None else None
