@@ -22,7 +22,7 @@ import os
 import sys
 
 from exam_lab.grader import contract
-from exam_lab.grader.publish import desk, feedback, grades, hand, moodle, report
+from exam_lab.grader.publish import desk, feedback, grades, hand, moodle
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.schema import RecordError
 
@@ -56,7 +56,7 @@ def main(argv=None):
               '(Assignment > View all submissions > Grading action: Download grading worksheet)' % args.out,
               file=sys.stderr)
         return 1
-    records = report.with_class_sheet(records)
+    records = desk.with_sheets(args.out, records, single=grades.graded_in(args.out) == [args.out])
     path = os.path.join(args.out, hand.FILE)
     if not contract.exists(path):
         print('worksheet: no %s: every student\'s hand points are missing (make grade writes it)' % path)

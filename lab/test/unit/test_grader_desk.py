@@ -419,6 +419,44 @@ def test_a_report_only_student_has_the_class_sheet_and_counts_in_no_statistic(tm
     assert 'nothing of the package ran: submission refused' in cleo['Feedback comments']
 
 
+
+def test_a_report_only_student_has_the_sheet_her_report_is_about(tmp_path):
+    """Issue 47: a report-only student in a class whose packages ran on the depth sheet, her report
+    (LibreOffice's, of the aerial drone) naming /temperature, /pressure, mydrone: her sheet is the one
+    her report answers, in hand.csv, grades.csv and her proposals (checked against the aerial drone's
+    outputs), and her notes say how; one whose report names no sheet gets the class's."""
+    import shutil
+    out = str(tmp_path)
+    data = os.path.join(os.path.dirname(__file__), 'data')
+    depth = [dict(record(name, participant=number), sheet='depth') for name, number in (('Ann', 1), ('Bob', 2))]
+    report_only = []
+    for name, number in (('Cleo', 3), ('Dora', 4)):
+        r = record(name, status='not graded', participant=number,
+                   reason='submission refused: no catkin package (package.xml) in %s_%d (seen: report.pdf)' % (name, number))
+        r['items'] = [dict(e, points=0.0) for e in r['items']]
+        r['total'] = 0.0
+        report_only.append(r)
+    records = depth + report_only
+    for r in records:
+        report.write_grade(os.path.join(out, r['student']), r)
+    shutil.copy(os.path.join(data, 'kept', 'report-fr_odt', 'report.json'), os.path.join(out, 'Cleo', 'report.json'))
+    for sheet in ('altitude', 'depth'):
+        shutil.copy(os.path.join(data, 'answers', 'reference-%s.json' % sheet), out)
+    report.write_csv(os.path.join(out, 'grades.csv'), records)
+    desk.finish(out, records)
+    with open(os.path.join(out, 'grades.csv'), encoding='utf-8') as f:
+        assert {row['student']: row['sheet'] for row in csv.DictReader(f)} == \
+            {'Ann': 'depth', 'Bob': 'depth', 'Cleo': 'altitude', 'Dora': 'depth'}
+    with open(os.path.join(out, hand.FILE), encoding='utf-8') as f:
+        assert [row['sheet'] for row in csv.DictReader(f) if row['student'] == 'Cleo'] == ['altitude']
+    sheeted = {r['student']: r for r in desk.with_sheets(out, records)}
+    assert any(n.startswith('sheet altitude: its report is about it (it names ') for n in sheeted['Cleo']['for_the_teacher'])
+    assert any(n.startswith("sheet depth: the class's") for n in sheeted['Dora']['for_the_teacher'])
+    assert sheeted['Ann'] is records[0]
+    with open(os.path.join(out, 'Cleo', 'proposals.json'), encoding='utf-8') as f:
+        q6 = [p for p in json.load(f) if p['item'] == 'Q6'][0]
+    assert 'topics: ok (/pressure, /rosout, /temperature)' in q6['evidence'] and q6['points'] == 1.0, q6
+
 def test_a_status_reason_is_said_once():
     """A doubt that is the status reason itself (several uploads) is not printed twice on its line."""
     twice = dict(record('Jane', status='needs a hand grade', reason='several uploads: a.zip and b.zip'),
@@ -428,3 +466,19 @@ def test_a_status_reason_is_said_once():
     text = page.render([twice], 'Class', {})
     first = re.sub(r' title="[^"]*"', '', text[text.index('id="first"'):text.index('id="histogram"')])
     assert first.count('several uploads') == 1  # (the status's tooltip aside)
+
+
+@pytest.mark.parametrize('text, sheet', [
+    ('$ rostopic list\n/pressure_robot\n/pressure_remote\n/depth\n/rosout', 'depth'),
+    ('catkin_create_pkg exam rospy std_msgs submarinedrone ; rosservice call /depth_warning', 'depth'),
+    ('rostopic list /pressure /temperature; rosnode info /mydrone', 'altitude'),
+    ('la pression et la température, pressure and temperature, depth and altitude', None),  # prose names nothing
+    ('/pressure_robot and /temperature', None),                # one of each: neither
+    ('/mydrone/pressure /exam/depth_x /altitudes', None),      # whole names only
+    ('/pressure /temperature /altitude mydrone, unlike /depth', 'altitude'),  # 4 against 1
+])
+def test_the_sheet_a_text_is_about(text, sheet):
+    from exam_lab.grader.score.sheets import sheet_named_in
+    named, words = sheet_named_in(text)
+    assert named == sheet, words
+    assert words.startswith('it names ') and "of the depth sheet's ROS names" in words

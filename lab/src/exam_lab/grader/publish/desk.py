@@ -115,6 +115,17 @@ def _student(out, record, single):
     return entry
 
 
+def with_sheets(out, records, single=False):
+    """``records`` as :func:`report.with_class_sheet` gives them, the sheet of a student whose package
+    ran nothing read from the report kept in her folder of ``out``."""
+    def report_text(record):
+        try:
+            return proposals.report_text(out if single else contract.student_folder(out, record['student']))
+        except contract.ContractError:  # no folder of hers to read: the class's sheet
+            return ''
+    return report.with_class_sheet(records, report_text)
+
+
 def finish(out, records, single=False, similar=None, worksheet=None, title=None, show=None):
     """Write the desk's files for ``records`` graded into ``out``; return lines for the terminal.
 
@@ -132,7 +143,7 @@ def finish(out, records, single=False, similar=None, worksheet=None, title=None,
                         % type(similar).__name__)
     lines, notes, entries = [], [], {}
     records, refused = _grade_records(records)
-    sheeted = report.with_class_sheet(records)
+    sheeted = with_sheets(out, records, single)
     if not single and any(a is not b for a, b in zip(records, sheeted)) and \
             os.path.isfile(os.path.join(out, 'grades.csv')):
         report.write_csv(os.path.join(out, 'grades.csv'), sheeted)

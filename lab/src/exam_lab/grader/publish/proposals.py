@@ -52,6 +52,11 @@ def read_report(folder):
     return record_type.kept(folder).value
 
 
+def report_text(folder):
+    """The text of every page of the report the run kept for one student ('' when none was read)."""
+    return '\n'.join(page.get('text') or '' for page in read_report(folder).get('pages') or ())
+
+
 def read_comments(folder):
     """The code's ``comments`` as the inspection measured them (measurements.json's), or None."""
     path = os.path.join(folder, kept.MeasurementsRecord.FILE)

@@ -15,7 +15,7 @@ import os
 from exam_lab.grader import contract
 from exam_lab.grader.publish import cells
 from exam_lab.grader.score import kept, safe_text
-from exam_lab.grader.score.sheets import ITEMS, SHEETS
+from exam_lab.grader.score.sheets import ITEMS, SHEETS, sheet_named_in
 
 #: What no machine scores, with the rubric's points (sheet 000's notes).
 NOT_SCORED = ('comments (4 points), code quality (2 points), and the report: questions 1-9 and the '
@@ -152,15 +152,25 @@ def ran_nothing(record):
     return record.get('status') == 'not graded'
 
 
-def with_class_sheet(records):
+def with_class_sheet(records, report_text=lambda record: ''):
     """``records``, each one that ran nothing (:func:`ran_nothing`: its sheet is the runner's default,
-    not detected) given the class's sheet: the one most of the others were detected on (when any ran),
-    so that hand.csv, the page and the worksheet show the sheet her report answers."""
+    not detected) given the sheet its report is about (``report_text(record)``, its pages' text, naming
+    one sheet's ROS names: :func:`~exam_lab.grader.score.sheets.sheet_named_in`), else the class's sheet:
+    the one most of the others were detected on (when any ran), so that hand.csv, the page, the
+    proposals and the worksheet show the sheet her report answers; how, in her notes for the teacher."""
     counts = collections.Counter(r['sheet'] for r in records if not ran_nothing(r) and r.get('sheet'))
-    if not counts:
-        return list(records)
-    sheet = counts.most_common(1)[0][0]
-    return [dict(r, sheet=sheet) if ran_nothing(r) and r.get('sheet') != sheet else r for r in records]
+    common = counts.most_common(1)[0][0] if counts else None
+    sheeted = []
+    for r in records:
+        named, words = sheet_named_in(report_text(r)) if ran_nothing(r) else (None, '')
+        sheet = named or common
+        if not ran_nothing(r) or sheet is None or (sheet == r.get('sheet') and not named):
+            sheeted.append(r)
+            continue
+        how = 'sheet %s: its report is about it (%s)' % (sheet, words) if named else \
+            'sheet %s: the class\'s, most of its packages ran on it (its report is about no sheet: %s)' % (sheet, words)
+        sheeted.append(dict(r, sheet=sheet, for_the_teacher=list(r.get('for_the_teacher') or []) + [how]))
+    return sheeted
 
 
 def evidence_lines(record):

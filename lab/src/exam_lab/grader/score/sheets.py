@@ -92,6 +92,26 @@ def sheet_of_drone(pkg):
     return None
 
 
+def _ros_names(sheet):
+    """Patterns of the ROS names only this sheet has: its drone's package and service (a slash before
+    or not), its topics (with their slash: "pressure" alone is prose)."""
+    names = [r'(?<!\w)' + re.escape(word) for word in (sheet.drone_pkg, sheet.service)]
+    return names + [r'(?<![\w/])/' + re.escape(topic) for topic in sheet.inputs + (sheet.output,)]
+
+
+def sheet_named_in(text):
+    """``(sheet, words)``: the sheet a student's text (a report, of a student whose package does not say
+    it) is about, when it names that sheet's ROS names (:func:`_ros_names`) at least twice and at least
+    twice as often as the other's, else None; ``words`` how many of each it named, for the teacher.
+    Only whole names count: ``/pressure`` is not ``/pressure_robot``, prose ("la pression") nothing."""
+    counts = collections.OrderedDict(
+        (name, sum(len(re.findall(pattern + r'(?![\w/])', text)) for pattern in _ros_names(sheet)))
+        for name, sheet in SHEETS.items())
+    words = ', '.join('%d of the %s sheet\'s' % (n, name) for name, n in counts.items())
+    (first, most), (_, other) = sorted(counts.items(), key=lambda item: -item[1])
+    return (first if most >= 2 and most >= 2 * other else None), 'it names %s ROS names' % words
+
+
 def margin_of(threshold):
     """How far beyond the threshold the probe flies (student units): 10 %, at least 10 m."""
     return max(0.1 * abs(threshold), 10.0)
