@@ -44,6 +44,9 @@ SUBMISSIONS = os.path.join(HERE, '..', 'test', 'grader', 'submissions')
 OUR_EXAM = os.path.realpath(os.path.join(HERE, '..', '..', 'exam'))
 
 
+#: A class of 60 at the default JOBS on two cores: its goal (issue 48: six minutes; it was 15).
+CLASS_GOAL_S = 360
+
 #: The packages whose WARNING is meant to miss the 5 s window: left out of its spread.
 NOT_ON_TIME = ('no_delay', 'late_warning')
 
@@ -298,7 +301,7 @@ def render(results):
     for klass in results['classes']:
         goals.append('class of %d at JOBS=%d: %.1f min%s' % (
             klass['students'], klass['jobs'], klass['wall'] / 60.0,
-            '' if klass['students'] != 60 else (' (goal met)' if klass['wall'] <= 900 else ' (goal missed)')))
+            '' if klass['students'] != 60 else (' (goal met)' if klass['wall'] <= CLASS_GOAL_S else ' (goal missed)')))
     return '\n'.join([
         '## The grader', '',
         '_Measured by `%s --record` on %s (UTC)%s at commit %s, after `make build` and `source tools/env.sh`; '
@@ -317,10 +320,10 @@ def render(results):
         'from the node\'s own value and passes 4.7 s up to the delay, one period of the slowest input and a tick: '
         '`score/flight.py` `warning_window`; the packages warning at once or 50 s late left out) and the NORMAL after the first reading back (<= 0.5 s).', '']
         + rows + ['',
-        'Goals: one submission in at most 90 s (%s), a class of 60 in at most 15 minutes on two cores, no point '
+        'Goals: one submission in at most 90 s (%s), a class of 60 in at most %d minutes on two cores (issue 48), no point '
         'moved. Measured: %s. %s' % (
             'every package' if not slow else 'every package but %s, flown until its late WARNING comes'
-            % ', '.join(slow), '; '.join(goals), (
+            % ', '.join(slow), CLASS_GOAL_S // 60, '; '.join(goals), (
             'Every student got the points of its package alone (the largest difference of a total: 0).' if not differ else
             'Points that differed: %s. The largest difference of a total: %s point(s).' % (
                 '; '.join(differ), _total({'': largest})))), '',
