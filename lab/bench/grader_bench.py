@@ -4,7 +4,7 @@
     python3 lab/bench/grader_bench.py [--students 60] [--jobs 4,6] [--out DIR] [--record] [--no-alone]
     python3 lab/bench/grader_bench.py --from-results DIR/results.json [--record]
 
-(from the repository, after ``make build`` and ``source tools/env.sh``; about 70 minutes on two cores (67 on 2026-11-27)). A full
+(from the repository, after ``make build`` and ``source tools/env.sh``; about 36 minutes on two cores with --jobs 4 (2140 s on 2026-12-02)). A full
 ``make bench`` runs it last and records it; ``BENCH_STAGES=grader make bench`` runs a class of 4 into
 ``$EXAM_WS/bench-quick/grader``. Phases:
 
@@ -278,7 +278,7 @@ def render(results):
     when = results.get('date', '?')
     load = ''
     if results.get('load_start'):
-        load = ' Load average (1, 5, 15 min) at start %s, at end %s: the machine (2 cores) is shared.' % (
+        load = ' Load average (1, 5, 15 min) at start %s, at end %s, on 2 cores (the work of anything else running counts too).' % (
             ', '.join('%.2f' % x for x in results['load_start']),
             ', '.join('%.2f' % x for x in results.get('load_end', [])))
     default = class_run.default_jobs()

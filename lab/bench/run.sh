@@ -8,7 +8,7 @@
 #   BENCH_FLEET_SIZES=5,20,50  the fleet sizes of ours (default 1,5,10,20,50,100: 200 nodes and the
 #                    master's CPU at 100 pairs need a machine with the cores and about 8 GB for them)
 # A full run ends with the grader's speed (lab/bench/grader_bench.py: a class of 60 at JOBS 4 and 6,
-# about 70 minutes more on two cores), recorded in lab/bench/grader.md and rendered into docs/benchmarks.md.
+# 2140 s on two cores with --jobs 4 alone on 2026-12-02, a second class more at JOBS 6), recorded in lab/bench/grader.md and rendered into docs/benchmarks.md.
 #   BENCH_PROFILE=1  also profile ours with py-spy (installed from PyPI into a throwaway directory)
 #   BENCH_RENDER_ONLY=1  measure nothing: render the docs again from the last results
 # Every process it starts carries the run's log folder in its environment (exam_lab's supervisor); the
@@ -95,7 +95,7 @@ else
   wait "$bench_pid"
 fi
 if [ "$grader" = record ]; then
-  echo "bench: the grader's speed (lab/bench/grader_bench.py, about 70 minutes)"
+  echo "bench: the grader's speed (lab/bench/grader_bench.py, about 50 minutes)"
   /usr/bin/python3 "$repo/lab/bench/grader_bench.py" --out "$scratch/grader" --record &
   bench_pid=$!
   wait "$bench_pid"
