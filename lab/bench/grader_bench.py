@@ -322,7 +322,7 @@ def render(results):
         + rows + ['',
         'Goals: one submission in at most 90 s (%s), a class of 60 in at most %d minutes on two cores (issue 48), no point '
         'moved. Measured: %s. %s' % (
-            'every package' if not slow else 'every package but %s, flown until its late WARNING comes'
+            'every package' if not slow else 'every package but %s, whose flights wait for a call that comes late or never'
             % ', '.join(slow), CLASS_GOAL_S // 60, '; '.join(goals), (
             'Every student got the points of its package alone (the largest difference of a total: 0).' if not differ else
             'Points that differed: %s. The largest difference of a total: %s point(s).' % (
