@@ -8,7 +8,7 @@ import zipfile
 import pytest
 
 from exam_lab.grader.boxed import report_files, report_reader, report_text
-from exam_lab.grader.score.records import RecordError, ReportRecord
+from exam_lab.grader.score.records import REPORT_UNSURE, RecordError, ReportRecord
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'data', 'reports')
 
@@ -50,6 +50,19 @@ def test_ocr_facts_give_the_mean_confidence_and_the_unsure_words_once():
     facts = report_text.ocr_facts(words)
     assert facts == {'confidence': 84.0, 'unsure': ['remote']}
     assert report_text.ocr_facts([]) == {'confidence': None, 'unsure': []}
+
+
+def test_more_unsure_words_than_the_cap_are_said_in_a_note():
+    word = report_text.parse_tsv(TSV)[0]
+    words = [word._replace(text='w%d' % n, confidence=10.0) for n in range(REPORT_UNSURE + 40)]
+    notes = []
+    facts = report_text.ocr_facts(words + words, 'page 2 of report.pdf', notes)
+    assert facts['unsure'] == ['w%d' % n for n in range(REPORT_UNSURE)]
+    assert notes == ['page 2 of report.pdf: %d words read by OCR with low confidence, the first %d listed'
+                     % (REPORT_UNSURE + 40, REPORT_UNSURE)]
+    notes = []
+    report_text.ocr_facts(words[:REPORT_UNSURE], 'page 1 of a.pdf', notes)
+    assert notes == []
 
 
 def test_a_pictures_text_goes_where_the_picture_stands():

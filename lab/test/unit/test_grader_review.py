@@ -279,6 +279,20 @@ def test_the_report_is_read_through_its_checked_record_as_make_rescore_reads_it(
     assert cyd.report is None
 
 
+def test_the_readers_notes_are_on_the_students_page(out):
+    """What the reader left out or could not read (its record's notes: a page not read by OCR, the cap
+    of unsure words) is said on the student's page, escaped, never a silent cut."""
+    record = json.loads((out / 'ann' / 'report.json').read_text())
+    record['notes'] = ['page 2 of report.pdf: 340 words read by OCR with low confidence, the first 200 listed',
+                       'page 3 of report.pdf: not read by OCR: <tesseract> stopped']
+    (out / 'ann' / 'report.json').write_text(json.dumps(record))
+    students, notes = folder.load(str(out))
+    ann = [s for s in students if s.name == 'ann'][0]
+    shown = page.student_page('t', '/T', ann, decisions.cells_now(str(out / hand.FILE)), folder.code_files(ann.folder))
+    assert '340 words read by OCR with low confidence, the first 200 listed' in shown
+    assert 'not read by OCR: &lt;tesseract&gt; stopped' in shown and '<tesseract>' not in shown
+
+
 def test_fields_of_another_type_are_dropped_with_a_note(out):
     (out / 'cyd' / 'proposals.json').write_text(json.dumps([
         {'item': 'Q4', 'points': 7, 'state': 'proposed', 'evidence': ['x'], 'passage': 3},

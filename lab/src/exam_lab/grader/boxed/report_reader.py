@@ -280,7 +280,7 @@ class Ocr(object):
             w, h = info['sizes'].get(page['number'], (595.0, 842.0))
             if lines is None:
                 words = self.tesseract(report_images.prepare_page(page_image()), stem, 3)
-                page.update(text=words_text(words), **ocr_facts(words))
+                page.update(text=words_text(words), **ocr_facts(words, _where(page, path), self.notes))
                 return
             boxes = [b for line in lines for b in line['boxes']]
             regions = report_images.picture_regions(
@@ -303,9 +303,10 @@ class Ocr(object):
                     blocks.append((region[1] if region is not None else h, words_text(words)))
                     everything += words
             if blocks:
-                page.update(text=merge_pictures(lines, blocks), pictures=len(blocks), **ocr_facts(everything))
+                page.update(text=merge_pictures(lines, blocks), pictures=len(blocks),
+                            **ocr_facts(everything, _where(page, path), self.notes))
         except (ToolFailed, report_images.PictureError) as err:
-            self.notes.append('page %d of %s: not read by OCR: %s' % (page['number'], os.path.basename(path), err))
+            self.notes.append('%s: not read by OCR: %s' % (_where(page, path), err))
 
     def tesseract(self, image, stem, psm):
         """The words tesseract reads in the PIL ``image`` (:data:`Word`), underscores it dropped put back."""
@@ -329,7 +330,8 @@ class Ocr(object):
         words = self.tesseract(report_images.prepare_picture(image), os.path.join(self.scratch, 'picture%d' % index), 6)
         return dict({'file': index, 'number': 1, 'source': 'ocr', 'text': bounds.cut(records_clean(words_text(words)),
                                                                                     REPORT_PAGE_TEXT),
-                     'layout': '', 'pictures': 0, 'image': 'report/' + target}, **ocr_facts(words))
+                     'layout': '', 'pictures': 0, 'image': 'report/' + target},
+                    **ocr_facts(words, os.path.basename(path), self.notes))
 
 
 class Reader(Pages, Ocr, Tools):
@@ -427,6 +429,11 @@ class Reader(Pages, Ocr, Tools):
         sizes = {int(n): (float(w), float(h)) for n, w, h in
                  re.findall(r'^Page\s+(\d+) size:\s+([\d.]+) x ([\d.]+)', text, re.M)}
         return {'pages': int(pages.group(1)), 'sizes': sizes}
+
+
+def _where(page, path):
+    """A page of a file, as a note names it: "page 2 of report.pdf"."""
+    return 'page %d of %s' % (page['number'], os.path.basename(path))
 
 
 def office_profile(profile, office=OFFICE):

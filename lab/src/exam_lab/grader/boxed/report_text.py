@@ -100,16 +100,18 @@ def words_text(words):
     return '\n'.join(out)
 
 
-def ocr_facts(words):
-    """``{"confidence", "unsure"}`` of OCR words: their mean confidence, those under the floor."""
+def ocr_facts(words, where='the page', notes=None):
+    """``{"confidence", "unsure"}`` of OCR words: their mean confidence, those under the floor (each
+    once, at most REPORT_UNSURE); when more were, ``notes`` gets a sentence saying how many, of
+    ``where``: a cap is said, never a silent cut."""
     if not words:
         return {'confidence': None, 'unsure': []}
-    unsure, seen = [], set()
-    for text, confidence in ((w.text, w.confidence) for w in words):
-        if confidence < CONFIDENCE_FLOOR and text not in seen and len(unsure) < REPORT_UNSURE:
-            seen.add(text)
-            unsure.append(bounds.cut(records_clean(text), 100))
-    return {'confidence': round(sum(w.confidence for w in words) / len(words), 1), 'unsure': unsure}
+    unsure = list(dict.fromkeys(w.text for w in words if w.confidence < CONFIDENCE_FLOOR))
+    if len(unsure) > REPORT_UNSURE and notes is not None:
+        notes.append('%s: %d words read by OCR with low confidence, the first %d listed'
+                     % (where, len(unsure), REPORT_UNSURE))
+    return {'confidence': round(sum(w.confidence for w in words) / len(words), 1),
+            'unsure': [bounds.cut(records_clean(text), 100) for text in unsure[:REPORT_UNSURE]]}
 
 
 def matching_picture(region, pictures):

@@ -252,6 +252,8 @@ def _report(base, student):
         parts.append('<ul>%s</ul>' % ''.join('<li>%s (%s%s, %s page(s))%s</li>' % (
             _e(f['name']), _e(f['kind']), ', converted' if f['converted'] else '', _e(_points(f['pages'])),
             (': ' + _e(f['note'])) if f['note'] else '') for f in report['files']))
+    if report['notes']:  # what the reader left out or could not read: said, never a silent cut
+        parts.append('<ul class="flag">%s</ul>' % ''.join('<li>%s</li>' % _e(n) for n in report['notes']))
     for index, page in enumerate(report['pages']):
         label = 'page %d%s, %s%s' % (page['number'], (' of file %d' % (page['file'] + 1)) if len(report['files']) > 1
                                      else '', page['source'],
