@@ -19,8 +19,7 @@ import argparse
 import os
 import sys
 
-from exam_lab.grader.publish import desk, grades, report
-from exam_lab.grader.score import records as records_
+from exam_lab.grader.publish import desk, grades, proposals, report
 from exam_lab.grader.score import safe_text
 
 
@@ -49,7 +48,7 @@ def main(argv=None):
     # Each student's report as its run read it (report.json, checked as a box's record is): never read
     # again from the PDF, no box here. One not read, or a kept file refused, is said.
     for folder in grades.graded_folders(out):
-        kept = records_.ReportRecord.kept(folder)
+        kept = proposals.kept_report(folder)
         if kept.state != 'read':
             print('  report of %s not read: %s' % (safe_text.one_line(os.path.basename(folder)), safe_text.one_line(kept.why)))
     single = grades.graded_folders(out) == [out]

@@ -89,7 +89,7 @@ def test_make_grade_writes_the_proposals_the_reports_and_their_copies(small_clas
     assert 'proposals: %s' % (out / proposals.FILE) in shown, shown[-3000:]
     for name, package in (('Ann Good', True), ('Bob Scan', True), ('Zoe Report', False)):
         folder = out / name
-        record = ReportRecord.kept(str(folder))
+        record = proposals.kept_report(str(folder))
         assert record.state == 'read', (name, record.why)
         assert json.loads((folder / 'report.json').read_text())['state'] == 'read'
         assert record.pages[0]['source'] == ('ocr' if name == 'Bob Scan' else 'text'), (name, record.pages[0])
@@ -120,7 +120,7 @@ def test_the_reports_time_beside_the_students(small_class):
     for name in ('Ann Good', 'Bob Scan', 'Zoe Report'):
         measured = json.loads((out / name / MEASUREMENTS).read_text())
         seconds = (measured.get('extra') or {}).get('seconds')
-        report = ReportRecord.kept(str(out / name)).seconds
+        report = proposals.kept_report(str(out / name)).seconds
         print('%s: graded in %s s, of which the report %.1f s' % (name, seconds, report))
         assert report > 0
 

@@ -189,7 +189,7 @@ def test_a_class_with_reports_not_read_grades_every_student(tmp_path):
     by_name = {r['student']: r for r in records}
     assert sorted(by_name) == ['Anne Roy', 'Jeanne Martin', 'Marc Petit']
     assert by_name['Jeanne Martin']['total'] == 17, json.dumps(by_name['Jeanne Martin'], indent=1)[:3000]
-    kept = {name: ReportRecord.kept(str(out / name)) for name in by_name}
+    kept = {name: proposals.kept_report(str(out / name)) for name in by_name}
     assert kept['Jeanne Martin'].state == 'read'
     assert kept['Anne Roy'].state == 'not read' and 'an encrypted PDF' in kept['Anne Roy'].why
     assert kept['Marc Petit'].state == 'not read' and '30000 x 30000 pixels' in kept['Marc Petit'].why

@@ -9,7 +9,8 @@ from exam_lab.grader.boxed import derive, launch, source
 
 from exam_lab.grader.judge import legs, pilot
 
-from exam_lab.grader.score import fields, flight, records, rubric, runs, tolerances, verdict
+from exam_lab.grader.score import flight, records, rubric, runs, tolerances, verdict
+from exam_lab.grader.score.job import PLAN, Plan
 
 from exam_lab.grader.publish import report
 
@@ -317,11 +318,11 @@ class ScriptedNode(object):
 
 
 def plan(**change):
-    """A run's plan as the judge reads it from its job (:meth:`~exam_lab.grader.score.records.JobRecord.plan`):
+    """A run's plan as the judge reads it from its job (:meth:`~exam_lab.grader.score.job.JobRecord.plan`):
     the main run's of a 1300 m threshold, checked."""
     value = dict({'kind': 'main', 'sheet': 'altitude', 'threshold': 1300.0, 'margin': 130.0, 'delay': 5.0,
                   'start_timeout': 20.0, 'output': '/altitude', 'late_warning': 60.0}, **change)
-    return fields.view(records.check(value, records.PLAN, 'plan'), records.PLAN)
+    return Plan(**records.check(value, PLAN, 'plan'))
 
 
 def synthetic_flight(monkeypatch, node, clock, rates, warned_before=False):

@@ -1,5 +1,6 @@
 """Reading students' launch files: the drone, the exam node, the threshold however it is set; the
 derived copies the grader runs."""
+import dataclasses
 import os
 import shutil
 import xml.etree.ElementTree as ET
@@ -387,8 +388,8 @@ def test_the_threshold_run_value_is_drawn_once_written_and_planned(tmp_path, dra
     again = derive.threshold_param(launch.analyse(derived, os.path.join(str(ws), 'src', 'exam')), 'altitude')[0]
     assert (again.name, launch.as_number(again.value)) == ('--threshold', value)
     job = runner.plan_job(records.InspectRecord(records.check(found, records.InspectRecord.SCHEMA)))
-    main, threshold = [run['plan'] for run in job.runs]
-    assert threshold == dict(main, kind='threshold', threshold=value), 'the main run\'s plan around the new value'
+    main, threshold = [run.plan for run in job.runs]
+    assert threshold == dataclasses.replace(main, kind='threshold', threshold=value), 'the main run\'s plan around the new value'
     with pytest.raises(ValueError):
         sheets.threshold_run_value(1300.0, 1.0)
 

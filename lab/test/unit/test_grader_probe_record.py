@@ -1,5 +1,6 @@
 """The probe's result and the session's outcome as records: checked where root reads them, their
 text made safe once there, a result of another shape the run's crash, a round trip through JSON."""
+import dataclasses
 import copy
 import json
 import math
@@ -11,8 +12,9 @@ from exam_lab.grader import runner
 from exam_lab.grader.publish import grades
 from exam_lab.grader.host import session
 from exam_lab.grader.host import run as host_run
-from exam_lab.grader.score import records
+from exam_lab.grader.score import job as job_records, records
 from exam_lab.grader.score.records import ProbeRecord, RecordError, SessionRecord
+from exam_lab.grader.score.schema import plain
 
 from test_grader_kept import kept_copy
 
@@ -198,23 +200,24 @@ def test_the_job_and_its_plans_are_records_that_round_trip(tmp_path, capsys):
     """The plan (runner), the job as the session reads it (job.json) and each run's plan as the judge
     reads it (from the same job: JobRecord.plan) are checked records: what the runner made is what they read."""
     job = runner.plan_job(inspected())
-    assert isinstance(job, records.JobRecord) and [run['tag'] for run in job.runs] == ['main', 'threshold']
+    assert isinstance(job, job_records.JobRecord) and [run.tag for run in job.runs] == ['main', 'threshold']
     main, threshold = job.plan('main'), job.plan('threshold')
     assert (main.threshold, threshold.threshold, threshold.margin) == (1300.0, 900.0, 130.0) and main.late_warning > 0
-    assert records.JobRecord.from_json(job.to_json().encode()) == job
-    assert runner.plan_job(inspected(calls_service=False)).runs[0]['plan']['late_warning'] == 0.0
+    assert job_records.JobRecord.from_json(job.to_json().encode()) == job
+    assert runner.plan_job(inspected(calls_service=False)).runs[0].plan.late_warning == 0.0
     assert runner.plan_job(inspected(main_launch=None, threshold_launch=None, threshold_run_value=None)) is None
     with pytest.raises(RecordError, match='main run, then the threshold run'):
         job.replaced(runs=list(reversed(job.runs)))
     with pytest.raises(RecordError, match='the threshold run with a plan of a main run'):
-        job.replaced(runs=[job.runs[0], dict(job.runs[1], plan=job.runs[0]['plan'])])
+        job.replaced(runs=[job.runs[0], dataclasses.replace(job.runs[1], plan=job.runs[0].plan)])
     with pytest.raises(RecordError, match='late_warning'):
-        job.replaced(runs=[dict(job.runs[0], plan=dict(job.runs[0]['plan'], late_warning=-1.0)), job.runs[1]])
+        job.replaced(runs=[dataclasses.replace(job.runs[0], plan=dataclasses.replace(job.runs[0].plan, late_warning=-1.0)),
+                           job.runs[1]])
     with pytest.raises(RecordError, match='no threshold run'):
         runner.plan_job(inspected(threshold_launch=None, threshold_run_value=None)).plan('threshold')
     # The judge's plan is the job's, field for field: what the runner made, nothing added on the way.
-    again = records.JobRecord.from_json(job.to_json().encode()).plan('threshold')
-    assert {key: getattr(again, key) for key in records.PLAN} == job.runs[1]['plan']
+    again = job_records.JobRecord.from_json(job.to_json().encode()).plan('threshold')
+    assert {key: getattr(again, key) for key in job_records.PLAN} == plain(job.runs[1].plan) and again == job.runs[1].plan
     # The session refuses a job that is not one, naming the field, and writes no record.
     bad = tmp_path / 'job.json'
     bad.write_text(json.dumps(dict(json.loads(job.to_json()), run_timeout='90')))

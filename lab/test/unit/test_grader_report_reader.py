@@ -8,6 +8,7 @@ import zipfile
 import pytest
 
 from exam_lab.grader.boxed import report_files, report_reader, report_text
+from exam_lab.grader.publish import proposals
 from exam_lab.grader.score.records import REPORT_UNSURE, RecordError, ReportRecord
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'data', 'reports')
@@ -157,12 +158,23 @@ def test_the_records_text_is_cleaned_of_escape_sequences():
 
 
 def test_a_kept_report_is_read_back_checked_or_said_not_read(tmp_path):
-    assert ReportRecord.kept(str(tmp_path)).why.startswith('no report.json kept')
+    assert proposals.kept_report(str(tmp_path)).why.startswith('no report.json kept')
     (tmp_path / 'report.json').write_text(ReportRecord.make(_record()).to_json())
-    assert ReportRecord.kept(str(tmp_path)).state == 'read'
+    assert proposals.kept_report(str(tmp_path)).state == 'read'
     (tmp_path / 'report.json').write_text('{"version": 1, "state": "read"}')
-    kept = ReportRecord.kept(str(tmp_path))
+    kept = proposals.kept_report(str(tmp_path))
     assert kept.state == 'not read' and 'not a record of the grader' in kept.why
+    # Read through the contract: a link to a good record is not followed, a FIFO is not waited on.
+    good = tmp_path / 'good.json'
+    good.write_text(ReportRecord.make(_record()).to_json())
+    for plant in ('link', 'fifo'):
+        (tmp_path / 'report.json').unlink()
+        if plant == 'link':
+            (tmp_path / 'report.json').symlink_to(good)
+        else:
+            os.mkfifo(str(tmp_path / 'report.json'))
+        kept = proposals.kept_report(str(tmp_path))
+        assert kept.state == 'not read' and 'not a record of the grader' in kept.why, (plant, kept.why)
 
 
 def test_an_underscore_is_told_from_a_space_by_its_ink():

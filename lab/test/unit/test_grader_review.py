@@ -265,7 +265,7 @@ def test_the_report_is_read_through_its_checked_record_as_make_rescore_reads_it(
     does not list) is shown "not read" with why and a note, never its text; a report.json that is a link
     is not read at all."""
     record = json.loads((out / 'ann' / 'report.json').read_text())
-    assert folder.report_record(str(out / 'ann'), 'ann', []) == ReportRecord.kept(str(out / 'ann')).value
+    assert folder.report_record(str(out / 'ann'), 'ann', []) == proposals.kept_report(str(out / 'ann')).value
     record['pages'][0]['file'] = 3
     record['pages'][0]['text'] = 'PLANTED TEXT'
     (out / 'ann' / 'report.json').write_text(json.dumps(record))

@@ -210,6 +210,46 @@ def test_the_trust_check_sees_root_importing_box_code(tmp_path, folder):
     assert '%s imports %s.boxed.archives' % (name, GRADER) in trust_violations(folder, {name: str(relative)})
 
 
+#: Where root (or the teacher's publish step) reads what it did not write in this process: only
+#: through the contract's reader (exam_lab.grader.contract.read_record), never a record type's own.
+CONTRACT_READERS = ROOT_SIDE + ('publish',)
+
+
+def own_record_reads(path):
+    """["<file>:<line> <Type>.<read|from_json>"] of every call in ``path`` of a record type's own reader
+    (``XRecord.read(...)``, ``XRecord.from_json(...)``): a file read past the contract."""
+    found = []
+    for node in nodes(path):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and \
+                node.func.attr in ('read', 'from_json'):
+            owner = node.func.value
+            name = owner.id if isinstance(owner, ast.Name) else owner.attr if isinstance(owner, ast.Attribute) else ''
+            if name.endswith('Record'):
+                found.append('%s:%d %s.%s' % (os.path.basename(path), node.lineno, name, node.func.attr))
+    return found
+
+
+@pytest.mark.parametrize('folder', CONTRACT_READERS + ('scripts',))
+def test_root_reads_records_only_through_the_contract(folder):
+    """Root's side, publish, and the lab's scripts (make grade, rescore, worksheet, review, check)."""
+    paths = glob.glob(os.path.join(REPO, 'lab', 'scripts', '*.py')) if folder == 'scripts' else \
+        [source_modules()[name] for name in grader_modules(folder)]
+    assert paths
+    offending = []
+    for path in paths:
+        offending += own_record_reads(path)
+    assert offending == []
+
+
+def test_the_contract_check_sees_a_record_read_past_it(tmp_path):
+    planted = tmp_path / 'planted.py'
+    planted.write_text('from exam_lab.grader.score import kept, records\n'
+                       'grade = kept.GradeRecord.read("OUT/ann/grade.json")\n'
+                       'job = records.JobRecord.from_json(open("job.json", "rb").read())\n'
+                       'text = open("notes.txt").read()\n')
+    assert own_record_reads(str(planted)) == ['planted.py:2 GradeRecord.read', 'planted.py:3 JobRecord.from_json']
+
+
 def test_the_trust_check_sees_a_forbidden_import_absolute_or_relative(tmp_path):
     # A planted module of boxed/ that imports root's side, both ways: the check must fail on each.
     planted = tmp_path / 'planted.py'

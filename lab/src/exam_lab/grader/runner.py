@@ -21,7 +21,7 @@ parses the student's bytes. So one grading runs as three kinds of processes:
 What crosses, and how:
 
   - down, into the box: the upload (bytes), and a job root computed from the inspection's record, once
-    (:func:`plan_job`: a :class:`~exam_lab.grader.score.records.JobRecord`, each run's plan in it, which
+    (:func:`plan_job`: a :class:`~exam_lab.grader.score.job.JobRecord`, each run's plan in it, which
     reaches the judge as it was made);
   - up, out of the box: one record per step (the inspection's, the session's
     :class:`~exam_lab.grader.score.records.SessionRecord`), each read through the contract (no link,
@@ -54,7 +54,9 @@ from exam_lab.grader.host.side_by_side import markers
 from exam_lab.grader.host.underlay import box_binds, default_underlay, ensure_underlay, package_path
 from exam_lab.grader.publish import grades, progress, teacher
 from exam_lab.grader.score import identity, records
+from exam_lab.grader.score.job import JobRecord
 from exam_lab.grader.score.records import Outcome
+from exam_lab.grader.score.schema import plain
 from exam_lab.grader.score.boxenv import BOX_WS, CODE_COPY
 from exam_lab.grader.score.sheets import DELAY, LATE_WARNING_S, SHEETS, margin_of
 from exam_lab.harness.supervisor import Supervisor, end_pids, marked
@@ -199,7 +201,7 @@ def inspect(box, work, upload, wanted_sheet, timeout=None):
 
 
 def plan_job(record):
-    """The session's job (a :class:`~exam_lab.grader.score.records.JobRecord`) from a checked inspection
+    """The session's job (a :class:`~exam_lab.grader.score.job.JobRecord`) from a checked inspection
     record: the runs' plans are computed here, from its numbers; the launch files stay relative to the
     workspace. None when there is nothing to run."""
     if record.main_launch is None:
@@ -215,7 +217,7 @@ def plan_job(record):
         # sheets.threshold_run_value), flown as the main run around it, with the main run's margin.
         runs.append({'tag': 'threshold', 'launch': record.threshold_launch,
                      'plan': dict(plan, kind='threshold', threshold=record.threshold_run_value)})
-    return records.JobRecord.make({'namespace': record.namespace, 'build_timeout': BUILD_TIMEOUT,
+    return JobRecord.make({'namespace': record.namespace, 'build_timeout': BUILD_TIMEOUT,
                                    'run_timeout': RUN_TIMEOUT, 'runs': runs, 'handed_in_launch': record.handed_in_launch})
 
 
@@ -266,14 +268,14 @@ def run_session(job, *, work, underlay, isolate, box, twin=None, on_step=None, l
     judge_home = os.path.join(work, 'judge')
     for folder in (log_dir, judge_home):
         os.makedirs(folder, mode=0o700, exist_ok=True)
-    runs = [dict(run, launch=os.path.join(box.workspace, run['launch'])) for run in job.runs]
+    runs = [dict(plain(run), launch=os.path.join(box.workspace, run.launch)) for run in job.runs]
     if twin is not None:
         os.makedirs(os.path.join(work, 'judge-twin'), mode=0o700, exist_ok=True)
         drawn = random.SystemRandom().randrange(2)
-        runs[drawn] = dict(runs[drawn], box=twin.describe(), judge_home=os.path.join(work, 'judge-twin'))
+        runs[drawn].update(box=twin.describe(), judge_home=os.path.join(work, 'judge-twin'))
     job = job.replaced(workspace=box.workspace, runs=runs, underlay=underlay, log_dir=log_dir, judge_home=judge_home,
                        box=box.describe(), budget=left, student_budget=STUDENT_BUDGET, side_by_side=twin is not None)
-    job_path = os.path.join(work, records.JobRecord.FILE)
+    job_path = os.path.join(work, JobRecord.FILE)
     with open(job_path, 'w') as f:
         f.write(job.to_json())
     argv = [sys.executable, '-m', 'exam_lab.grader.host.session', job_path]

@@ -24,6 +24,7 @@ import subprocess
 import sys
 import tempfile
 
+from exam_lab.grader import contract
 from exam_lab.grader.host.bwrap import can_isolate, network_namespace
 from exam_lab.grader.score.reference import ReferenceRecord, reference_file
 from exam_lab.grader.score.records import RecordError
@@ -111,14 +112,14 @@ def ensure(sheet, underlay, out=None, timeout=CAPTURE_TIMEOUT):
         digest = f.read().strip()[:16]
     cached = os.path.join(cache_dir, 'reference-%s-%s.json' % (sheet, digest))
     try:
-        record = ReferenceRecord.read(cached)
+        record = contract.read_record(cached, ReferenceRecord)
     except RecordError:
         record = None
     if record is None:
         record = captured(sheet, underlay, timeout)
-        _write(cached, record)
+        contract.write_record(cached, record)
     if out:
-        _write(os.path.join(out, reference_file(sheet)), record)
+        contract.write_record(os.path.join(out, reference_file(sheet)), record)
     return record
 
 
@@ -139,7 +140,7 @@ def captured(sheet, underlay, timeout=CAPTURE_TIMEOUT):
         if done.returncode != 0:
             raise RuntimeError('the reference outputs of %s could not be captured: %s' % (
                 SHEETS[sheet].drone_pkg, done.stdout.decode('utf-8', 'replace')[-2000:]))
-        return ReferenceRecord.read(target)
+        return contract.read_record(target, ReferenceRecord)
     finally:
         end_pids(marked(os.path.join(scratch, 'logs')))  # a capture stopped at its limit leaves no master behind
         shutil.rmtree(scratch, ignore_errors=True)
@@ -161,12 +162,6 @@ def keep_for(out, sheets, underlay=None):
     return lines
 
 
-def _write(path, record):
-    with open(path + '.part', 'w') as f:
-        f.write(record.to_json())
-    os.rename(path + '.part', path)
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--sheet', required=True, choices=sorted(SHEETS))
@@ -175,7 +170,7 @@ def main(argv=None):
     parser.add_argument('--scratch', required=True, help='a folder for the logs and question 9\'s package')
     args = parser.parse_args(argv)
     record = ReferenceRecord.make(capture(args.sheet, args.underlay, args.scratch))
-    _write(args.out, record)
+    contract.write_record(args.out, record)
     return 0
 
 

@@ -12,7 +12,9 @@ import time
 
 from exam_lab.grader.host.cgroups import memory_use, reset_memory_peak
 from exam_lab.grader.contract import read_capped, read_record, write_record
-from exam_lab.grader.score.records import MAX_ENDED, MAX_LOG_TEXT, JobRecord, ProbeRecord, RecordError
+from exam_lab.grader.score.job import JobRecord
+from exam_lab.grader.score.records import MAX_ENDED, MAX_LOG_TEXT, ProbeRecord, RecordError
+from exam_lab.grader.score.schema import plain
 from exam_lab.grader.score.runs import WATCHED_DEATHS
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.harness.supervisor import ros_env, workspace_env
@@ -136,10 +138,10 @@ def run_one(sup, job, run, base_env, box, budget):
     happened (the probe's result as read, when it ran, whether its master ended), which the rubric
     judges (:func:`~exam_lab.grader.score.runs.judged_run`), never the session. The probe is waited
     for at most the run's limit or what is left of the ``budget``. The judge's folder is the run's own
-    (``run['judge_home']``) when it has one, else the job's; the threshold run's judge reads the main
+    (``run.judge_home``) when it has one, else the job's; the threshold run's judge reads the main
     run's word there (:data:`MAIN_WORD`), once the session wrote it."""
-    tag = run['tag']
-    log_dir, judge_dir = sup.log_dir, run.get('judge_home') or job.judge_home
+    tag = run.tag
+    log_dir, judge_dir = sup.log_dir, job.judge_home_of(run)
     reset_memory_peak(box.judge_cgroups.get('master', []))
     killed_before = (memory_use(box.judge_cgroups.get('master', [])) or {}).get('oom_kills', 0)
     master = sup.start_master(name='master-%s' % tag, wrap=box.judge_argv([], 'master'),
@@ -148,13 +150,13 @@ def run_one(sup, job, run, base_env, box, budget):
     launch_env = ros_env(base_env, master.uri, os.path.join(box.home, 'ros-%s' % tag), ip='127.0.0.1')
     launch = sup.start('launch-%s' % tag, box.argv(
         ['bash', '-c', 'source "$1/devel/setup.bash" && exec roslaunch --screen "$2"', 'bash',
-         job.workspace, run['launch']], launch_env))
+         job.workspace, run.launch], launch_env))
     # The job as the session read it, for the judge to take its run's plan from, as it was made; the
     # plan in the log folder marks the flight's start for the progress and says what was flown.
-    job_path, plan = os.path.join(judge_dir, JobRecord.FILE), run['plan']
+    job_path = os.path.join(judge_dir, JobRecord.FILE)
     write_record(job_path, job)
     with open(os.path.join(log_dir, 'plan-%s.json' % tag), 'w') as f:
-        json.dump(plan, f, indent=1, sort_keys=True)
+        json.dump(plain(run.plan), f, indent=1, sort_keys=True)
     result_path, ended = os.path.join(judge_dir, 'probe-%s.json' % tag), os.path.join(judge_dir, LAUNCH_ENDED % tag)
     word = [os.path.join(judge_dir, MAIN_WORD)] if tag == 'threshold' else []
     probe_env = ros_env(master.env, master.uri, os.path.join(judge_dir, 'ros-probe-%s' % tag), ip='127.0.0.1')

@@ -109,16 +109,16 @@ class Box(object):
         self.rootless, self.owner, self.netns = False, None, None
 
     def describe(self):
-        """What the session needs to make this box's command lines (JSON): see :meth:`attached`."""
+        """What the session needs to make this box's command lines (a BoxPlace's JSON): see :meth:`attached`."""
         return {name: getattr(self, name) for name in ('work', 'bwrap', 'cpus', 'binds', 'name') + _OPENED}
 
     @classmethod
-    def attached(cls, described):
-        """The box :meth:`describe` described, opened by another process (the runner holds it)."""
-        box = cls(described['work'], described['binds'], described['bwrap'], described.get('cpus'),
-                  described.get('name', 'box'))
-        for name in _OPENED:
-            setattr(box, name, described.get(name, getattr(box, name)))
+    def attached(cls, place):
+        """The box :meth:`describe` described (a BoxPlace), opened by another process (the runner holds it)."""
+        box = cls(place.work, place.binds, place.bwrap, place.cpus, place.name or 'box')
+        box.slot, box.cgroups, box.rootless, box.owner, box.netns = place.slot, list(place.cgroups), place.rootless, \
+            place.owner, place.netns
+        box.judge_cgroups = {part: list(folders) for part, folders in place.judge_cgroups.items()}
         return box
 
     @property

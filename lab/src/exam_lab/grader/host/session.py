@@ -39,17 +39,20 @@ CPU time as ``<log_dir>/timings.json`` (:mod:`~exam_lab.grader.host.timings`). W
 (its result's times, the clock, the master) is the rubric's to say (:mod:`~exam_lab.grader.score.runs`),
 from these facts, again at each rescore.
 """
+import dataclasses
 import json
 import os
 import sys
 
+from exam_lab.grader import contract
 from exam_lab.grader.host import side_by_side as both
 from exam_lab.grader.host.run import (
     MAIN_WORD, MIN_RUN_S, RUN_STOP_S, STEP_STOP_S, Budget, base_environment, capped_log, judge_environment,
     run_one, tail)
 from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.host.timings import Stopwatch, boxes_cpu
-from exam_lab.grader.score.records import JobRecord, Outcome, RecordError, SessionRecord
+from exam_lab.grader.score.job import JobRecord
+from exam_lab.grader.score.records import Outcome, RecordError, SessionRecord
 from exam_lab.grader.score.runs import judged_run, warned_in_long_excursion
 from exam_lab.grader.score.safe_text import clean as clean_text
 from exam_lab.harness.supervisor import Supervisor
@@ -162,15 +165,15 @@ def one_after_the_other(sup, job, base_env, box, budget, result):
     WARNING as long as the main run's took (told before it starts, as a run flown beside it is told:
     :func:`~exam_lab.grader.host.side_by_side.tell_threshold_run`); into ``result``."""
     for run in job.runs:
-        run = {key: value for key, value in run.items() if key not in ('box', 'judge_home')}  # all in ``box``
-        if run['tag'] == 'threshold':
+        run = dataclasses.replace(run, box=None, judge_home=None)  # all in ``box``, the job's judge's
+        if run.tag == 'threshold':
             main = judged_run(result['runs'][0])['probe'] if result['runs'] else None
             if not warned_in_long_excursion(main):
                 result['threshold_skipped'] = 'the node never warned in the main run'
                 break
             both.tell_threshold_run(main, os.path.join(job.judge_home, MAIN_WORD), box.judge_uid)
         if budget.left(RUN_STOP_S) < MIN_RUN_S:
-            budget.spend('the %s run was not started (%.0f s left)' % (run['tag'], budget.left()))
+            budget.spend('the %s run was not started (%.0f s left)' % (run.tag, budget.left()))
             break
         result['runs'].append(run_one(sup, job, run, base_env, box, budget))
         result['survivors'] += result['runs'][-1]['survivors']
@@ -181,11 +184,11 @@ def main(argv):
         sys.stderr.write('usage: python3 -m exam_lab.grader.host.session JOB.json\n')
         return 2
     try:
-        job = JobRecord.read(argv[0])
+        job = contract.read_record(argv[0], JobRecord)
     except RecordError as err:  # the grader's own bug, as below
         sys.stderr.write('the job is not one: %s\n' % err)
         return 1
-    watch = Stopwatch(boxes_cpu(*[Box.attached(box) for box in [job.box] + [r['box'] for r in job.runs if r.get('box')]]))
+    watch = Stopwatch(boxes_cpu(*[Box.attached(box) for box in [job.box] + [r.box for r in job.runs if r.box]]))
     try:
         with watch.stage('session'):
             record = SessionRecord.make(session(job, argv[0], watch))

@@ -15,12 +15,14 @@ import shutil
 import subprocess
 import sys
 
+from exam_lab.grader import contract
 from exam_lab.grader.host import bwrap
 from exam_lab.grader.host.run import (
     MAIN_WORD, STEP_STOP_S, Budget, base_environment, judge_environment, probe_record, run_one, tail)
 from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.host.timings import Stopwatch, boxes_cpu
-from exam_lab.grader.score.records import JobRecord, RecordError
+from exam_lab.grader.score.job import JobRecord
+from exam_lab.grader.score.records import RecordError
 from exam_lab.grader.score.runs import judged_run, warned_in_long_excursion, warning_latency
 from exam_lab.harness.supervisor import Supervisor, end_pids, marked
 from exam_lab.harness.wait import wait_until
@@ -43,7 +45,7 @@ def copy_build(box, runs):
     box's uid runs any more), owned by the second box's uid; nothing of that box has run yet, so no link
     of its own can lie in the way. False when it could not be copied (the runs then fly one after the
     other, in ``box``)."""
-    twins = [run['box'] for run in runs if run.get('box')]
+    twins = [run.box for run in runs if run.box]
     if not twins or not box.bwrap:
         return False
     twin = Box.attached(twins[0])
@@ -75,18 +77,18 @@ def side_by_side(sup, job, job_path, budget, result):
     flies in the copy was drawn by the runner (:func:`~exam_lab.grader.runner.plan_job`): a node that
     tells the copy (its uid, its files' times) learns nothing of its run. Into ``result``."""
     main, threshold = job.runs
-    word = os.path.join(threshold.get('judge_home') or job.judge_home, MAIN_WORD)
-    main_result = os.path.join(main.get('judge_home') or job.judge_home, 'probe-main.json')
+    word = os.path.join(job.judge_home_of(threshold), MAIN_WORD)
+    main_result = os.path.join(job.judge_home_of(main), 'probe-main.json')
     started = {}
     for run in job.runs:
-        argv = [sys.executable, '-m', 'exam_lab.grader.host.side_by_side', job_path, run['tag'], '%.3f' % budget.left()]
-        started[run['tag']] = sup.start('run-%s' % run['tag'], bwrap.network_namespace(argv))
+        argv = [sys.executable, '-m', 'exam_lab.grader.host.side_by_side', job_path, run.tag, '%.3f' % budget.left()]
+        started[run.tag] = sup.start('run-%s' % run.tag, bwrap.network_namespace(argv))
     told = []
 
     def done():
         if not told and (os.path.isfile(main_result) or started['main'].poll() is not None):
             probe = probe_record(main_result)[0] if os.path.isfile(main_result) else None
-            tell_threshold_run(probe, word, Box.attached(threshold.get('box') or job.box).judge_uid)
+            tell_threshold_run(probe, word, Box.attached(job.box_of(threshold)).judge_uid)
             told.append(True)
         return all(proc.poll() is not None for proc in started.values())
 
@@ -136,14 +138,14 @@ def run_alone(job, tag, seconds):
     """The run ``tag`` of ``job`` in this process (started by :func:`side_by_side` in a network
     namespace of its own), within ``seconds``: its record in ``<log_dir>/run-<tag>.json``, its
     timings in ``<log_dir>/timings-<tag>.json``."""
-    run = next(r for r in job.runs if r['tag'] == tag)
-    box = Box.attached(run.get('box') or job.box)
+    run = job.run(tag)
+    box = Box.attached(job.box_of(run))
     watch = Stopwatch(boxes_cpu(box))
-    judge_home = run.get('judge_home') or job.judge_home
+    judge_home = job.judge_home_of(run)
     budget = Budget(seconds, job.student_budget)
     with watch.stage(tag):
         with Supervisor(job.log_dir, env=judge_environment(judge_home, box), marker=run_marker(job.log_dir, tag)) as sup:
-            record = run_one(sup, job, dict(run, judge_home=judge_home), base_environment(job), box, budget)
+            record = run_one(sup, job, run, base_environment(job), box, budget)
     with open(run_file(job.log_dir, tag) + '.part', 'w') as f:
         json.dump(record, f)
     os.rename(run_file(job.log_dir, tag) + '.part', run_file(job.log_dir, tag))
@@ -156,7 +158,7 @@ def main(argv):
         sys.stderr.write('usage: python3 -m exam_lab.grader.host.side_by_side JOB.json main|threshold SECONDS\n')
         return 2
     try:
-        job = JobRecord.read(argv[0])
+        job = contract.read_record(argv[0], JobRecord)
     except RecordError as err:  # the grader's own bug: the session says the run failed, and why
         sys.stderr.write('the job is not one: %s\n' % err)
         return 1

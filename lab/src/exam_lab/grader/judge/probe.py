@@ -10,8 +10,8 @@ sensor's next tick, as the real drone's reading does), driven by a script with n
 the oracle, so the same package gets the same measurements. The probe only
 measures; the points are given by :mod:`exam_lab.grader.score.rubric` from the JSON it writes.
 
-The plan is the run ``TAG``'s of the session's job (:class:`~exam_lab.grader.score.records.JobRecord`,
-:data:`~exam_lab.grader.score.records.PLAN`), as the runner made it: ``kind`` ("main": the whole
+The plan is the run ``TAG``'s of the session's job (:class:`~exam_lab.grader.score.job.JobRecord`,
+:data:`~exam_lab.grader.score.job.PLAN`), as the runner made it: ``kind`` ("main": the whole
 scenario, "threshold": the check of question 14a, the same scenario around the threshold drawn for
 it), ``sheet``, ``threshold`` (student units), ``margin`` (how far beyond the threshold to fly),
 ``delay`` (s), ``start_timeout`` (s to wait for the node once roslaunch is up), ``late_warning`` (s a
@@ -58,7 +58,8 @@ from exam_lab.grader.judge.pilot import Calibration, Flight, Inputs
 from exam_lab.grader.judge.graph import ClockWatch, Graph, NodeWatch, RefusedConnections, node_pid, node_uri
 from exam_lab.grader.judge.legs import AFTER_S, trace
 from exam_lab.grader.judge.node import NodeFinder
-from exam_lab.grader.score.records import JobRecord, RecordError
+from exam_lab.grader.score.job import JobRecord
+from exam_lab.grader.score.records import RecordError
 from exam_lab.harness.fake_drone import Drone
 
 

@@ -18,8 +18,10 @@ import io
 import json
 import os
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import cells
 from exam_lab.grader.score import answers, code_items, kept, records, safe_text
+from exam_lab.grader.score.records import ReportRecord
 from exam_lab.grader.score.reference import ReferenceRecord, facts, reference_file
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
@@ -32,24 +34,34 @@ MAX_EVIDENCE = 1500
 
 
 def read_reference(out, sheet):
-    """``(facts, why)``: the class's reference outputs for ``sheet`` (kept in OUT) as
-    :func:`~exam_lab.grader.score.reference.facts`, or ``(None, why not)``."""
+    """``(facts, why)``: the class's reference outputs for ``sheet`` (kept in OUT, read through the
+    contract) as :func:`~exam_lab.grader.score.reference.facts`, or ``(None, why not)``."""
     path = os.path.join(out, reference_file(sheet))
-    if not os.path.isfile(path):
+    if not contract.exists(path):
         return None, 'no %s in OUT (the drone was not run for the reference)' % reference_file(sheet)
     try:
-        return facts(ReferenceRecord.read(path)), None
+        return facts(contract.read_record(path, ReferenceRecord)), None
     except records.RecordError as err:
         return None, '%s is not a reference record: %s' % (reference_file(sheet), err)
 
 
+def kept_report(folder):
+    """The :class:`~exam_lab.grader.score.records.ReportRecord` kept in a student's ``folder`` of OUT,
+    read through the contract (capped, checked, no link followed, never waited on): what make rescore,
+    the proposals and the review page read, never the box again. A file missing or refused is a
+    report "not read" saying so (the student's report is then the teacher's to read)."""
+    path = os.path.join(folder, ReportRecord.FILE)
+    if not contract.exists(path):
+        return ReportRecord.not_read('no report.json kept (graded before reports were read: make grade again)')
+    try:
+        return contract.read_record(path, ReportRecord)
+    except records.RecordError as err:
+        return ReportRecord.not_read('the kept report.json is not a record of the grader: %s' % err)
+
+
 def read_report(folder):
-    """The report the run kept for one student (its ReportRecord's value; one "not read" saying why
-    when it is missing, refused, or the grader has no report reader)."""
-    record_type = getattr(records, 'ReportRecord', None)
-    if record_type is None:
-        return {'state': 'not read', 'why': 'this grader has no report reader'}
-    return record_type.kept(folder).value
+    """The report the run kept for one student (:func:`kept_report`'s value)."""
+    return kept_report(folder).value
 
 
 def report_text(folder):
@@ -58,12 +70,13 @@ def report_text(folder):
 
 
 def read_comments(folder):
-    """The code's ``comments`` as the inspection measured them (measurements.json's), or None."""
+    """The code's ``comments`` as the inspection measured them (measurements.json's, read through the
+    contract), or None."""
     path = os.path.join(folder, kept.MeasurementsRecord.FILE)
-    if not os.path.isfile(path):
+    if not contract.exists(path):
         return None
     try:
-        return kept.MeasurementsRecord.read(path).comments
+        return contract.read_record(path, kept.MeasurementsRecord).comments
     except records.RecordError:
         return None
 
@@ -84,16 +97,14 @@ def write(out, grade_records, single=False):
     rows, lines, references = [], [], {}
     states = {}
     for record in grade_records:
-        folder = out if single else os.path.join(out, record['student'])
         sheet = record.get('sheet') or 'altitude'
         if sheet not in references:
             references[sheet] = read_reference(out, sheet)
         try:
+            folder = out if single else contract.student_folder(out, record['student'])
             made = student_proposals(folder, sheet, references[sheet])
-            partial = os.path.join(folder, STUDENT_FILE + '.part')
-            with open(partial, 'w') as f:
-                json.dump(made, f, indent=1, sort_keys=True, ensure_ascii=False)
-            os.rename(partial, os.path.join(folder, STUDENT_FILE))
+            contract.write_text(os.path.join(folder, STUDENT_FILE),
+                                json.dumps(made, indent=1, sort_keys=True, ensure_ascii=False))
         except Exception as err:  # one student's bug: its rows say so, the class goes on
             why = safe_text.one_line('%s: %s' % (type(err).__name__, err))[:300]
             lines.append('%s: proposals not made (a grader bug, please report): %s' % (record['student'], why))
@@ -103,13 +114,12 @@ def write(out, grade_records, single=False):
             rows.append([record.get('participant'), record['student'], p['item'],
                          '' if p['points'] is None else _num(p['points']), _num(p['max']), p['state'],
                          p['evidence'][:MAX_EVIDENCE]])
-    partial = os.path.join(out, FILE + '.part')
-    with open(partial, 'w', newline='') as f:
-        writer = csv.writer(f)
-        writer.writerow(COLUMNS)
-        for row in rows:
-            writer.writerow(cells.row(row))
-    os.rename(partial, os.path.join(out, FILE))
+    table = io.StringIO(newline='')
+    writer = csv.writer(table)
+    writer.writerow(COLUMNS)
+    for row in rows:
+        writer.writerow(cells.row(row))
+    contract.write_text(os.path.join(out, FILE), table.getvalue())
     for sheet, (ref, why) in sorted(references.items()):
         if ref is None:
             lines.append('proposals of sheet %s: the answers were not compared with the drone: %s' % (sheet, why))

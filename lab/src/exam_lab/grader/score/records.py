@@ -9,7 +9,6 @@ that box, never data to use. What the grader keeps of a grading (its measurement
 records too: :mod:`exam_lab.grader.score.kept`.
 """
 import enum
-import os
 import re
 import typing
 from dataclasses import dataclass
@@ -18,7 +17,6 @@ from dataclasses import dataclass
 from exam_lab.grader.score.schema import (  # noqa: F401
     MAX_ITEMS, MAX_TEXT, DataRecord, Items, Map, Maybe, Number, OneOf, Optional, Record, RecordError, Row, Text, check,
     parse, relative, shown, write)
-from exam_lab.grader.score.fields import view
 from exam_lab.grader.score.sheets import SHEETS
 
 #: What a grading measured, kept beside grade.json by the runner (:class:`~exam_lab.grader.score.kept.MeasurementsRecord`,
@@ -201,7 +199,7 @@ _HIGHLIGHT = re.compile(r"<span class='highlight-(?:red|green)'>|</span>")
 #: A value the student's node published or the flight was computed from: any float (NaN, infinities).
 _VALUE = Number(finite=False)
 #: A ROS name (node, topic, service, type) as the master gave it: the student's node chose it.
-_NAME = Text(1000)
+NAME = Text(1000)
 #: A time (the wall clock's seconds, the judge's own).
 _TIME = Number()
 _COUNT = Number(0, 1e12, integer=True)
@@ -236,11 +234,11 @@ class ProbeRecord(Record):
         'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
         'margin': Number(), 'delay': Number(), 'start_timeout': Number(),
         'input_rates': Map(Text(100), Number(0, 1e6), 10),
-        'nodes': Optional([_NAME]), 'node_seen_s': Optional(Maybe(Number())), 'launch_seen_s': Optional(Maybe(Number())),
-        'subscribed': Optional(Map(_NAME, [_NAME], 10)),
-        'input_types': Optional(Map(_NAME, {'type': Maybe(_NAME), 'connected': bool, 'refused': Maybe(Text()),
-                                            'adapted': Maybe(_NAME), 'published': Optional(_NAME)}, 10)),
-        'output': Optional({'expected': _NAME, 'topic': Maybe(_NAME), 'type': Maybe(_NAME), 'candidates': [_NAME]}),
+        'nodes': Optional([NAME]), 'node_seen_s': Optional(Maybe(Number())), 'launch_seen_s': Optional(Maybe(Number())),
+        'subscribed': Optional(Map(NAME, [NAME], 10)),
+        'input_types': Optional(Map(NAME, {'type': Maybe(NAME), 'connected': bool, 'refused': Maybe(Text()),
+                                            'adapted': Maybe(NAME), 'published': Optional(NAME)}, 10)),
+        'output': Optional({'expected': NAME, 'topic': Maybe(NAME), 'type': Maybe(NAME), 'candidates': [NAME]}),
         # A probe of before issue 45 kept the last value of each row only: no 'before', 'changes', 'values'.
         'formula': Optional(Items({'inputs': Map(Text(100), _VALUE, 4), 'expected': _VALUE,
                                    'published': Maybe(_VALUE), 'samples': _COUNT,
@@ -257,80 +255,18 @@ class ProbeRecord(Record):
         'silent': Optional(bool),
         'rate': Optional({'samples': _COUNT, 'hz': Maybe(Number()), 'max_gap': Maybe(Number()),
                           'non_finite': Optional(_COUNT)}),
-        'node_watch': {'deaths': Items({'node': _NAME, 't': Maybe(_TIME), 'detail': Text()}, MAX_DEATHS),
-                       'nodes': [_NAME]},
+        'node_watch': {'deaths': Items({'node': NAME, 't': Maybe(_TIME), 'detail': Text()}, MAX_DEATHS),
+                       'nodes': [NAME]},
         'calls': Items(Row(_TIME, _REQUEST), MAX_CALLS),
         'answers': Items(Row(_TIME, _REQUEST, bool, _ANSWER), MAX_CALLS),
-        'graph': Map(_NAME, {'publishes': Items(Row(_NAME, _NAME)), 'subscribes': Items(Row(_NAME, _NAME)),
-                             'services': [_NAME]}),
+        'graph': Map(NAME, {'publishes': Items(Row(NAME, NAME)), 'subscribes': Items(Row(NAME, NAME)),
+                             'services': [NAME]}),
         'alive_at_end': bool, 't0': _TIME,
         'clock': {'use_sim_time': Items(Maybe((bool, _VALUE, Text())), 2), 'messages': _COUNT,
-                  'publishers': [_NAME], 'ros_time_is_wall': bool},
+                  'publishers': [NAME], 'ros_time_is_wall': bool},
         'judge_uid': Number(0, 2 ** 32, integer=True),
         'trace': {'published': Items(Row(_TIME, Maybe(_VALUE)), 100000), 'oracle': Items(Row(_TIME, _VALUE), 1000)},
     }
-
-
-#: A folder or file of the grader's machine (the session's work folders, the underlay).
-_PATH = Text(4096)
-
-
-#: One run's plan, the judge's orders (:mod:`exam_lab.grader.judge.probe`): the sheet, the threshold
-#: flown and its margin, the rule's delay, how long the node may take to start, the output topic
-#: expected, how long a late WARNING is waited for (``late_warning``; 0 when the code calls no
-#: service). Part of the job (:class:`JobRecord`), made once by :func:`exam_lab.grader.runner.plan_job`.
-PLAN = {
-    'kind': OneOf('main', 'threshold'), 'sheet': OneOf(*sorted(SHEETS)), 'threshold': Number(),
-    'margin': Number(0), 'delay': Number(0), 'start_timeout': Number(0), 'output': _NAME,
-    'late_warning': Number(0),
-}
-
-
-#: A box as the runner opened it, for the session to make its command lines
-#: (:meth:`exam_lab.grader.host.sandbox.Box.describe`).
-_BOX = {'work': _PATH, 'bwrap': bool, 'cpus': Maybe(Number(0, 4096)), 'binds': [_PATH],
-        'slot': Maybe(Number(0, 1e6, integer=True)), 'cgroups': [_PATH], 'judge_cgroups': Map(Text(50), [_PATH], 10),
-        'rootless': bool, 'owner': Maybe(Number(0, 2 ** 32, integer=True)), 'netns': Maybe(Text(200)),
-        'name': Optional(OneOf('box', 'box-twin'))}
-
-
-class JobRecord(Record):
-    """The session's job (``job.json``, read by :mod:`exam_lab.grader.host.session`): the runs (each its
-    tag, its launch file, its :data:`PLAN`), the student's namespace, the time limits, the launch file
-    as handed in (for roslaunch's check). :func:`~exam_lab.grader.runner.plan_job` makes it from the
-    inspection, the launch files relative to the workspace;
-    :func:`~exam_lab.grader.runner.run_session` adds where the session runs (``workspace``, the
-    ``underlay``, the folders, the ``box``) and the student's ``budget``, the launch files then absolute;
-    with ``side_by_side``, the two runs fly at once, the threshold run in a ``box`` and a ``judge_home``
-    of its own. The plans are made once, there, and go down to the judge as they are, in the job
-    (:meth:`plan`): nothing on the way changes them. What the threshold run learns of the main run
-    (how late its WARNING came) is the main run's word, not its plan
-    (:class:`~exam_lab.grader.judge.probe.MainWord`)."""
-    FILE = 'job.json'
-    MAX_BYTES = 1 << 20
-    SCHEMA = {
-        'namespace': Text(1000), 'build_timeout': Number(0), 'run_timeout': Number(0),
-        'runs': Items({'tag': OneOf('main', 'threshold'), 'launch': _PATH, 'plan': PLAN,
-                       'box': Optional(_BOX), 'judge_home': Optional(_PATH)}, 2),
-        'handed_in_launch': Maybe(_PATH), 'side_by_side': Optional(bool),
-        'workspace': Optional(_PATH), 'underlay': Optional(_PATH), 'log_dir': Optional(_PATH),
-        'judge_home': Optional(_PATH), 'box': Optional(_BOX), 'budget': Optional(Number()),
-        'student_budget': Optional(Number(0)),
-    }
-
-    def validate(self):
-        if [run['tag'] for run in self.runs] not in (['main'], ['main', 'threshold']):
-            raise RecordError('job.json.runs: the main run, then the threshold run if any')
-        for run in self.runs:
-            if run['plan']['kind'] != run['tag']:
-                raise RecordError('job.json.runs: the %s run with a plan of a %s run' % (run['tag'], run['plan']['kind']))
-
-    def plan(self, tag):
-        """The plan of the run ``tag``, read by attributes (``plan.threshold``): the judge's orders."""
-        for run in self.runs:
-            if run['tag'] == tag:
-                return view(run['plan'], PLAN)
-        raise RecordError('job.json.runs: no %s run' % tag)
 
 
 class Outcome(str, enum.Enum):
@@ -376,7 +312,7 @@ _RUN = {
     # by its session (probe_refused, refused_probe).
     'probe_wall': Optional(Row(_TIME, _TIME)),
     'probe_uid': Optional(Maybe(Number(0, 2 ** 32, integer=True))),
-    'launch': {'ended': Items({'node': _NAME, 'how': OneOf('died', 'finished cleanly'), 'detail': Text()}, MAX_ENDED),
+    'launch': {'ended': Items({'node': NAME, 'how': OneOf('died', 'finished cleanly'), 'detail': Text()}, MAX_ENDED),
                'not_started': Items(Text(), 50), 'tail': Text(MAX_LOG_TEXT)},
     'launch_running': Optional(bool), 'seconds': Optional(Number(0)), 'budget': Optional(Text()),
     'survivors': Optional(_COUNT),
@@ -401,7 +337,7 @@ class SessionRecord(Record):
         'survivors': Optional(_COUNT),
         'launch_check': Optional(Maybe({'file': Text(4096), 'status': Maybe(Number(-1e6, 1e6, integer=True)),
                                         'refused': Text(MAX_LOG_TEXT), 'warnings': Items(Text(), 20),
-                                        'nodes': Items(_NAME, 20)})),
+                                        'nodes': Items(NAME, 20)})),
         'budget_used': Optional(Maybe(Text())), 'error': Optional(Text(MAX_LOG_TEXT)),
         'threshold_skipped': Optional(Text()), 'refused': Optional(bool), 'no_node': Optional(bool),
     }
@@ -485,16 +421,3 @@ class ReportRecord(Record):
         """The record of a report that was not read, and why (one sentence)."""
         return cls.make({'version': REPORT_VERSION, 'state': 'not read', 'why': why, 'files': list(files),
                          'pages': [], 'notes': list(notes), 'seconds': seconds})
-
-    @classmethod
-    def kept(cls, folder):
-        """The report.json kept in a student's ``folder`` of OUT, read as a box's record is (capped,
-        checked): what make rescore and the proposals read, never the box again. A file missing or
-        refused is a report "not read" saying so (the student's report is then the teacher's to read)."""
-        path = os.path.join(folder, cls.FILE)
-        if not os.path.isfile(path):
-            return cls.not_read('no report.json kept (graded before reports were read: make grade again)')
-        try:
-            return cls.read(path)
-        except RecordError as err:
-            return cls.not_read('the kept report.json is not a record of the grader: %s' % err)

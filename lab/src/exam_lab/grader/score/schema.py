@@ -8,11 +8,13 @@ most ``n`` characters), :class:`Number` (finite, within bounds), ``[schema]`` (a
 (None or the schema), :class:`OneOf` (one of fixed values), :class:`Map` (an object whose keys are data),
 :class:`Row` (a list of fixed length, each item its own schema), a tuple of schemas (any one of them).
 """
+import collections.abc
 import dataclasses
 import json
 import math
 import os
 import re
+import types
 import typing
 
 from exam_lab.grader.score.safe_text import cleaned
@@ -298,9 +300,11 @@ class _Readable(object):
 
     @classmethod
     def read(cls, path):
-        """The record in the file ``path``, one the grader wrote itself (kept in OUT; for a box's, root
-        uses :func:`exam_lab.grader.contract.read_record`): read up to ``MAX_BYTES``, then as
-        :meth:`from_json`; raises :class:`RecordError` naming the file when it cannot be read."""
+        """The record in the file ``path``, for a reader that is not root (the judge reads its job) and
+        for the tests: read up to ``MAX_BYTES``, then as :meth:`from_json`; raises :class:`RecordError`
+        naming the file when it cannot be read. Root reads every file it did not write in this process
+        (a box's, the judge's, one kept in OUT) through :func:`exam_lab.grader.contract.read_record`
+        (no link, regular files only, never waited on): test_layers holds it to that."""
         try:
             with open(path, 'rb') as f:
                 raw = f.read(cls.MAX_BYTES + 1)
@@ -346,12 +350,18 @@ class DataRecord(_Readable):
     @property
     def value(self):
         """The record as JSON data: what :meth:`make` reads back."""
-        return _plain(self)
+        return plain(self)
+
+    def replaced(self, **changes):
+        """A new record of this type: this one's fields with ``changes`` (JSON data or the fields'
+        own types), checked as :meth:`make` checks (``dataclasses.replace``, checked)."""
+        return self.make(dict(self.value, **{key: plain(value) for key, value in changes.items()}))
 
 
 def _built(hint, value):
     """The checked JSON ``value`` as a field of the type ``hint`` holds it: an object its dataclass
-    (``Optional[X]`` an X or None), a list a tuple (``Tuple[X, ...]`` of X)."""
+    (``Optional[X]`` an X or None), a list a tuple (``Tuple[X, ...]`` of X), an object whose keys
+    are data (``Mapping[str, X]``) a read-only mapping of X."""
     origin, args = getattr(hint, '__origin__', None), getattr(hint, '__args__', ())
     if value is None:
         return None
@@ -362,16 +372,21 @@ def _built(hint, value):
         return hint(**{key: _built(hints[key], inner) for key, inner in value.items()})
     if origin is tuple or hint is tuple:
         return tuple(_built(args[0] if args[-1:] == (Ellipsis,) else None, item) for item in value)
+    if origin in (collections.abc.Mapping, dict):
+        return types.MappingProxyType({key: _built(args[1] if args else None, inner) for key, inner in value.items()})
     return value
 
 
-def _plain(value):
-    """JSON data of a frozen dataclass record or of one of its fields (a tuple a list)."""
+def plain(value):
+    """JSON data of a frozen dataclass record or of one of its fields (a tuple a list, a mapping an
+    object); JSON data stays as it is."""
     if dataclasses.is_dataclass(value):
-        return {field.name: _plain(getattr(value, field.name)) for field in dataclasses.fields(value)
+        return {field.name: plain(getattr(value, field.name)) for field in dataclasses.fields(value)
                 if not (field.default is None and getattr(value, field.name) is None)}
-    if isinstance(value, tuple):
-        return [_plain(item) for item in value]
+    if isinstance(value, (tuple, list)):
+        return [plain(item) for item in value]
+    if isinstance(value, collections.abc.Mapping):
+        return {key: plain(inner) for key, inner in value.items()}
     return value
 
 

@@ -4,25 +4,24 @@ proposals, its report's record and page images, its code. No rospy.
 Every file here is the grader's own output, but what is in it came from a student: the text of a
 report, the names of files, the code itself. So each is read as data, capped, each field checked for
 its type and cleaned (:mod:`~exam_lab.grader.score.safe_text`) before the page shows it; and nothing
-is read through a link: :func:`read_inside` opens each component of the path below the student's
-folder without following one (``O_NOFOLLOW``), so a link planted among the copies of a student's files
+is read through a link: :func:`read_inside` reads by the contract's one reader, which opens each
+component of the path below the student's folder without following one, so a link planted among the copies of a student's files
 (``code/notes -> /etc``) is never read, and a path with ``..`` is refused before anything is opened.
 
 The report is read as make rescore and the proposals read it, through its record
-(:meth:`~exam_lab.grader.score.records.ReportRecord.kept`: capped, checked against its schema, a record
-that is none said as a report "not read"); proposals.csv through the proposals' own reader
+(:func:`~exam_lab.grader.publish.proposals.kept_report`, through the contract: capped, checked
+against its schema, a record that is none said as a report "not read"); proposals.csv through the proposals' own reader
 (:func:`~exam_lab.grader.publish.proposals.rows`), each of its rows and of proposals.json checked field by
 field again (a field of another type is dropped, with a note): the page trusts no file of OUT.
 """
 import collections
 import json
 import os
-import stat
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import grades
 from exam_lab.grader.publish import hand, proposals as proposals_csv
 from exam_lab.grader.score import safe_text
-from exam_lab.grader.score.records import ReportRecord
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
 PROPOSALS_CSV = 'proposals.csv'
@@ -58,40 +57,15 @@ class Refused(Exception):
 
 
 def read_inside(base, relative, cap):
-    """The bytes of ``base/relative``, never through a link nor outside ``base``; Refused otherwise
-    (and for a file over ``cap`` bytes, or not a regular file)."""
+    """The bytes of ``base/relative``, read by the contract's one reader (never through a link nor
+    outside ``base``, a regular file only, at most ``cap`` bytes); Refused otherwise."""
     parts = relative.replace('\\', '/').split('/')
     if not relative or relative.startswith('/') or any(p in ('', '.', '..') for p in parts) or '\0' in relative:
         raise Refused('%r is no path inside the student\'s folder' % relative)
-    flags = os.O_RDONLY | getattr(os, 'O_NOFOLLOW', 0) | getattr(os, 'O_CLOEXEC', 0)
     try:
-        fd = os.open(base, flags | os.O_DIRECTORY)
-    except OSError as err:
-        raise Refused('%s: %s' % (relative, err.strerror))
-    try:
-        for part in parts[:-1]:
-            try:
-                inner = os.open(part, flags | os.O_DIRECTORY, dir_fd=fd)
-            except OSError as err:
-                raise Refused('%s: %s (a folder, not a link)' % (relative, err.strerror))
-            os.close(fd)
-            fd = inner
-        try:
-            leaf = os.open(parts[-1], flags | getattr(os, 'O_NONBLOCK', 0), dir_fd=fd)
-        except OSError as err:
-            raise Refused('%s: %s (a file, not a link)' % (relative, err.strerror))
-    finally:
-        os.close(fd)
-    with os.fdopen(leaf, 'rb') as f:
-        info = os.fstat(f.fileno())
-        if not stat.S_ISREG(info.st_mode):
-            raise Refused('%s is not a file' % relative)
-        if info.st_size > cap:
-            raise Refused('%s: %d bytes, over the page\'s %d' % (relative, info.st_size, cap))
-        data = f.read(cap + 1)
-    if len(data) > cap:
-        raise Refused('%s: over the page\'s %d bytes' % (relative, cap))
-    return data
+        return contract.read_bytes(os.path.join(base, *parts), cap, under=base)
+    except contract.ContractError as err:
+        raise Refused(str(err))
 
 
 def _text(value, cap):
@@ -187,7 +161,7 @@ def report_record(folder, name, notes):
         read_inside(folder, REPORT_JSON, RECORD_CAP)  # no link, no folder, under the cap
     except Refused:
         return None
-    record = ReportRecord.kept(folder).value
+    record = proposals_csv.kept_report(folder).value
     if record['state'] == 'not read' and record['why'].startswith('the kept report.json is not'):
         notes.append('%s/%s: %s' % (name, REPORT_JSON, record['why']))
     for page in record['pages']:
