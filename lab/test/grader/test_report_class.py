@@ -92,8 +92,8 @@ def test_make_grade_writes_the_proposals_the_reports_and_their_copies(small_clas
         record = proposals.kept_report(str(folder))
         assert record.state == 'read', (name, record.why)
         assert json.loads((folder / 'report.json').read_text())['state'] == 'read'
-        assert record.pages[0]['source'] == ('ocr' if name == 'Bob Scan' else 'text'), (name, record.pages[0])
-        copies = [f['copy'] for f in record.files]
+        assert record.pages[0].source == ('ocr' if name == 'Bob Scan' else 'text'), (name, record.pages[0])
+        copies = [f.copy for f in record.files]
         assert copies and all(c and (folder / c).is_file() for c in copies), (name, record.files)
         assert writable(str(folder / 'report')) == [], name
         assert (folder / 'code').is_dir() == package, name

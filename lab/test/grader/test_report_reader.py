@@ -14,6 +14,7 @@ import pytest
 
 from exam_lab.grader import class_run
 from exam_lab.grader.host import reports
+from exam_lab.grader.publish import proposals
 from exam_lab.grader.score.records import ReportRecord
 
 HERE = os.path.dirname(os.path.realpath(__file__))
@@ -36,15 +37,15 @@ def read(tmp_path, *names, folder='Jeanne Martin_12_assignsubmission_file_'):
 def page_with(record, words, source):
     """The page holding every one of ``words`` (its number), read from ``source``."""
     for page in record.pages:
-        if all(w in page['text'] for w in words):
-            assert page['source'] == source, (page['number'], page['source'])
+        if all(w in page.text for w in words):
+            assert page.source == source, (page.number, page.source)
             return page
-    raise AssertionError('%s on no page:\n%s' % (words, '\n----\n'.join(p['text'] for p in record.pages)))
+    raise AssertionError('%s on no page:\n%s' % (words, '\n----\n'.join(p.text for p in record.pages)))
 
 
 def assert_kept(record, out):
     """Every file and page image the record names is in OUT/report/, read-only, a page a PNG."""
-    for path in [f['copy'] for f in record.files] + [p['image'] for p in record.pages]:
+    for path in [f.copy for f in record.files] + [p.image for p in record.pages]:
         assert path is not None
         full = os.path.join(str(out), path)
         assert not os.stat(full).st_mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH)
@@ -56,12 +57,12 @@ def assert_kept(record, out):
 def test_a_libreoffice_pdf_is_read_from_its_text_layer_and_its_screenshots_by_ocr(tmp_path):
     record, out = read(tmp_path, 'fr_odt.pdf')
     assert record.state == 'read' and record.why == ''
-    assert [(f['kind'], f['converted'], f['pages'], f['state']) for f in record.files] == [('pdf', False, 2, 'read')]
+    assert [(f.kind, f.converted, f.pages, f.state) for f in record.files] == [('pdf', False, 2, 'read')]
     first = page_with(record, ['Question 4', '$ rosnode list', '/mydrone', 'Deux nœuds tournent'], 'text')
-    assert first['number'] == 1 and first['confidence'] is None and first['pictures'] == 0
+    assert first.number == 1 and first.confidence is None and first.pictures == 0
     second = page_with(record, ['Question 7', 'float32 data', 'average rate: 0.778'], 'text')
-    assert second['number'] == 2 and second['pictures'] == 2 and second['confidence'] > 80
-    text = second['text']
+    assert second.number == 2 and second.pictures == 2 and second.confidence > 80
+    text = second.text
     # the screenshots' words, where the screenshots stand: Q7's type before its comment, Q8's rate after its echo
     assert text.index('[picture 1, OCR]') < text.index('rosmsg info std_msgs/Float32') < text.index('Le message est du type')
     assert text.index('data: ') < text.index('[picture 2, OCR]') < text.index('average rate: 0.778') < \
@@ -73,22 +74,22 @@ def test_a_libreoffice_pdf_is_read_from_its_text_layer_and_its_screenshots_by_oc
 def test_a_word_document_with_its_answers_in_a_table_is_read(tmp_path, name, converted):
     record, out = read(tmp_path, name, folder='John Smith_13_assignsubmission_file_')
     assert record.state == 'read'
-    assert [(f['kind'], f['converted'], f['state']) for f in record.files] == \
+    assert [(f.kind, f.converted, f.state) for f in record.files] == \
         [(name.rsplit('.', 1)[1], converted, 'read')]
     # each cell's text on lines of its own, as the cell wraps it
     q7 = page_with(record, ['Q7', 'std_msgs/Float32', 'float32 data', 'The type is', 'one field'], 'text')
-    assert 'Q7' in q7['layout'] and 'float32 data' in q7['layout']
+    assert 'Q7' in q7.layout and 'float32 data' in q7.layout
     # the table's columns side by side in the layout text: the question, its command, its output
-    assert any('Q4' in line and 'rosnode list' in line for line in q7['layout'].splitlines())
+    assert any('Q4' in line and 'rosnode list' in line for line in q7.layout.splitlines())
     remote = page_with(record, ['[picture 1, OCR]', 'rostopic echo -n 3 /pressure_remote',
                                 'subscribed to [/pressure_remote]', 'average rate: 1.0'], 'text')
-    assert remote['pictures'] == 1
+    assert remote.pictures == 1
     assert_kept(record, out)
 
 
 def test_an_odt_handed_in_is_converted_in_the_box(tmp_path):
     record, _ = read(tmp_path, 'fr_odt.odt')
-    assert [(f['kind'], f['converted'], f['pages']) for f in record.files] == [('odt', True, 2)]
+    assert [(f.kind, f.converted, f.pages) for f in record.files] == [('odt', True, 2)]
     page_with(record, ['Question 9', 'catkin_create_pkg exam rospy std_msgs mydrone'], 'text')
 
 
@@ -114,21 +115,21 @@ def test_libreoffice_starts_once_from_the_readers_profile_without_its_graphics_t
 
 def test_an_image_only_scan_is_read_by_ocr_with_its_confidence(tmp_path):
     record, out = read(tmp_path, 'scan.pdf')
-    assert record.state == 'read' and [p['source'] for p in record.pages] == ['ocr', 'ocr']
-    assert all(p['layout'] == '' and 50 < p['confidence'] <= 100 for p in record.pages)
+    assert record.state == 'read' and [p.source for p in record.pages] == ['ocr', 'ocr']
+    assert all(p.layout == '' and 50 < p.confidence <= 100 for p in record.pages)
     page_with(record, ['Question 4', 'rosnode list', '/mydrone', '/rosout'], 'ocr')
     page_with(record, ['Question 8', 'float32 data', '0.778'], 'ocr')
-    assert all(isinstance(w, str) for p in record.pages for w in p['unsure'])
+    assert all(isinstance(w, str) for p in record.pages for w in p.unsure)
     assert_kept(record, out)
 
 
 def test_a_screenshot_handed_in_is_read_by_ocr(tmp_path):
     record, _ = read(tmp_path, 'screenshot_rosnode_list.png')
-    assert [(f['kind'], f['state']) for f in record.files] == [('image', 'read')]
+    assert [(f.kind, f.state) for f in record.files] == [('image', 'read')]
     page = page_with(record, ['/mydrone', '/rosout_agg', '/temperature', 'rostopic list'], 'ocr')
     # tesseract reads this screenshot's first command "rosnode List" (its case is the proposals' to ignore)
-    assert 'rosnode list' in page['text'].lower()
-    assert page['image'] == 'report/page-1-1.png' and page['confidence'] > 70
+    assert 'rosnode list' in page.text.lower()
+    assert page.image == 'report/page-1-1.png' and page.confidence > 70
 
 
 @pytest.mark.parametrize('name,why', [
@@ -139,16 +140,16 @@ def test_a_screenshot_handed_in_is_read_by_ocr(tmp_path):
 ])
 def test_a_report_that_cannot_be_read_is_not_read_with_why(tmp_path, name, why):
     record, out = read(tmp_path, name)
-    assert record.state == 'not read' and record.pages == []
+    assert record.state == 'not read' and record.pages == ()
     assert record.why.startswith(why), record.why
-    assert record.files[0]['state'] == 'not read' and record.files[0]['note'] == record.why
-    assert os.path.isfile(os.path.join(str(out), record.files[0]['copy']))  # kept for the teacher all the same
+    assert record.files[0].state == 'not read' and record.files[0].note == record.why
+    assert os.path.isfile(os.path.join(str(out), record.files[0].copy))  # kept for the teacher all the same
 
 
 def test_one_file_not_read_leaves_the_others_read(tmp_path):
     record, _ = read(tmp_path, 'encrypted.pdf', 'fr_odt.pdf')
-    assert record.state == 'read' and [f['state'] for f in record.files] == ['not read', 'read']
-    assert {p['file'] for p in record.pages} == {1}
+    assert record.state == 'read' and [f.state for f in record.files] == ['not read', 'read']
+    assert {p.file for p in record.pages} == {1}
 
 
 def test_no_report_handed_in_is_said(tmp_path):
@@ -166,7 +167,7 @@ def test_the_report_inside_the_package_zip_is_read(tmp_path):
         zf.write(os.path.join(DATA, 'fr_odt.pdf'), 'exam/rapport.pdf')
         zf.writestr('exam/package.xml', '<package><name>exam</name></package>')
     record = reports.read_report(str(folder), str(tmp_path / 'out'))
-    assert [f['name'] for f in record.files] == ['exam.zip/exam/rapport.pdf']
+    assert [f.name for f in record.files] == ['exam.zip/exam/rapport.pdf']
     page_with(record, ['Question 4', '/mydrone'], 'text')
 
 

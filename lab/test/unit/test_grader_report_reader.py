@@ -139,7 +139,7 @@ def _record(**changes):
 
 
 def test_the_report_record_is_checked_across_its_fields():
-    assert ReportRecord.make(_record()).pages[0]['text'] == 'x'
+    assert ReportRecord.make(_record()).pages[0].text == 'x'
     assert ReportRecord.not_read('report.pdf: an encrypted PDF').state == 'not read'
     for bad, why in ((_record(state='not read'), 'state not read with 1 page'),
                      (_record(why='encrypted'), 'state read with a why'),
@@ -154,7 +154,7 @@ def test_the_report_record_is_checked_across_its_fields():
 
 def test_the_records_text_is_cleaned_of_escape_sequences():
     record = ReportRecord.make(_record(pages=[_page(text='rate: 0.778\x1b[2J\x1b]0;owned\x07 Hz')]))
-    assert record.pages[0]['text'] == 'rate: 0.778 Hz'
+    assert record.pages[0].text == 'rate: 0.778 Hz'
 
 
 def test_a_kept_report_is_read_back_checked_or_said_not_read(tmp_path):

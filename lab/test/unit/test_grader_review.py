@@ -59,9 +59,9 @@ def boxes(tmp_path_factory):
         record = ReportRecord.read(os.path.join(KEPT, 'report-' + fixture, ReportRecord.FILE))
         where = str(root / fixture)
         os.makedirs(os.path.join(where, 'report'))
-        (copy,) = [f['copy'] for f in record.files]
+        (copy,) = [f.copy for f in record.files]
         shutil.copyfile(os.path.join(REPORTS, fixture + '.pdf'), os.path.join(where, copy))
-        for number, image in [(p['number'], p['image']) for p in record.pages]:
+        for number, image in [(p.number, p.image) for p in record.pages]:
             prefix = os.path.join(where, 'page')
             subprocess.run(['pdftoppm'] + PREVIEW + ['-singlefile', '-f', str(number), '-l', str(number),
                                                     os.path.join(where, copy), prefix], check=True)
@@ -224,6 +224,24 @@ def test_review_json_that_is_not_the_pages_is_never_written_over(tmp_path):
     path = tmp_path / decisions.FILE
     path.write_text('{"cells": []}')
     with pytest.raises(decisions.ReviewError):
+        decisions.load(str(path))
+
+
+def test_review_json_is_read_and_written_by_the_contract_never_through_a_link(tmp_path):
+    """A review.json that is a link (to a review of the page's own shape) or a FIFO is refused, never
+    followed nor waited on; saving replaces a link planted in its place, never writes through it."""
+    elsewhere = tmp_path / 'elsewhere.json'
+    elsewhere.write_text(json.dumps(decisions.empty()))
+    path = tmp_path / decisions.FILE
+    path.symlink_to(elsewhere)
+    with pytest.raises(decisions.ReviewError, match='not read'):
+        decisions.load(str(path))
+    decisions.save(str(path), dict(decisions.empty(), history=[{'planted': False}]))
+    assert not path.is_symlink() and json.loads(elsewhere.read_text()) == decisions.empty()
+    assert decisions.load(str(path))['history'] == [{'planted': False}]
+    path.unlink()
+    os.mkfifo(str(path))
+    with pytest.raises(decisions.ReviewError, match='not a regular file'):
         decisions.load(str(path))
 
 

@@ -84,6 +84,14 @@ def test_the_stopwatch_times_each_stage_wall_and_cpu(tmp_path):
     watch.write(str(tmp_path))
     assert timings.read(str(tmp_path)) == dict(watch.value())
     assert timings.read(str(tmp_path / 'none')) == {}
+    # Read and written by the contract: a link in its place is replaced, never written through nor read.
+    (tmp_path / 'logs').mkdir()
+    (tmp_path / 'elsewhere.json').write_text('{"planted": true}')
+    (tmp_path / 'logs' / timings.FILE).symlink_to(tmp_path / 'elsewhere.json')
+    assert timings.read(str(tmp_path / 'logs')) == {}
+    watch.write(str(tmp_path / 'logs'))
+    assert (tmp_path / 'elsewhere.json').read_text() == '{"planted": true}'
+    assert timings.read(str(tmp_path / 'logs')) == dict(watch.value())
 
 
 def test_a_cgroups_cpu_is_read_from_either_version(tmp_path):

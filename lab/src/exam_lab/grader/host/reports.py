@@ -13,6 +13,7 @@ box's uid, without network, within :data:`REPORT_BOUNDS`), reads back one capped
 read-only. Whatever happens to one report (a bomb, a crash of the box, its bounds), it is that
 student's report "not read" with why: never the grade's stop, never the class's.
 """
+import dataclasses
 import os
 import shutil
 import stat
@@ -116,9 +117,9 @@ def keep_copies(record, box_out, out_dir):
         budget[0] -= len(data)
         contract.write_bytes(os.path.join(target, name), data, mode=0o444)
         return path
-    files = [dict(f, copy=take(f['copy'], False)) for f in record.files]
-    pages = [dict(p, image=take(p['image'], True)) for p in record.pages]
-    return record.replaced(files=files, pages=pages, notes=list(record.notes) + notes)
+    files = [dataclasses.replace(f, copy=take(f.copy, False)) for f in record.files]
+    pages = [dataclasses.replace(p, image=take(p.image, True)) for p in record.pages]
+    return record.replaced(files=files, pages=pages, notes=record.notes + tuple(notes))
 
 
 def keep_code(source, out_dir):

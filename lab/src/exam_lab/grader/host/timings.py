@@ -14,9 +14,12 @@ import os
 import resource
 import time
 
+from exam_lab.grader import contract
 from exam_lab.grader.host.cgroups import cpu_use
 
 FILE = 'timings.json'
+#: Most bytes of a timings.json read back (a few stages and their numbers: a few kB)
+MAX_BYTES = 1 << 20
 
 
 def process_cpu():
@@ -66,18 +69,16 @@ class Stopwatch(object):
         return dict(self.extra, stages=self.stages)
 
     def write(self, folder):
-        """``<folder>/timings.json``, written whole (a reader never sees half of it)."""
-        path = os.path.join(folder, FILE)
-        with open(path + '.part', 'w') as f:
-            json.dump(self.value(), f, indent=1, sort_keys=True)
-        os.rename(path + '.part', path)
+        """``<folder>/timings.json``, written whole by the contract's writer (a reader never sees half of
+        it; in OUT, never through an entry there)."""
+        contract.write_text(os.path.join(folder, FILE), json.dumps(self.value(), indent=1, sort_keys=True))
 
 
 def read(folder):
-    """The timings a grading wrote in ``folder`` (its own file, never a box's), or {}."""
+    """The timings a grading's session wrote in ``folder`` (its own file, never a box's), read through
+    the contract, or {}."""
     try:
-        with open(os.path.join(folder, FILE)) as f:
-            value = json.load(f)
+        value = json.loads(contract.read_text(os.path.join(folder, FILE), MAX_BYTES))
         return value if isinstance(value, dict) else {}
-    except (OSError, ValueError):
+    except (contract.ContractError, ValueError):
         return {}

@@ -364,7 +364,34 @@ _REPORT_TEXT = Text(REPORT_PAGE_TEXT)
 _REPORT_NAME = re.compile(r'^[A-Za-z0-9][A-Za-z0-9._ -]{0,199}$')
 
 
-class ReportRecord(Record):
+@dataclass(frozen=True)
+class ReportFile(object):
+    """A file handed in as a report (see :class:`ReportRecord`)."""
+    name: str
+    kind: str
+    converted: bool
+    pages: int
+    note: str
+    state: str
+    copy: typing.Optional[str]
+
+
+@dataclass(frozen=True)
+class ReportPage(object):
+    """A page read of a report (see :class:`ReportRecord`)."""
+    file: int
+    number: int
+    source: str
+    text: str
+    layout: str
+    confidence: typing.Optional[float]
+    unsure: typing.Tuple[str, ...]
+    pictures: int
+    image: typing.Optional[str]
+
+
+@dataclass(frozen=True)
+class ReportRecord(DataRecord):
     """A student's report as read in a box (:mod:`exam_lab.grader.boxed.report_reader`,
     ``report.json``; root reads it back with :func:`exam_lab.grader.host.reports.read_report` and keeps
     it as ``OUT/<student>/report.json``; make rescore reads the kept one again, never the box).
@@ -402,6 +429,13 @@ class ReportRecord(Record):
         'notes': [str],
         'seconds': Number(0, 1e6),
     }
+    version: int
+    state: str
+    why: str
+    files: typing.Tuple[ReportFile, ...]
+    pages: typing.Tuple[ReportPage, ...]
+    notes: typing.Tuple[str, ...]
+    seconds: float
 
     def validate(self):
         if (self.state == 'read') != bool(self.pages):
@@ -409,10 +443,10 @@ class ReportRecord(Record):
         if (self.state == 'read') == bool(self.why):
             raise RecordError('report.json: state %s %s a why' % (self.state, 'with' if self.why else 'without'))
         for index, page in enumerate(self.pages):
-            if page['file'] >= len(self.files):
-                raise RecordError('report.json.pages[%d].file: %d of %d file(s)' % (index, page['file'], len(self.files)))
-        for where, path in [('files[%d].copy' % i, f['copy']) for i, f in enumerate(self.files)] + \
-                [('pages[%d].image' % i, p['image']) for i, p in enumerate(self.pages)]:
+            if page.file >= len(self.files):
+                raise RecordError('report.json.pages[%d].file: %d of %d file(s)' % (index, page.file, len(self.files)))
+        for where, path in [('files[%d].copy' % i, f.copy) for i, f in enumerate(self.files)] + \
+                [('pages[%d].image' % i, p.image) for i, p in enumerate(self.pages)]:
             if path is not None and not (path.startswith('report/') and _REPORT_NAME.match(path[len('report/'):])):
                 raise RecordError('report.json.%s: %s is not a file of report/' % (where, shown(path)))
 

@@ -20,6 +20,7 @@ import datetime
 import json
 import os
 
+from exam_lab.grader import contract
 from exam_lab.grader.publish import hand
 from exam_lab.grader.score import safe_text
 from exam_lab.grader.score.sheets import HAND_ITEMS
@@ -43,14 +44,14 @@ def cell_key(key, item):
 
 
 def load(path):
-    """review.json's content (:func:`empty` when there is none); ReviewError when it is not the page's."""
-    if not os.path.isfile(path):
+    """review.json's content (:func:`empty` when there is none), read through the contract (no link
+    followed, a regular file only, at most CAP bytes); ReviewError when it is not the page's."""
+    if not contract.exists(path):
         return empty()
-    if os.path.getsize(path) > CAP:
-        raise ReviewError('%s is over %d bytes: not the page\'s' % (path, CAP))
     try:
-        with open(path, encoding='utf-8') as f:
-            state = json.load(f)
+        state = json.loads(contract.read_text(path, CAP))
+    except contract.ContractError as err:
+        raise ReviewError('%s: not read (%s): move it away to start the review again' % (path, err))
     except ValueError as err:
         raise ReviewError('%s is no JSON (%s): move it away to start the review again' % (path, err))
     if not (isinstance(state, dict) and state.get('version') == VERSION and isinstance(state.get('cells'), dict)
@@ -60,10 +61,8 @@ def load(path):
 
 
 def save(path, state):
-    temporary = path + '.new'
-    with open(temporary, 'w', encoding='utf-8') as f:
-        json.dump(state, f, indent=1, sort_keys=True, ensure_ascii=False)
-    os.replace(temporary, path)
+    """review.json written whole by the contract's writer (never through an entry there)."""
+    contract.write_text(path, json.dumps(state, indent=1, sort_keys=True, ensure_ascii=False))
 
 
 def parse_points(text, item):
