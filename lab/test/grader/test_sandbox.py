@@ -26,6 +26,7 @@ from exam_lab.grader.host import boxed_run
 
 from exam_lab.grader import contract
 from exam_lab.grader.host import limits, sandbox, staging, uids
+from exam_lab.grader.score.inspection import InspectRecord
 from exam_lab.grader.score.sheets import ITEMS
 from exam_lab.harness.wait import wait_until
 from hostile_run import GOOD as VICTIM, HOSTILE, NAMES, SECRET_DIR, VICTIM_NAME, files_under, write_secrets
@@ -155,7 +156,7 @@ def test_reading_student_bytes_is_bounded(tmp_path):
                 boxed = boxed_run.Boxed(box, work)
                 with pytest.raises(boxed_run.InspectionFailed) as failed:
                     boxed.run('timeit', ['-n', '1', '-r', '1', '-s', 'import os, time', statement],
-                              records.InspectRecord, bounds)
+                              InspectRecord, bounds)
                 assert not box.leftovers()
             assert words in str(failed.value), (statement, str(failed.value))
             assert time.monotonic() - start < bounds[0] + 30.0

@@ -15,7 +15,8 @@ import pytest
 
 from exam_lab.grader.boxed import bounds, inspect, intake, similarity
 from exam_lab.grader.score import records
-from exam_lab.grader.score.records import MAX_ITEMS, MAX_TEXT, InspectRecord, SimilarityRecord
+from exam_lab.grader.score.inspection import InspectRecord
+from exam_lab.grader.score.records import MAX_ITEMS, MAX_TEXT, SimilarityRecord
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 GOOD = os.path.join(HERE, '..', 'grader', 'submissions', 'good_student', 'exam')
@@ -60,9 +61,9 @@ def test_501_python_files_are_graded_on_the_first_500(tmp_path):
     graded. Now the first 500 are read for the comments, and the record says so."""
     found = package_with(tmp_path, {'src/exam/parts/m%03d.py' % i: 'x = %d\n' % i for i in range(500)})
     record = read_back(InspectRecord, found)
-    assert len(record.comments['files']) == MAX_ITEMS
+    assert len(record.comments.files) == MAX_ITEMS
     assert '501 Python files (at most 500): the first 500 are read for comments' in record.notes
-    assert record.main_launch is not None and record.static['threshold']['name'] == '/threshold'
+    assert record.main_launch is not None and record.static.threshold.name == '/threshold'
 
 
 def test_every_list_the_code_makes_is_bounded_and_the_threshold_kept(tmp_path):
@@ -78,13 +79,13 @@ def test_every_list_the_code_makes_is_bounded_and_the_threshold_kept(tmp_path):
     found = package_with(tmp_path, files)
     record = read_back(InspectRecord, found)
     static = record.static
-    assert len(static['params_in_code']) == MAX_ITEMS and '~threshold' in static['params_in_code']
-    assert all(len(p) <= MAX_TEXT for p in static['params_in_code'])
-    assert len(static['args_in_code']) == MAX_ITEMS
+    assert len(static.params_in_code) == MAX_ITEMS and '~threshold' in static.params_in_code
+    assert all(len(p) <= MAX_TEXT for p in static.params_in_code)
+    assert len(static.args_in_code) == MAX_ITEMS
     for key in ('publishes', 'timers', 'service_calls', 'private_before_init'):
-        assert len(static['code'][key]) == MAX_ITEMS, key
+        assert len(getattr(static.code, key)) == MAX_ITEMS, key
     # read before init_node, so a read rospy resolves against <ns>/unnamed: the rubric must still see it
-    assert [w for w in static['code']['private_before_init'] if w.endswith(': ~threshold')]
+    assert [w for w in static.code.private_before_init if w.endswith(': ~threshold')]
     said = [n for n in record.notes if '(at most 500): the first 500 are kept' in n]
     assert said[0] == '603 parameter names the code reads (at most 500): the first 500 are kept', said
     assert '600 arguments the code reads (at most 500): the first 500 are kept' in said
@@ -99,7 +100,7 @@ def test_python_2_findings_are_bounded(tmp_path):
     naming five and counting the rest."""
     found = package_with(tmp_path, {'scripts/old%03d.py' % i: 'print "old"\n' for i in range(501)})
     record = read_back(InspectRecord, found)
-    assert len(record.static['python2']) == MAX_ITEMS and record.static['python2'][0] == 'scripts/old000.py:1: print statement'
+    assert len(record.static.python2) == MAX_ITEMS and record.static.python2[0] == 'scripts/old000.py:1: print statement'
     assert '501 files of Python 2 (at most 500): the first 500 are kept' in record.notes
     assert '501 Python files that do not parse as Python 3 (at most 50): the first 50 are named' in record.notes
     assert [n for n in record.notes if n.startswith('Python 2 code, which ROS Noetic cannot run: ')
@@ -115,7 +116,7 @@ def test_a_record_over_its_bytes_cuts_its_lists_of_text(tmp_path):
     assert len(json.dumps(found)) <= InspectRecord.MAX_BYTES
     record = read_back(InspectRecord, found)
     assert [n for n in record.notes if n.startswith('inspect.json: ') and 'its lists of text cut' in n]
-    assert record.static['threshold']['name'] == '/threshold'
+    assert record.static.threshold.name == '/threshold'
 
 
 def test_fixes_and_notes_of_many_files_are_bounded(tmp_path):
@@ -127,8 +128,8 @@ def test_fixes_and_notes_of_many_files_are_bounded(tmp_path):
     record = read_back(InspectRecord, found)
     assert len(record.fixes) == MAX_ITEMS and record.fixes[-1].startswith('6') and 'fixes (at most 500)' in record.fixes[-1]
     assert len(record.notes) <= MAX_ITEMS
-    assert len(record.static['launch_files']) == MAX_ITEMS
-    assert record.static['launch']['file'] == 'launch/exam.launch'  # exam.launch read first when some are left out
+    assert len(record.static.launch_files) == MAX_ITEMS
+    assert record.static.launch.file == 'launch/exam.launch'  # exam.launch read first when some are left out
     assert any(n.startswith('601 launch files (at most 500): the first 500 are read') for n in record.notes)
     assert [n for n in record.notes if re.match(r'^\d+ problems of the launch files \(at most 50\): the first 50 '
                                                 r'are named$', n)], record.notes[-5:]
@@ -206,7 +207,7 @@ def test_the_code_s_functions_and_signals_over_their_caps_are_said(tmp_path, mon
     monkeypatch.setattr(code_quality, 'MAX_SIGNALS', 1)
     code = ''.join('def f%d():\n    global g%d\n    g%d = 1\n' % (i, i, i) for i in range(5))
     record = read_back(InspectRecord, package_with(tmp_path, {'scripts/many.py': code}))
-    assert len(record.comments['units']) == 3 and len(record.comments['quality']) == 1
+    assert len(record.comments.units) == 3 and len(record.comments.quality) == 1
     assert [n for n in record.notes if re.match(r'^\d+ functions and blocks of the code \(at most 3\): the first 3 '
                                                 r'are judged for their comments$', n)], record.notes
     assert [n for n in record.notes if re.match(r'^\d+ signs of bad practice in the code \(at most 1\): the first '
@@ -252,7 +253,7 @@ def test_the_inspection_says_the_pdfs_it_did_not_list(tmp_path, monkeypatch):
     record = read_back(InspectRecord, bounds.fit(inspect.inspect(str(tmp_path / 'upload' / 'exam'), str(ws),
                                                                  str(tmp_path / 'out2'), None, 0.5), InspectRecord))
     assert '2 PDF files (at most 1): the first 1 is listed' in record.notes
-    assert [d['name'] for d in record.facts['documents']] == ['fr_odt.pdf']
+    assert [d.name for d in record.facts.documents] == ['fr_odt.pdf']
 
 
 def test_a_code_file_over_the_bytes_compared_is_said(tmp_path, monkeypatch):

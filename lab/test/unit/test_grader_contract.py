@@ -8,6 +8,8 @@ import pytest
 
 from exam_lab.grader import contract
 from exam_lab.grader.score import records
+from exam_lab.grader.score.inspection import InspectRecord
+from exam_lab.grader.score.schema import plain
 
 
 def inspect_record(**changes):
@@ -34,9 +36,9 @@ def write(tmp_path, value, name='inspect.json'):
 
 
 def test_a_good_record_is_read(tmp_path):
-    record = contract.read_record(write(tmp_path, inspect_record()), records.InspectRecord)
+    record = contract.read_record(write(tmp_path, inspect_record()), InspectRecord)
     assert record.uid == 61003 and record.threshold_value == 1300.0
-    assert record.static['launch']['exam_type'] == 'exam_node.py'
+    assert record.static.launch.exam_type == 'exam_node.py'
     assert record.main_launch == 'src/exam/launch/.grader-main-exam.launch'
 
 
@@ -57,7 +59,7 @@ def test_a_good_record_is_read(tmp_path):
 ])
 def test_a_record_of_an_unexpected_shape_is_refused(tmp_path, change, words):
     with pytest.raises(records.RecordError) as refused:
-        contract.read_record(write(tmp_path, inspect_record(**change)), records.InspectRecord)
+        contract.read_record(write(tmp_path, inspect_record(**change)), InspectRecord)
     assert words in str(refused.value)
 
 
@@ -65,22 +67,22 @@ def test_nested_fields_are_checked_too(tmp_path):
     record = inspect_record()
     record['static']['launch']['comments'] = -1
     with pytest.raises(records.RecordError, match=r'static\.launch\.comments: -1 is outside'):
-        contract.read_record(write(tmp_path, record), records.InspectRecord)
+        contract.read_record(write(tmp_path, record), InspectRecord)
     del record['static']['launch']
     with pytest.raises(records.RecordError, match='launch is missing'):
-        contract.read_record(write(tmp_path, record), records.InspectRecord)
+        contract.read_record(write(tmp_path, record), InspectRecord)
 
 
 def test_not_json_and_non_numbers_are_refused(tmp_path):
     for raw in (b'{"uid": 1', b'\xff\xfe', b'[]', json.dumps(inspect_record()).replace('1300.0', 'NaN').encode()):
         with pytest.raises(records.RecordError):
-            contract.read_record(write(tmp_path, raw), records.InspectRecord)
+            contract.read_record(write(tmp_path, raw), InspectRecord)
 
 
 def test_an_oversized_record_is_refused_unread(tmp_path):
     path = write(tmp_path, inspect_record(notes=['x' * 1000] * 200))
     with pytest.raises(records.RecordError, match='bytes \\(at most 100000\\)'):
-        contract.read_record(path, records.InspectRecord, max_bytes=100000)
+        contract.read_record(path, InspectRecord, max_bytes=100000)
 
 
 def test_links_fifos_and_missing_files_are_refused(tmp_path):
@@ -88,12 +90,12 @@ def test_links_fifos_and_missing_files_are_refused(tmp_path):
     os.chmod(secret, 0o600)
     os.symlink(secret, str(tmp_path / 'inspect.json'))
     with pytest.raises(records.RecordError, match='a link, not followed'):
-        contract.read_record(str(tmp_path / 'inspect.json'), records.InspectRecord)
+        contract.read_record(str(tmp_path / 'inspect.json'), InspectRecord)
     os.mkfifo(str(tmp_path / 'fifo.json'))
     with pytest.raises(records.RecordError, match='not a regular file'):  # and never blocks
-        contract.read_record(str(tmp_path / 'fifo.json'), records.InspectRecord)
+        contract.read_record(str(tmp_path / 'fifo.json'), InspectRecord)
     with pytest.raises(records.RecordError, match='missing'):
-        contract.read_record(str(tmp_path / 'none.json'), records.InspectRecord)
+        contract.read_record(str(tmp_path / 'none.json'), InspectRecord)
 
 
 def test_an_intake_names_only_students_inside_its_folder(tmp_path):
@@ -136,12 +138,12 @@ def test_a_cap_hit_is_a_sentence_naming_the_cap_and_the_value(tmp_path):
     files = ['scripts/n%d.py' % i for i in range(records.MAX_ITEMS + 1)]
     record = inspect_record(comments={'comments': 1, 'code': 2, 'files': files})
     with pytest.raises(records.RecordError) as refused:
-        contract.read_record(write(tmp_path, record), records.InspectRecord)
+        contract.read_record(write(tmp_path, record), InspectRecord)
     assert str(refused.value) == 'inspect.json.comments.files: 501 files (at most 500)'
     with pytest.raises(records.RecordError, match=r'^inspect.json.notes: 501 notes \(at most 500\)$'):
-        records.write(str(tmp_path), records.InspectRecord, inspect_record(notes=['n'] * 501))
+        records.write(str(tmp_path), InspectRecord, inspect_record(notes=['n'] * 501))
     with pytest.raises(records.RecordError, match=r'inspect.json: 1048577 bytes \(at most 1048576\)$'):
-        contract.read_record(write(tmp_path, b' ' * ((1 << 20) + 1)), records.InspectRecord)
+        contract.read_record(write(tmp_path, b' ' * ((1 << 20) + 1)), InspectRecord)
 
 
 def test_a_class_larger_than_a_list_cap_is_one_intake(tmp_path):
@@ -162,8 +164,8 @@ def test_the_inspections_text_is_made_safe_where_its_record_is_made(tmp_path):
                            static=dict(inspect_record()['static'], threshold_reason='reads \x1b]0;owned\x07it'),
                            facts={'participant': 1, 'folder': 'F\x1b[31m', 'documents': [{'name': 'r\x07.pdf', 'pages': 1}]},
                            handed_in_launch='exam/launch/\udcfe.launch', comments={'comments': 1, 'code': 2, 'files': [odd]})
-    record = contract.read_record(write(tmp_path, json.dumps(found).encode()), records.InspectRecord)
-    assert record.notes == ['link scripts/n\\xff.py dropped', 'bell'] and record.fixes == ['evil']
-    assert record.static['threshold_reason'] == 'reads it' and record.facts['folder'] == 'F'
-    assert record.facts['documents'] == [{'name': 'r.pdf', 'pages': 1}]
-    assert record.handed_in_launch == 'exam/launch/\udcfe.launch' and record.comments['files'] == [odd]
+    record = contract.read_record(write(tmp_path, json.dumps(found).encode()), InspectRecord)
+    assert record.notes == ('link scripts/n\\xff.py dropped', 'bell') and record.fixes == ('evil',)
+    assert record.static.threshold_reason == 'reads it' and record.facts.folder == 'F'
+    assert plain(record.facts.documents) == [{'name': 'r.pdf', 'pages': 1}]
+    assert record.handed_in_launch == 'exam/launch/\udcfe.launch' and record.comments.files == (odd,)

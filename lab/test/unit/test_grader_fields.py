@@ -5,7 +5,7 @@ import keyword
 
 import pytest
 
-from exam_lab.grader.score import fields, records, rubric
+from exam_lab.grader.score import fields, inspection, records, rubric
 
 from test_grader_rubric import STATIC, measured
 
@@ -71,8 +71,8 @@ def test_a_value_not_of_the_schemas_shape_is_given_as_it_is():
     assert fields.view({'where': 'nowhere', 'tags': 'x'}, SCHEMA).where == 'nowhere'
 
 
-@pytest.mark.parametrize('schema', [records.SessionRecord.SCHEMA, records.ProbeRecord.SCHEMA, records.STATIC,
-                                    records.InspectRecord.SCHEMA])
+@pytest.mark.parametrize('schema', [records.SessionRecord.SCHEMA, records.ProbeRecord.SCHEMA, inspection.STATIC,
+                                    inspection.InspectRecord.SCHEMA])
 def test_every_field_of_the_records_reads_as_an_attribute(schema):
     def keys(schema):
         while isinstance(schema, (records.Maybe, records.Optional)):
@@ -96,7 +96,7 @@ def test_every_field_of_the_records_reads_as_an_attribute(schema):
 def test_the_rubric_reads_a_session_as_kept_or_as_its_view():
     session, static = measured(calls=[[13.55, 'WARNING']]), dict(STATIC, code={'service_calls': [], 'publishes': [],
                                                                               'timers': []})
-    viewed = fields.view(session, records.SessionRecord.SCHEMA), fields.view(static, records.STATIC)
+    viewed = fields.view(session, records.SessionRecord.SCHEMA), fields.view(static, inspection.STATIC)
     assert rubric.score('altitude', viewed[1], viewed[0]) == rubric.score('altitude', static, session)
     assert rubric.status(viewed[1], viewed[0]) == rubric.status(static, session)
     assert rubric.doubts(viewed[1], viewed[0]) == rubric.doubts(static, session)

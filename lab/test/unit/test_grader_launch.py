@@ -8,6 +8,7 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from exam_lab.grader.boxed import derive, launch
+from exam_lab.grader.score.inspection import InspectRecord
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 SUBMISSIONS = os.path.join(HERE, '..', 'grader', 'submissions')
@@ -387,7 +388,7 @@ def test_the_threshold_run_value_is_drawn_once_written_and_planned(tmp_path, dra
     derived = os.path.join(str(ws), found['threshold_launch'])
     again = derive.threshold_param(launch.analyse(derived, os.path.join(str(ws), 'src', 'exam')), 'altitude')[0]
     assert (again.name, launch.as_number(again.value)) == ('--threshold', value)
-    job = runner.plan_job(records.InspectRecord(records.check(found, records.InspectRecord.SCHEMA)))
+    job = runner.plan_job(InspectRecord.make(found))
     main, threshold = [run.plan for run in job.runs]
     assert threshold == dataclasses.replace(main, kind='threshold', threshold=value), 'the main run\'s plan around the new value'
     with pytest.raises(ValueError):

@@ -13,6 +13,7 @@ from exam_lab.grader.publish import grades
 from exam_lab.grader.host import session
 from exam_lab.grader.host import run as host_run
 from exam_lab.grader.score import job as job_records, records
+from exam_lab.grader.score.inspection import InspectRecord
 from exam_lab.grader.score.records import ProbeRecord, RecordError, SessionRecord
 from exam_lab.grader.score.schema import plain
 
@@ -193,7 +194,7 @@ def inspected(**change):
              'threshold_value': 1300.0, 'calls_service': True, 'namespace': '/', 'main_launch': 'grader/main.launch',
              'threshold_launch': 'grader/threshold.launch', 'threshold_run_value': 900.0, 'handed_in_launch': None,
              'comments': None, 'facts': {'participant': None, 'folder': 'Ann', 'documents': []}}
-    return records.InspectRecord.make(dict(value, **change))
+    return InspectRecord.make(dict(value, **change))
 
 
 def test_the_job_and_its_plans_are_records_that_round_trip(tmp_path, capsys):

@@ -48,8 +48,9 @@ The folder a module lives in says who runs it, on whose bytes (docs/grading.md, 
   :mod:`~.score.runs` (whether a run counts: its result's times, the clock, the master, the judge's deaths);
   :mod:`~.score.fields` (a record read by attributes, following its schema), :mod:`~.score.safe_text`
   (student-derived text without control characters, for every record and output), :mod:`~.score.records`
-  (the typed records that cross the boundary, with their schemas), :mod:`~.score.job` (the
-  session's job and each run's plan, root's orders), :mod:`~.score.kept` (what a grading
+  (the typed records that cross the boundary, with their schemas), :mod:`~.score.inspection`
+  (what the inspection's box read of a submission), :mod:`~.score.job` (the session's job and each
+  run's plan, root's orders), :mod:`~.score.kept` (what a grading
   keeps, as records: its measurements and its grade, versioned), :mod:`~.score.schema` (a schema, its
   check, the base of every record), :mod:`~.score.answers` (the report's questions 4-9 found by their
   headings and judged by named checks), :mod:`~.score.report_tables` (a report's table read from its

@@ -13,7 +13,7 @@ parses the student's bytes. So one grading runs as three kinds of processes:
     runs it, as ``python -m`` in the box, and reads its record.
   - the box's uid (``boxed/``, on the student's bytes, without network): the inspection unpacks the
     upload, finds the package, reads its launch files and sources, writes the derived launch files,
-    and hands back one record (:class:`~exam_lab.grader.score.records.InspectRecord`); then the
+    and hands back one record (:class:`~exam_lab.grader.score.inspection.InspectRecord`); then the
     student's build and nodes run as the same uid in the session's network namespace of loopback only.
   - the judge's uid (``judge/``, never root, never reading the student's files): the master and the
     probe, which plays the drone, flies the plan and measures the node from the ROS graph.
@@ -55,6 +55,7 @@ from exam_lab.grader.host.underlay import box_binds, default_underlay, ensure_un
 from exam_lab.grader.publish import grades, progress, teacher
 from exam_lab.grader.score import identity, records
 from exam_lab.grader.score.job import JobRecord
+from exam_lab.grader.score.inspection import InspectRecord
 from exam_lab.grader.score.records import Outcome
 from exam_lab.grader.score.schema import plain
 from exam_lab.grader.score.boxenv import BOX_WS, CODE_COPY
@@ -126,11 +127,12 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
                 notes.extend(found.notes)
                 fixes.extend(found.fixes)
                 # Who it is, as root read it from the listed entry's name: never as the box says.
-                facts, comments = dict(found.facts, participant=facts['participant'], folder=facts['folder']), found.comments
+                facts = dict(plain(found.facts), participant=facts['participant'], folder=facts['folder'])
+                comments = plain(found.comments)
                 if found.refused is not None:
                     raise records.UnpackError(found.refused)
                 notes.extend(reports.keep_code(os.path.join(work, 'out', CODE_COPY), out_dir))
-                chosen_sheet, static = found.sheet, found.static
+                chosen_sheet, static = found.sheet, plain(found.static)
                 job = plan_job(found)
                 if job is None:
                     session = grades.no_session(Outcome.NO_NODE, 'no script of the package starts a ROS node', no_node=True)
@@ -180,7 +182,7 @@ def grade_submission(submission, out_dir, *, sheet=None, student=None, underlay=
 def inspect(box, work, upload, wanted_sheet, timeout=None):
     """Run :mod:`exam_lab.grader.boxed.inspect` on the staged ``upload`` (a path below ``<work>/upload``)
     in ``box`` (:class:`Boxed`), bounded by INSPECT_BOUNDS (its wall clock by ``timeout`` if less); return its checked
-    :class:`~exam_lab.grader.score.records.InspectRecord`. The package is written, as the box's uid, to
+    :class:`~exam_lab.grader.score.inspection.InspectRecord`. The package is written, as the box's uid, to
     the workspace the build box sees: ``<work>/ws/src`` (read-only there), or unsandboxed the box's
     own copy.
 
@@ -197,7 +199,7 @@ def inspect(box, work, upload, wanted_sheet, timeout=None):
             '--toplevel', os.path.join(package_path('catkin'), 'cmake', 'toplevel.cmake'),
             '--draw', repr(random.SystemRandom().random())]
     return boxed.run('exam_lab.grader.boxed.inspect', args + (['--sheet', wanted_sheet] if wanted_sheet else []),
-                     records.InspectRecord, (min(INSPECT_BOUNDS[0], timeout or INSPECT_BOUNDS[0]),) + INSPECT_BOUNDS[1:])
+                     InspectRecord, (min(INSPECT_BOUNDS[0], timeout or INSPECT_BOUNDS[0]),) + INSPECT_BOUNDS[1:])
 
 
 def plan_job(record):

@@ -9,7 +9,7 @@ It unpacks the upload (:mod:`~exam_lab.grader.boxed.package`, scratch under ``OU
 into ``WS/src/<name>``, makes the teacher's fixes (:mod:`~exam_lab.grader.boxed.source`), analyses the
 launch files and writes the derived ones (:mod:`~exam_lab.grader.boxed.launch`), reads the PDF facts
 (:mod:`~exam_lab.grader.boxed.documents`) and the comment statistics, and writes ``OUT/inspect.json``:
-one :class:`~exam_lab.grader.score.records.InspectRecord`, which root checks before using anything of it.
+one :class:`~exam_lab.grader.score.inspection.InspectRecord`, which root checks before using anything of it.
 
 ``WS`` is the workspace at the path the build and run box sees it (``/box/ws``), so every path written
 into a derived launch file is valid there. ``T`` (catkin's toplevel.cmake) is linked as
@@ -24,6 +24,7 @@ import sys
 
 from exam_lab.grader.boxed import archives, bounds, code_quality, derive, documents, launch, package, source
 from exam_lab.grader.score import boxenv, records
+from exam_lab.grader.score.inspection import InspectRecord
 from exam_lab.grader.score.sheets import PACKAGE, SHEETS, threshold_run_value
 
 
@@ -61,7 +62,7 @@ def _executable_in(pkg, name):
 
 
 def inspect(upload, ws, out, wanted_sheet=None, draw=None):
-    """The record (a dict, :class:`~exam_lab.grader.score.records.InspectRecord`'s fields) of the
+    """The record (a dict, :class:`~exam_lab.grader.score.inspection.InspectRecord`'s fields) of the
     submission ``upload``; its package is written to ``ws/src/<name>``, scratch goes below ``out``.
 
     :param draw: in [0, 1), drawn by the grader at grading time: where the threshold run's value lies
@@ -217,7 +218,7 @@ def main(argv=None):
         os.symlink(args.toplevel, os.path.join(args.ws, 'src', 'CMakeLists.txt'))
     try:
         record = inspect(args.upload, args.ws, args.out, args.sheet, args.draw)
-        records.write(args.out, records.InspectRecord, bounds.fit(record, records.InspectRecord))
+        records.write(args.out, InspectRecord, bounds.fit(record, InspectRecord))
     except records.RecordError as err:  # a sentence for the teacher, not a traceback
         sys.stderr.write('inspect: its record exceeds a bound: %s\n' % err)
         return 4

@@ -13,9 +13,9 @@ shape is no grade of today's grader: it stops that student's rescore and workshe
 "graded by an older grader: grade again" (:data:`OLDER`), the file named; one of no shape at all
 with a sentence naming the file and the field.
 """
+from exam_lab.grader.score.inspection import STATIC, InspectRecord
 from exam_lab.grader.score.records import (
-    MEASUREMENTS, STATIC, InspectRecord, Items, Map, Maybe, Number, OneOf, Optional, Record, RecordError,
-    SessionRecord, Text, shown)
+    MEASUREMENTS, Items, Map, Maybe, Number, OneOf, Optional, Record, RecordError, SessionRecord, Text, shown)
 from exam_lab.grader.score.sheets import ITEMS, SHEETS
 from exam_lab.grader.score.verdict import STATUSES
 

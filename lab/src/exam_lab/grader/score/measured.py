@@ -5,7 +5,7 @@ the node ran, published and stayed up, the inputs rospy refused, and an item's r
 Every function here takes the records as they are kept (dicts, from ``measurements.json`` or a test)
 or as views, and reads views only.
 """
-from exam_lab.grader.score import fields, records
+from exam_lab.grader.score import fields, inspection, records
 from exam_lab.grader.score.runs import judged
 from exam_lab.grader.score.sheets import ITEMS
 
@@ -23,9 +23,9 @@ def session_of(session):
 
 
 def static_of(static):
-    """The view of what the inspection read (:data:`~exam_lab.grader.score.records.STATIC`), None
+    """The view of what the inspection read (:data:`~exam_lab.grader.score.inspection.STATIC`), None
     staying None."""
-    return fields.view(static, records.STATIC)
+    return fields.view(static, inspection.STATIC)
 
 
 def probe_of(probe):
