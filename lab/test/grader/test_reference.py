@@ -18,7 +18,7 @@ def test_the_capture_runs_the_drone_and_finds_its_node_and_topics(sheet, node, t
     assert found['topics'] == topics
     assert found['type'] == 'std_msgs/Float32' and found['fields'] == ['float32 data']
     assert found['rate'] == rate and found['measured'] == pytest.approx(rate, rel=0.05)
-    assert 'Pid:' in record.commands['rosnode_info']['output']
-    assert 'transport: TCPROS' in record.commands['rosnode_info']['output']
-    assert record.commands['rostopic_echo']['output'].count('data:') == 3
+    assert 'Pid:' in record.commands['rosnode_info'].output
+    assert 'transport: TCPROS' in record.commands['rosnode_info'].output
+    assert record.commands['rostopic_echo'].output.count('data:') == 3
     assert found['created'] == ['exam/CMakeLists.txt', 'exam/package.xml']

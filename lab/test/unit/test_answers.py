@@ -33,7 +33,7 @@ def sub():
 def out(sheet, key):
     """``$ <line>`` and the output the drone printed for it, as pasted from a terminal."""
     command = reference(sheet).commands[key]
-    return '$ %s\n%s' % (command['line'], command['output'])
+    return '$ %s\n%s' % (command.line, command.output)
 
 
 def page(text, number=1, layout='', unsure=(), confidence=None, source='text'):

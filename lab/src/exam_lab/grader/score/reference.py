@@ -9,8 +9,10 @@ topics only this simulator has (its LED, its ground truth, ``/diagnostics``: the
 none), the float digits of the readings.
 """
 import re
+import typing
+from dataclasses import dataclass
 
-from exam_lab.grader.score.schema import Map, Maybe, Number, OneOf, Record, Text
+from exam_lab.grader.score.schema import DataRecord, Map, Maybe, Number, OneOf, Text
 from exam_lab.grader.score.sheets import SHEETS
 
 
@@ -19,7 +21,16 @@ def reference_file(sheet):
     return 'reference-%s.json' % sheet
 
 
-class ReferenceRecord(Record):
+@dataclass(frozen=True)
+class Command(object):
+    """One command as the drone's reference ran it: its line, its output, its exit status."""
+    line: str
+    output: str
+    status: typing.Optional[int]
+
+
+@dataclass(frozen=True)
+class ReferenceRecord(DataRecord):
     """The reference outputs of one sheet's drone (``reference-<sheet>.json``): its package, its node's
     name, the question's topic and the other input, the rates its spec configures (Hz by topic name),
     each command's ``{line, output, status}`` by key (:func:`~exam_lab.grader.host.reference.commands`,
@@ -34,6 +45,15 @@ class ReferenceRecord(Record):
                                    'status': Maybe(Number(-1e6, 1e6, integer=True))}, 20),
         'created': [Text(500)],
     }
+    version: int
+    sheet: str
+    drone: str
+    node: str
+    topic: str
+    other_topic: str
+    rates: typing.Mapping[str, float]
+    commands: typing.Mapping[str, Command]
+    created: typing.Tuple[str, ...]
 
 
 #: rostopic hz's line of a rate ("average rate: 0.778").
@@ -58,7 +78,7 @@ def facts(record):
     (rostopic hz's last average, or None), ``other_rate`` (the other input's), ``publications`` (the
     node's, without the extras), ``services`` (the node's own service), ``created`` (the files
     catkin_create_pkg made), ``node``, ``topic``, ``other_topic``, ``drone``."""
-    value = record.value if isinstance(record, Record) else record
+    value = record.value if isinstance(record, ReferenceRecord) else record
     out = value['commands']
 
     def output(key):
