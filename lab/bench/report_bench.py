@@ -11,7 +11,8 @@ lab/test/unit/data/reports (LibreOffice's PDFs, one a .docx converted in the box
 the worst wall clock of each kind, against the goals (a text report under 5 s, a 10-page scan under 30 s
 on two cores), its CPU (user + sys of this process, its children and the box's cgroup: on a shared
 machine the wall clock is also the others' load, shown), and what a class of 60 adds at the default JOBS. Prints a Markdown section and writes
-``reports_results.json`` in --out; ``--record`` also writes the section to lab/bench/reports.md.
+``reports_results.json`` in --out; ``--record`` also writes the section to lab/bench/reports.md and keeps
+the results beside it (lab/bench/reports_results.json).
 """
 import argparse
 import datetime
@@ -107,9 +108,10 @@ def main(argv=None):
         json.dump(results, f, indent=1)
     text = section(results)
     print(text)
-    if args.record:
+    if args.record:  # the section and the raw results it was rendered from, kept together
         with open(os.path.join(HERE, 'reports.md'), 'w') as f:
             f.write(text)
+        shutil.copyfile(os.path.join(out, 'reports_results.json'), os.path.join(HERE, 'reports_results.json'))
     return 0
 
 
