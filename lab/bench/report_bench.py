@@ -10,7 +10,9 @@ lab/test/unit/data/reports (LibreOffice's PDFs, one a .docx converted in the box
 ``--repeat`` times by :func:`exam_lab.grader.host.reports.read_report`, box included; the median and
 the worst wall clock of each kind, against the goals (a text report under 5 s, a 10-page scan under 30 s
 on two cores), its CPU (user + sys of this process, its children and the box's cgroup: on a shared
-machine the wall clock is also the others' load, shown), and what a class of 60 adds at the default JOBS. Prints a Markdown section and writes
+machine the wall clock is also the others' load, shown), and what a class of 60 adds at the default JOBS.
+Then a class of ``--class-size`` (8) copies of the good student's package, each with a text report beside
+it, is graded as make grade grades a class: each grading's own report stage, and what they add to the class. Prints a Markdown section and writes
 ``reports_results.json`` in --out; ``--record`` also writes the section to lab/bench/reports.md and keeps
 the results beside it (lab/bench/reports_results.json).
 """
@@ -22,9 +24,11 @@ import shutil
 import statistics
 import sys
 import tempfile
+import time
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 DATA = os.path.join(HERE, '..', 'test', 'unit', 'data', 'reports')
+GOOD = os.path.join(HERE, '..', 'test', 'grader', 'submissions', 'good_student', 'exam')
 sys.path.insert(0, os.path.join(HERE, '..', 'test', 'reports'))
 
 from exam_lab.grader import class_run  # noqa: E402
@@ -57,6 +61,30 @@ def measure(path, scratch, repeat):
     return row
 
 
+def class_with_reports(scratch, count):
+    """A class of ``count`` copies of the good student's package, each handed in with fr_odt.pdf beside
+    it, graded as ``make grade CLASS=`` grades one (:func:`exam_lab.grader.class_run.grade_class`, the
+    default JOBS): ``{"students", "jobs", "seconds"`` (the class's wall clock), ``"report"`` (each
+    student's report stage, wall s, as its grading timed it in ``logs/timings.json``), ``"read"`` (the
+    reports read)``}``."""
+    folder, out = os.path.join(scratch, 'class'), os.path.join(scratch, 'class-out')
+    for n in range(count):
+        student = os.path.join(folder, 's%02d' % (n + 1))
+        shutil.copytree(GOOD, os.path.join(student, 'exam'), ignore=shutil.ignore_patterns('__pycache__'))
+        shutil.copyfile(os.path.join(DATA, 'fr_odt.pdf'), os.path.join(student, 'rapport.pdf'))
+    jobs = class_run.default_jobs()
+    start = time.monotonic()
+    graded = class_run.grade_class(folder, out, jobs=jobs)
+    seconds = round(time.monotonic() - start, 1)
+    walls, read = [], 0
+    for record in graded:
+        with open(os.path.join(out, record['student'], 'logs', timings.FILE)) as f:
+            walls.append(json.load(f)['stages']['report']['wall'])
+        with open(os.path.join(out, record['student'], 'report.json')) as f:
+            read += json.load(f)['state'] == 'read'
+    return {'students': count, 'jobs': jobs, 'seconds': seconds, 'report': walls, 'read': read}
+
+
 def section(results):
     jobs = class_run.default_jobs()
     lines = ['### Reading the reports', '',
@@ -78,6 +106,17 @@ def section(results):
               '%.0f s to its grading at the default JOBS=%d (the reports are read side by side as the students '
               'are graded: %d x median / JOBS).' % (statistics.median(text), max(text), CLASS,
                                                      CLASS * statistics.median(text) / jobs, jobs, CLASS), '']
+    graded = results.get('class')
+    if graded:
+        added = sum(graded['report']) / graded['jobs']
+        lines += ['In a class: %d copies of the good student\'s package, each with fr_odt.pdf beside it, graded as '
+                  '`make grade CLASS=` grades one at the default JOBS=%d in %.0f s; %d of %d reports read. Each '
+                  'student\'s report stage (its own `logs/timings.json`) took median %.1f s, worst %.1f s, read '
+                  'while the other slots fly: the reports added about %.0f s to the class (their stages\' sum / '
+                  'JOBS), about %.0f s for a class of %d.' % (
+                      graded['students'], graded['jobs'], graded['seconds'], graded['read'], graded['students'],
+                      statistics.median(graded['report']), max(graded['report']), added,
+                      added * CLASS / graded['students'], CLASS), '']
     return '\n'.join(lines)
 
 
@@ -86,6 +125,8 @@ def main(argv=None):
     parser.add_argument('--repeat', type=int, default=5)
     parser.add_argument('--out', default=None)
     parser.add_argument('--record', action='store_true')
+    parser.add_argument('--class-size', type=int, default=8,
+                        help='students of the class graded with a report each (0: none)')
     args = parser.parse_args(argv)
     out = args.out or tempfile.mkdtemp(prefix='report-bench-')
     os.makedirs(out, exist_ok=True)
@@ -102,7 +143,11 @@ def main(argv=None):
             results['reports'][name] = dict({'kind': kind, 'pages': pages}, **measure(path, work, args.repeat))
             print('report_bench: %s: %s s, CPU %s s' % (name, results['reports'][name]['seconds'],
                                                         results['reports'][name]['cpu']), flush=True)
+        if args.class_size:
+            results['class'] = class_with_reports(scratch, args.class_size)
+            print('report_bench: a class of %d: %s' % (args.class_size, results['class']), flush=True)
     finally:
+        reports.remove_read_only(scratch)
         shutil.rmtree(scratch, ignore_errors=True)
     with open(os.path.join(out, 'reports_results.json'), 'w') as f:
         json.dump(results, f, indent=1)
