@@ -110,7 +110,7 @@ if [ "$grader" = record ]; then
   bench_pid=$!
   wait "$bench_pid"
 elif [ "$grader" = quick ]; then
-  /usr/bin/python3 "$repo/lab/bench/report_bench.py" --repeat 2 --out "$out/reports" &
+  /usr/bin/python3 "$repo/lab/bench/report_bench.py" --repeat 2 --class-size 2 --out "$out/reports" &
   bench_pid=$!
   wait "$bench_pid"
   /usr/bin/python3 "$repo/lab/bench/grader_bench.py" --students 4 --jobs 2 --out "$out/grader" &
