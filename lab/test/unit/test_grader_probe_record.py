@@ -197,6 +197,31 @@ def inspected(**change):
     return InspectRecord.make(dict(value, **change))
 
 
+def test_the_sessions_job_with_its_boxes_is_frozen_and_round_trips(tmp_path):
+    """The job as run_session completes it (the boxes, the judges' folders, the twin's box on one run):
+    read back equal, each box attached as it was described, nothing of it changeable."""
+    from exam_lab.grader.host.sandbox import Box
+    box = Box(str(tmp_path), bwrap=True, cpus=1.5)
+    box.slot, box.cgroups, box.judge_cgroups = 3, ['/sys/fs/cgroup/x'], {'master': ['/sys/fs/cgroup/m']}
+    twin = Box(str(tmp_path), bwrap=True, name='box-twin')
+    job = runner.plan_job(inspected())
+    runs = [plain(run) for run in job.runs]
+    runs[1].update(box=twin.describe(), judge_home=str(tmp_path / 'judge-twin'))
+    done = job.replaced(runs=runs, box=box.describe(), judge_home=str(tmp_path / 'judge'), side_by_side=True,
+                        workspace='/box/ws', log_dir=str(tmp_path / 'logs'), budget=280.0, student_budget=300.0)
+    again = job_records.JobRecord.from_json(done.to_json().encode())
+    assert again == done and again.runs[0].box is None and again.runs[1].box.name == 'box-twin'
+    attached = Box.attached(done.box_of(done.runs[0]))
+    assert (attached.slot, attached.cpus, attached.judge_cgroups) == (3, 1.5, {'master': ['/sys/fs/cgroup/m']})
+    assert Box.attached(done.box_of(done.runs[1])).folder == twin.folder
+    assert done.judge_home_of(done.runs[1]) == str(tmp_path / 'judge-twin')
+    assert done.judge_home_of(done.runs[0]) == str(tmp_path / 'judge')
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        done.runs[0].plan.threshold = 0.0
+    with pytest.raises(TypeError):
+        done.box.judge_cgroups['probe'] = ('/elsewhere',)
+
+
 def test_the_job_and_its_plans_are_records_that_round_trip(tmp_path, capsys):
     """The plan (runner), the job as the session reads it (job.json) and each run's plan as the judge
     reads it (from the same job: JobRecord.plan) are checked records: what the runner made is what they read."""
