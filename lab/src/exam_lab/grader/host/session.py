@@ -40,7 +40,6 @@ CPU time as ``<log_dir>/timings.json`` (:mod:`~exam_lab.grader.host.timings`). W
 from these facts, again at each rescore.
 """
 import dataclasses
-import json
 import os
 import sys
 
@@ -50,6 +49,7 @@ from exam_lab.grader.host.run import (
     MAIN_WORD, MIN_RUN_S, RUN_STOP_S, STEP_STOP_S, Budget, base_environment, capped_log, judge_environment,
     run_one, tail)
 from exam_lab.grader.host.sandbox import Box
+from exam_lab.grader.host import timings
 from exam_lab.grader.host.timings import Stopwatch, boxes_cpu
 from exam_lab.grader.score.job import JobRecord
 from exam_lab.grader.score.records import Outcome, RecordError, SessionRecord
@@ -196,15 +196,12 @@ def main(argv):
         sys.stderr.write('the session\'s record is not one: %s\n' % err)
         return 1
     for tag in ('main', 'threshold'):
-        path = os.path.join(job.log_dir, 'timings-%s.json' % tag)
-        if os.path.isfile(path):
-            with open(path) as f:
-                watch.stages.update(json.load(f).get('stages', {}))
-            os.unlink(path)
+        name = 'timings-%s.json' % tag
+        if contract.exists(os.path.join(job.log_dir, name)):
+            watch.stages.update(timings.read(job.log_dir, name).get('stages') or {})
+            os.unlink(os.path.join(job.log_dir, name))
     watch.write(job.log_dir)
-    with open(os.path.join(job.log_dir, SessionRecord.FILE + '.part'), 'w') as f:
-        f.write(record.to_json())
-    os.rename(os.path.join(job.log_dir, SessionRecord.FILE + '.part'), os.path.join(job.log_dir, SessionRecord.FILE))
+    contract.write_record(os.path.join(job.log_dir, SessionRecord.FILE), record)
     return 0
 
 

@@ -22,7 +22,7 @@ from exam_lab.grader.host.run import (
 from exam_lab.grader.host.sandbox import Box
 from exam_lab.grader.host.timings import Stopwatch, boxes_cpu
 from exam_lab.grader.score.job import JobRecord
-from exam_lab.grader.score.records import RecordError
+from exam_lab.grader.score.records import RecordError, SessionRecord
 from exam_lab.grader.score.runs import judged_run, warned_in_long_excursion, warning_latency
 from exam_lab.harness.supervisor import Supervisor, end_pids, marked
 from exam_lab.harness.wait import wait_until
@@ -128,9 +128,8 @@ def read_run(log_dir, tag, sup):
     :raises RuntimeError: when it wrote none (its master did not start...): the session fails, as
         it does when that happens to a run flown in this process."""
     try:
-        with open(run_file(log_dir, tag)) as f:
-            return json.load(f)
-    except (OSError, ValueError):
+        return json.loads(contract.read_text(run_file(log_dir, tag), SessionRecord.MAX_BYTES))
+    except (contract.ContractError, ValueError):
         raise RuntimeError('the %s run failed: %s' % (tag, tail(sup.output('run-%s' % tag), 10)))
 
 
@@ -146,12 +145,10 @@ def run_alone(job, tag, seconds):
     with watch.stage(tag):
         with Supervisor(job.log_dir, env=judge_environment(judge_home, box), marker=run_marker(job.log_dir, tag)) as sup:
             record = run_one(sup, job, run, base_environment(job), box, budget)
-    with open(run_file(job.log_dir, tag) + '.part', 'w') as f:
-        json.dump(record, f)
-    os.rename(run_file(job.log_dir, tag) + '.part', run_file(job.log_dir, tag))
+    contract.write_text(run_file(job.log_dir, tag), json.dumps(record))
     watch.extra['tag'] = tag
-    with open(os.path.join(job.log_dir, 'timings-%s.json' % tag), 'w') as f:
-        json.dump(watch.value(), f)
+    watch.write(job.log_dir, 'timings-%s.json' % tag)
+
 
 def main(argv):
     if len(argv) != 3 or argv[1] not in ('main', 'threshold'):

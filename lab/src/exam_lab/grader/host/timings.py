@@ -68,17 +68,17 @@ class Stopwatch(object):
     def value(self):
         return dict(self.extra, stages=self.stages)
 
-    def write(self, folder):
-        """``<folder>/timings.json``, written whole by the contract's writer (a reader never sees half of
-        it; in OUT, never through an entry there)."""
-        contract.write_text(os.path.join(folder, FILE), json.dumps(self.value(), indent=1, sort_keys=True))
+    def write(self, folder, name=FILE):
+        """``<folder>/<name>`` (timings.json), written whole by the contract's writer (a reader never sees
+        half of it; in OUT, never through an entry there)."""
+        contract.write_text(os.path.join(folder, name), json.dumps(self.value(), indent=1, sort_keys=True))
 
 
-def read(folder):
-    """The timings a grading's session wrote in ``folder`` (its own file, never a box's), read through
-    the contract, or {}."""
+def read(folder, name=FILE):
+    """The timings a grading's session (or one of its runs) wrote as ``<folder>/<name>`` (its own file,
+    never a box's), read through the contract, or {}."""
     try:
-        value = json.loads(contract.read_text(os.path.join(folder, FILE), MAX_BYTES))
+        value = json.loads(contract.read_text(os.path.join(folder, name), MAX_BYTES))
         return value if isinstance(value, dict) else {}
     except (contract.ContractError, ValueError):
         return {}
