@@ -188,6 +188,30 @@ def test_threshold_run_flown_as_the_main_run():
     assert rubric.threshold_run_value(STATIC, measured(threshold_run=False)) is None
 
 
+def test_a_threshold_run_whose_node_never_received_an_input_is_not_disobedience():
+    """CI, 2026-12-02 (float64_pressure): the drone's /pressure re-typed for the node connected in the
+    main run, never in the threshold run, so the node published nothing there; Q14a then read "it does
+    not obey the parameter". A run in which the grader's drone did not reach the node shows nothing of
+    it: Q14a is judged from the code and says why, as for a node that never came."""
+    session = measured(threshold_shape='main')
+    refused = {'type': 'std_msgs/Float64', 'refused': 'rospy refused the connection: the node asked for '
+               'std_msgs/Float64, the drone publishes std_msgs/Float32', 'published': 'std_msgs/Float32'}
+    temperature = {'type': 'std_msgs/Float32', 'connected': True, 'refused': None, 'adapted': None}
+    session['runs'][0]['probe']['input_types'] = {
+        '/pressure': dict(refused, connected=True, adapted='std_msgs/Float64'), '/temperature': temperature}
+    threshold = session['runs'][1]['probe']
+    threshold.update(calls=[], input_types={'/pressure': dict(refused, connected=False, adapted=None),
+                                            '/temperature': temperature})
+    threshold['trace'] = {'published': [], 'oracle': []}
+    evidence = _item(rubric.score('altitude', STATIC, session), 'Q14a')['evidence']
+    assert 'its effect could not be observed (in the threshold run the node never received /pressure' in evidence
+    assert 'judged from the code' in evidence and 'does not obey' not in evidence
+    assert lost(session)['Q14a'] == 0.5
+    # The same inputs connected in both runs: judged on the flight, as before.
+    threshold['input_types']['/pressure'] = dict(refused, connected=True, adapted='std_msgs/Float64')
+    assert 'does not obey' in _item(rubric.score('altitude', STATIC, session), 'Q14a')['evidence']
+
+
 def test_a_threshold_run_whose_node_never_came_is_a_doubt_never_a_second_loss():
     """Issue 45: the same package and code as the main run, only the threshold changed, and its node never
     registered (no death seen): the machine's doing as far as the grader can tell (a start under heavy

@@ -132,6 +132,15 @@ def refused_inputs(probe):
     return sorted(t for t, info in (probe_of(probe).input_types or {}).items() if info and info.refused)
 
 
+def inputs_lost(main, other):
+    """The input topics the node received in the ``main`` run's probe but not in the ``other`` run's (the
+    grader's drone, re-typed for it or not, never connected there): that run shows nothing of the node.
+    An input the other run does not list (a result kept before inputs were listed) is not said lost."""
+    before, after = probe_of(main).input_types or {}, probe_of(other).input_types or {}
+    return sorted(t for t, info in before.items() if info and info.connected and
+                  after.get(t) is not None and not after.get(t).connected)
+
+
 def adapted_inputs(probe):
     """The grader's fixes for refused subscriptions, one line each: the inputs its drone published in
     the type the node asked for (:meth:`exam_lab.grader.judge.node.NodeFinder.input_types`)."""

@@ -10,8 +10,8 @@ and gives the item's ``{"id", "points", "max", "evidence"}``. The windows are re
 import math
 
 from exam_lab.grader.score import flight
-from exam_lab.grader.score.measured import (item, main_probe, no_node_words, node_ran, not_run, otherwise, stayed_up,
-                                            threshold_probe, unstarted_runs)
+from exam_lab.grader.score.measured import (inputs_lost, item, main_probe, no_node_words, node_ran, not_run, otherwise,
+                                            stayed_up, threshold_probe, unstarted_runs)
 from exam_lab.grader.score.sheets import DELAY, REQUESTS, SHEETS
 from exam_lab.grader.score.tolerances import LOOP_REPEATS, NORMAL_LATE_S, WARNING_EARLY_S
 
@@ -125,6 +125,12 @@ def score_q14a(sheet, static, session):
                % no_node_words(probe2) if unstarted else skipped or threshold.not_rewritable or 'the threshold run failed')
         return item('Q14a', static_points, '%s = %s in the launch file; its effect could not be observed (%s); '
                     'judged from the code: %s' % (what, threshold.value, why, static_note))
+    lost = inputs_lost(main_probe(session), probe2)
+    if lost:  # the grader's drone did not reach the node there: nothing of the parameter was seen
+        return item('Q14a', static_points, '%s = %s in the launch file; its effect could not be observed (in the '
+                    'threshold run the node never received %s, which it received in the main run: the grader\'s '
+                    'drone did not reach it); judged from the code: %s' % (what, threshold.value, ', '.join(lost),
+                                                                         static_note))
     schedule = probe2.schedule or {}
     # The threshold run flies the main run's legs (its long excursion above the new value, below the
     # launch file's); measurements kept from before flew a single step.
