@@ -93,6 +93,37 @@ def test_the_bounds_check_catches_a_stale_value():
     assert bounds_quoted(text)[-1] == '2 GB'
 
 
+def probe_waits_quoted(text):
+    """The probe's waits for the node as the Isolation step lists them: (roslaunch's start, the
+    registration, the second input, an input's connection or refusal, a re-typed input's first try, its
+    bound, the output publisher), or None."""
+    match = re.search(r"roslaunch's own start on the master \(([\d.]+) s\), the node's registration \(([\d.]+) s "
+                      r"from then\), its second input's subscription \(([\d.]+) s\), each input's connection or "
+                      r"rospy's refusal of it \(([\d.]+) s\), an input re-typed for the node \(registered anew "
+                      r"until it connects, each try twice as long as the last from ([\d.]+) s, ([\d.]+) s in all\), "
+                      r"its output publisher \(([\d.]+) s\)", text)
+    return match.groups() if match else None
+
+
+def expected_probe_waits():
+    pytest.importorskip('rospy')
+    from exam_lab.grader.judge import node
+    return tuple(seconds(v) for v in (node.LAUNCH_START_S, runner.START_TIMEOUT, node.SUBSCRIBE_S, node.SETTLE_S,
+                                      node.RETYPE_S, node.ADAPT_S, node.OUTPUT_S))
+
+
+def test_grading_quotes_the_probes_waits_for_the_node():
+    assert probe_waits_quoted(prose(read(GRADING))) == expected_probe_waits()
+
+
+def test_the_probe_waits_check_catches_a_stale_bound():
+    text = ("roslaunch's own start on the master (60 s), the node's registration (20 s from then), its second "
+            "input's subscription (6 s), each input's connection or rospy's refusal of it (3 s), an input re-typed "
+            "for the node (registered anew until it connects, each try twice as long as the last from 1 s, 15 s "
+            "in all), its output publisher (3 s)")
+    assert probe_waits_quoted(text)[3] == '3' != expected_probe_waits()[3]
+
+
 def test_default_jobs_is_quoted_as_the_code_computes_it():
     # The docs quote default_jobs's measured CPU of a grading and its share of the cores.
     text = prose(read(GRADING) + read(os.path.join(REPO, 'docs', 'benchmarks.md')))

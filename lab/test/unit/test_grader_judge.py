@@ -157,7 +157,7 @@ def test_a_node_that_subscribes_to_each_input_in_turn_subscribes_to_both(monkeyp
             turn = '/temperature' if (polls['n'] // 6) % 2 == 0 else '/pressure'
             return ['/exam'] if topic == turn else []
 
-    monkeypatch.setattr(node.NodeFinder, 'input_types', lambda self, inputs, timeout=3.0: {})
+    monkeypatch.setattr(node.NodeFinder, 'input_types', lambda self, inputs: {})
     drone = types.SimpleNamespace(fixed_topic='temperature', moving_topic='pressure')
     plan = types.SimpleNamespace(start_timeout=1.0)
     found = node.NodeFinder(plan, Graph(), None, drone, 0.0).wait_for_node()
@@ -174,7 +174,7 @@ def test_the_nodes_start_counts_from_roslaunchs(monkeypatch):
     import types
     from exam_lab.grader.judge import node
     monkeypatch.setattr(node, 'LAUNCH_START_S', 0.5)
-    monkeypatch.setattr(node.NodeFinder, 'input_types', lambda self, inputs, timeout=3.0: {})
+    monkeypatch.setattr(node.NodeFinder, 'input_types', lambda self, inputs: {})
     monkeypatch.setattr(node, 'SUBSCRIBE_S', 0.1)
     drone = types.SimpleNamespace(fixed_topic='temperature', moving_topic='pressure')
 
@@ -216,6 +216,53 @@ def test_the_nodes_start_counts_from_roslaunchs(monkeypatch):
     monkeypatch.setattr(node, 'LAUNCH_START_S', 3600.0)
     ended = found(Graph(launch_after=None, node_after=None), start_timeout=3600.0, launch_ended=lambda: True)
     assert ended['nodes'] == [] and ended['launch_seen_s'] is None
+
+
+def test_a_slow_machine_still_gets_the_nodes_type_refused_then_adapted(monkeypatch):
+    """Under load rospy's connection threads run late: a node's refusal of /pressure (it asked for
+    Float64) came after the 3 s the probe waited, and the publisher re-typed for it was registered
+    anew every second, each time before the node's connection to it could finish. The node's question
+    10 was then right but every value lost. The probe waits for the refusal up to SETTLE_S, and each try
+    of the re-typed publisher waits twice the last, so a connection slower than one try gets through.
+    Scaled times; every wait ends on its event."""
+    pytest.importorskip('rospy')
+    import time
+    import types
+    from exam_lab.grader.judge import node
+    monkeypatch.setattr(node, 'SETTLE_S', 5.0)
+    monkeypatch.setattr(node, 'RETYPE_S', 0.2)
+    monkeypatch.setattr(node, 'ADAPT_S', 5.0)
+    start, handshake = time.time(), 0.3  # the refusal comes after 0.5 s; a connection takes 0.3 s
+
+    class Graph(object):
+        def subscribers(self, topic):
+            return ['/exam']
+
+    class Refusals(object):
+        def refused(self):
+            late = time.time() - start > 0.5
+            return {'/pressure': {'node': '/exam', 'wanted': 'std_msgs/Float64',
+                                  'published': 'std_msgs/Float32'}} if late else {}
+
+    class Feeder(object):
+        retyped, tries = None, 0
+
+        def retype(self, name, msg_class):
+            assert name == 'pressure' and msg_class is node.VALUE_TYPES['std_msgs/Float64']
+            self.retyped, self.tries = time.time(), self.tries + 1
+
+        def connections(self, name):
+            if name == 'temperature':
+                return 1
+            return int(self.retyped is not None and time.time() - self.retyped >= handshake)
+
+    feeder = Feeder()
+    finder = node.NodeFinder(None, Graph(), Refusals(), types.SimpleNamespace(feeder=feeder), start)
+    found = finder.input_types({'/temperature': 'temperature', '/pressure': 'pressure'})
+    assert found['/pressure']['refused'] and found['/pressure']['connected'] is True
+    assert found['/pressure']['adapted'] == 'std_msgs/Float64'
+    assert found['/temperature'] == {'type': 'std_msgs/Float32', 'connected': True, 'refused': None, 'adapted': None}
+    assert feeder.tries == 2  # cut once at 0.2 s, connected within the next try's 0.4 s
 
 
 def _calibrated(slope):

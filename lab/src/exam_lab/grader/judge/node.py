@@ -17,8 +17,14 @@ from exam_lab.harness.wait import wait_until
 LAUNCH_START_S = 60.0
 #: Seconds to wait for the second input's subscription once the node is up.
 SUBSCRIBE_S = 6.0
-#: Seconds a publisher in the node's type waits for its connection before it is registered anew.
+#: Seconds to wait for each subscribed input to connect or be refused: rospy connects in its own
+#: threads, which a loaded machine runs late (over 3 s seen with two classes graded at once).
+SETTLE_S = 15.0
+#: Seconds a publisher in the node's type first waits for its connection before it is registered anew;
+#: each new try waits twice as long (a connection slower than one wait is not cut at every try).
 RETYPE_S = 1.0
+#: Seconds the node has to connect to the publishers re-typed for it.
+ADAPT_S = 15.0
 #: Seconds to wait for the output publisher once the node subscribed.
 OUTPUT_S = 3.0
 #: Message types the probe can read values from: every numeric std_msgs type (the sheet names none).
@@ -72,10 +78,10 @@ class NodeFinder(object):
         found['input_types'] = self.input_types(dict(zip(inputs, (self.drone.fixed_topic, self.drone.moving_topic))))
         return found
 
-    def input_types(self, inputs, timeout=3.0):
+    def input_types(self, inputs):
         """{input topic: {"type" the node subscribed with, "connected", "refused", "adapted"}}: a
         subscription rospy refused (another type than the drone's) shows as no connection and a refusal
-        in our log. Waits up to ``timeout`` s for each subscribed input to connect or be refused.
+        in our log. Waits up to SETTLE_S for each subscribed input to connect or be refused.
 
         A refused input the node asked for as another numeric std_msgs type is then published in that
         type (``adapted``: the type, once the node connected to it), as a teacher would change one word to
@@ -87,21 +93,21 @@ class NodeFinder(object):
         def settled():
             return all(not self.graph.subscribers(t) or feeder.connections(name) > 0 or t in self.refusals.refused()
                        for t, name in inputs.items())
-        wait_until(settled, timeout, period=0.1)
+        wait_until(settled, SETTLE_S, period=0.1)
         refused = self.refusals.refused()
         adapted = {t: refused[t]['wanted'] for t in inputs
                    if t in refused and refused[t]['wanted'] in VALUE_TYPES and refused[t]['wanted'] != 'std_msgs/Float32'}
         # The node's subscriber may still hold the refused connection when the master tells it of the new
         # publisher (rospy then skips a publisher it thinks it is connected to): a publisher not
-        # connected within RETYPE_S is registered anew, until SUBSCRIBE_S.
-        deadline = time.time() + SUBSCRIBE_S
+        # connected within its wait is registered anew, each wait twice the last, until ADAPT_S.
+        deadline, wait = time.time() + ADAPT_S, RETYPE_S
         waiting = sorted(adapted)
         while waiting and time.time() < deadline:
             for topic in waiting:
                 feeder.retype(inputs[topic], VALUE_TYPES[adapted[topic]])
             wait_until(lambda: all(feeder.connections(inputs[t]) > 0 for t in waiting),
-                       min(RETYPE_S, max(0.0, deadline - time.time())), period=0.05)
-            waiting = [t for t in waiting if feeder.connections(inputs[t]) == 0]
+                       min(wait, max(0.0, deadline - time.time())), period=0.05)
+            waiting, wait = [t for t in waiting if feeder.connections(inputs[t]) == 0], 2 * wait
         out = {}
         for topic, name in sorted(inputs.items()):
             connected = feeder.connections(name) > 0
