@@ -13,7 +13,9 @@ puts each grade.md, verbatim, between its markers in docs/grading.md
 no_kelvin is graded from a folder named as Moodle's "download all submissions" names one
 (FEEDBACK_FOLDER), and its student's feedback page, as ``moodle-feedback.zip`` holds it with the
 evidence shown, is written to docs/feedback_example.html; the markers ``<!-- example feedback ... -->``
-get the zip's folder name. lab/test/grader/test_page_browser.py opens that page in Chromium.
+get the zip's folder name, and its screenshot is docs/figures/feedback_page.png (headless Chromium, the
+PNG tagged with the page's digest: lab/report/screenshots.py). lab/test/grader/test_page_browser.py
+opens that page in Chromium.
 """
 import os
 import re
@@ -24,6 +26,8 @@ import zipfile
 
 from exam_lab.grader import runner
 from exam_lab.grader.publish import feedback
+
+import screenshots
 
 # realpath: a test imports this from the workspace's src/ link, and docs/ is the repository's.
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
@@ -85,7 +89,9 @@ def main(argv=None):
                 with open(FEEDBACK_PAGE, 'w') as f:
                     f.write(page)
                 text = splice(text, 'feedback', '%s/%s' % (zipped, feedback.PAGE), fence='text')
-                print('grading_examples: %s written' % os.path.relpath(FEEDBACK_PAGE, REPO))
+                screenshots.take(FEEDBACK_PAGE, screenshots.FEEDBACK_PNG, (1000, 1750), screenshots.digest(FEEDBACK_PAGE))
+                print('grading_examples: %s and %s written' % (os.path.relpath(FEEDBACK_PAGE, REPO),
+                                                             os.path.relpath(screenshots.FEEDBACK_PNG, REPO)))
     with open(GRADING, 'w') as f:
         f.write(text)
     print('grading_examples: docs/grading.md written')

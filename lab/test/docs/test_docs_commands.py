@@ -209,6 +209,24 @@ def test_the_noise_free_peak_is_equation_ones():
     assert len(noise_free_peak_problems('its noise-free estimate peaks at 1476.6 m')) == 1
 
 
+def report_peak_problems(architecture, report):
+    """architecture.md's highest value of the report's run against the one report.md was generated with
+    (lab/report/render.py's ``flight.max``)."""
+    flat = re.sub(r'\s+', ' ', architecture)
+    generated = re.findall(r'its estimate peaks at ([\d.]+) m \(appendix B\)', re.sub(r'\s+', ' ', report))
+    quoted = re.findall(r"the report's run saw up to ([\d.]+) m", flat)
+    return [] if len(generated) == 1 and quoted == generated else [
+        'architecture.md quotes %s m, the report\'s run peaked at %s m' % (quoted, generated)]
+
+
+def test_the_report_runs_peak_is_the_reports():
+    architecture = _read(os.path.join(REPO, 'docs', 'architecture.md'))
+    report = _read(os.path.join(REPO, 'docs', 'report.md'))
+    assert report_peak_problems(architecture, report) == []
+    assert len(report_peak_problems(architecture, re.sub(r'peaks at [\d.]+ m \(appendix B', 'peaks at 1480.2 m (appendix B',
+                                                         report))) == 1
+
+
 def window_problems(text):
     """grading.md's widths of question 14b's WARNING window and the short excursion's longest time
     above, per sheet (altitude, depth): from the rubric's tolerances and the drones' rates."""
@@ -227,6 +245,21 @@ def window_problems(text):
             legs.SHORT_S, above[0], above[1], start) not in text:
         problems.append('the short excursion: %s s / %s s < %s s' % (above[0], above[1], start))
     return problems
+
+
+def ours_excursion_problems(grading):
+    """The legs table's "3.0 s excursion above" for ours is what the example grade of ours says."""
+    ours = grading[grading.index('<!-- example ours:'):grading.index('<!-- end of example ours -->')]
+    said = re.findall(r'(\d+\.\d) s excursion above: no WARNING', ours)
+    quoted = re.findall(r'grade\.md\'s "(\d+\.\d) s excursion above" for ours', grading)
+    return [] if said and quoted == said[:1] else ['the legs table says %s s for ours, its grade %s s' % (quoted, said)]
+
+
+def test_the_short_excursion_of_ours_is_its_example_grades():
+    grading = _read(os.path.join(REPO, 'docs', 'grading.md'))
+    assert ours_excursion_problems(grading) == []
+    assert len(ours_excursion_problems(re.sub(r'"\d+\.\d s excursion above" for ours', '"9.9 s excursion above" for ours',
+                                              grading))) == 1
 
 
 def test_the_windows_quoted_are_the_rubrics():
@@ -299,7 +332,8 @@ def test_the_fairness_counts_are_the_generators():
 def bench_figure_problems(grading, bench):
     """The figures docs/grading.md derives from the grader's benchmark record (lab/bench/grader.md, made
     by grader_bench.py --record): the run's load average, the class of 60 at the default JOBS against the
-    worst case, and the Slurm course's waves of a correct student's time alone. When the benchmark runs
+    worst case, and the Slurm course's waves of a correct student's time alone (and the file system's
+    load over them). When the benchmark runs
     again, this test names each figure to write anew."""
     from exam_lab.grader import class_run
     flat = re.sub(r'\s+', ' ', grading)
@@ -316,6 +350,11 @@ def bench_figure_problems(grading, bench):
         'A correct student takes %d s graded alone' % seconds,
         'about 10 x %d s = %.1f minutes once the tasks start' % (seconds, 10 * seconds / 60.0),
         'twenty waves of %d s, %.1f minutes' % (seconds, 20 * seconds / 60.0),
+        # 1,000 students' 0.8 GB read, 150 MB written and 12 million metadata operations over the waves
+        'over the %.1f minutes (%.1f MB/s and %.1f MB/s' % (10 * seconds / 60.0, 800.0 / (10 * seconds),
+                                                            150.0 / (10 * seconds)),
+        'about 12 million metadata operations (about {:,} a second)'.format(
+            int(round(12e6 / (10 * seconds), -3))),
     ]
     return ['not said (from lab/bench/grader.md): %s' % e for e in expected if e not in flat]
 
@@ -329,21 +368,31 @@ def test_the_figures_from_the_grader_benchmark_are_its_records():
         'not said (from lab/bench/grader.md): load average 9.99 at the start of the run, %s at its end' % end]
 
 
-def leg_name_problems(grading):
-    """The plot's leg names (publish/flightplot.py LEG_NAMES) against the first column of the manual's
-    table of the legs, in the flight's order."""
+def leg_name_problems(grading, words=None):
+    """The plot's leg names (publish/flightplot.py LEG_NAMES) and grade.md's (score/flight.py LEG_WORDS:
+    the name and its side) against the first column of the manual's table of the legs, in the flight's order."""
     from exam_lab.grader.publish import flightplot
+    from exam_lab.grader.score import flight
+    words = flight.LEG_WORDS if words is None else words
     section = grading[grading.index('### The legs of the flight'):]
     table = re.findall(r'^\| ([a-z][a-z ]+) \| ', section, re.M)
-    names = [flightplot.LEG_NAMES[leg] for leg in ('rest', 'short_up', 'short_down', 'long_up', 'long_down', 'deep_down')]
+    legs = ('rest', 'short_up', 'short_down', 'long_up', 'long_down', 'deep_down')
+    names = [flightplot.LEG_NAMES[leg] for leg in legs]
     manual = [name for name in table if name != 'leg'][:len(names)]
-    return [] if manual == names else ['the manual names the legs %s, the plot %s' % (manual, names)]
+    problems = [] if manual == names else ['the manual names the legs %s, the plot %s' % (manual, names)]
+    said = [re.sub(r' (above|below)$', '', words[leg]) if words[leg] not in manual else words[leg] for leg in legs]
+    return problems + ([] if said == manual else ['the manual names the legs %s, grade.md %s' % (manual, said)])
 
 
 def test_the_plots_leg_names_are_the_manuals():
     grading = _read(os.path.join(REPO, 'docs', 'grading.md'))
     assert leg_name_problems(grading) == []
-    assert len(leg_name_problems(grading.replace('| just below | just below |', '| gap below | just below |'))) == 1
+    assert len(leg_name_problems(grading.replace('| just below | just below |', '| gap below | just below |'))) == 2
+    from exam_lab.grader.score import flight
+    assert leg_name_problems(grading, dict(flight.LEG_WORDS, short_down='gap below')) == [
+        "the manual names the legs ['rest', 'short excursion', 'just below', 'long excursion', 'return just below', "
+        "'further below'], grade.md ['rest', 'short excursion', 'gap', 'long excursion', 'return just below', "
+        "'further below']"]
 
 
 def test_the_plot_counts_the_calls_grade_md_counts(tmp_path, monkeypatch):

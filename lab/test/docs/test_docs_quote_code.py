@@ -23,6 +23,7 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.r
 sys.path.insert(0, os.path.join(REPO, 'lab', 'report'))
 
 import calibration  # noqa: E402  (lab/report is a script folder, not a package)
+import screenshots  # noqa: E402
 
 GRADER = os.path.join(REPO, 'lab', 'src', 'exam_lab', 'grader')
 GRADING = os.path.join(REPO, 'docs', 'grading.md')
@@ -164,6 +165,32 @@ def test_the_example_grades_were_scored_by_todays_rubric():
     assert quoted, 'docs/grading.md shows no example grade with its provenance'
     assert set(quoted) == {provenance.rubric_version()}, (
         'the example grades were scored by another rubric: run lab/report/grading_examples.py')
+
+
+# --- the page figures -----------------------------------------------------------------------------
+
+def test_the_feedback_figure_is_a_screenshot_of_the_example_page_beside_it():
+    """docs/figures/feedback_page.png is taken of docs/feedback_example.html by grading_examples.py."""
+    assert screenshots.tag(screenshots.FEEDBACK_PNG) == screenshots.digest(
+        os.path.join(REPO, 'docs', 'feedback_example.html')), (
+        'docs/figures/feedback_page.png is not of docs/feedback_example.html: run lab/report/grading_examples.py')
+
+
+def test_the_class_page_figure_was_taken_with_todays_page_code():
+    assert screenshots.tag(screenshots.PAGE_PNG) == screenshots.page_code_digest(), (
+        'the code that draws the class page changed since docs/figures/grader_page.png was taken: '
+        'GRADER_PAGE_SCREENSHOT=docs/figures/grader_page.png python3 -m pytest lab/test/grader/test_page_browser.py')
+
+
+def test_the_figure_tag_check_catches_an_untagged_and_a_retagged_png(tmp_path):
+    with open(screenshots.PAGE_PNG, 'rb') as f:
+        data = f.read()
+    plain = tmp_path / 'plain.png'
+    plain.write_bytes(data.replace(screenshots.KEY, b'other-sourcekey'))
+    assert screenshots.tag(str(plain)) is None
+    other = tmp_path / 'other.png'
+    other.write_bytes(screenshots.tagged(plain.read_bytes(), 'a stale digest'))
+    assert screenshots.tag(str(other)) == 'a stale digest' != screenshots.page_code_digest()
 
 
 # --- the grader's modules --------------------------------------------------------------------------

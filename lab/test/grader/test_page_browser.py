@@ -6,14 +6,15 @@ students' pages of OUT/moodle-feedback.zip, and docs/feedback_example.html, the 
 loaded or logged, the plot drawn, the threshold run's value in none.
 
 Chromium is installed by tools/install_deps.sh (Debian's ``chromium``); without it the test is
-skipped, saying so. GRADER_PAGE_SCREENSHOT=<path> keeps the screenshot (docs/figures/grader_page.png),
-GRADER_FEEDBACK_SCREENSHOT=<path> the example feedback page's (docs/figures/feedback_page.png).
+skipped, saying so. GRADER_PAGE_SCREENSHOT=docs/figures/grader_page.png retakes the class page's figure,
+tagged by lab/report/screenshots.py (the example feedback page's figure is lab/report/grading_examples.py's).
 """
 import json
 import os
 import re
 import shutil
 import subprocess
+import sys
 import zipfile
 
 import pytest
@@ -22,6 +23,9 @@ from exam_lab.grader.publish import feedback
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 DOCS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(HERE))), 'docs')
+sys.path.insert(0, os.path.join(os.path.dirname(DOCS), 'lab', 'report'))
+
+import screenshots  # noqa: E402  (lab/report is a script folder, not a package)
 CHROMIUM = shutil.which('chromium') or shutil.which('chromium-browser')
 #: The two students whose feedback pages are opened: the good student (its report.pdf of two pages)
 #: and one who lost points.
@@ -121,7 +125,8 @@ def test_a_screenshot_of_the_page(graded, tmp_path):
     assert (int.from_bytes(head[16:20], 'big'), int.from_bytes(head[20:24], 'big')) == (1280, 2300)
     assert os.path.getsize(shot) > 50000  # a page with plots, not a blank one
     if os.environ.get('GRADER_PAGE_SCREENSHOT'):
-        shutil.copyfile(shot, os.environ['GRADER_PAGE_SCREENSHOT'])
+        screenshots.take(os.path.join(out, 'index.html'), os.environ['GRADER_PAGE_SCREENSHOT'], (1280, 2300),
+                         screenshots.page_code_digest())
 
 
 #: Appended to a copy of a feedback page without its Content-Security-Policy (which lets no script run):
@@ -215,5 +220,3 @@ def test_the_docs_example_feedback_page_in_a_browser(tmp_path):
     with open(shot, 'rb') as f:
         head = f.read(24)
     assert head[:8] == b'\x89PNG\r\n\x1a\n' and os.path.getsize(shot) > 30000
-    if os.environ.get('GRADER_FEEDBACK_SCREENSHOT'):
-        shutil.copyfile(shot, os.environ['GRADER_FEEDBACK_SCREENSHOT'])

@@ -11,9 +11,9 @@ from exam_lab.grader.score.sheets import DELAY, REQUESTS, request_meaning
 from exam_lab.grader.score.tolerances import (LAG_SLACK_S, OLD_SLOWEST_HZ, RATE_HZ, RATE_TOLERANCE, WARNING_EARLY_S,
                                               WARNING_LATE_S)
 
-#: The legs of the flights, in words.
-LEG_WORDS = {'rest': 'rest below', 'short_up': 'short excursion above', 'short_down': 'gap below',
-             'long_up': 'long excursion above', 'long_down': 'return just below', 'deep_down': 'return further below',
+#: The legs of the flights, in words: docs/grading.md's names of the legs (and the plot's), with their side.
+LEG_WORDS = {'rest': 'rest below', 'short_up': 'short excursion above', 'short_down': 'just below',
+             'long_up': 'long excursion above', 'long_down': 'return just below', 'deep_down': 'further below',
              'start': 'start below',
              'step': 'step above the new threshold'}
 
