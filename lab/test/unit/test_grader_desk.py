@@ -125,6 +125,18 @@ def test_page_has_one_row_per_student_and_the_teacher_first(tmp_path):
     assert text.count('<rect ') == 18  # the histogram: one bar per point, 0 to 17
 
 
+def test_the_page_lists_the_students_a_note_names_under_it():
+    """"moodle feedback: 2 student(s) left out ...:" and its indented lines, as on the terminal."""
+    notes = ['worksheet: 2 grades', 'moodle feedback: 2 student(s) left out (the teacher must still look at them):',
+             '  Ada: status "not graded"', '  Bob <x>: status "needs a hand grade"', 'similarity: 3 pairs', '  odd']
+    text = page.render([record('Ada')], 'Class', {}, None, notes)
+    section = text[text.index('id="notes"'):text.index('id="histogram"')]
+    assert ('<li>moodle feedback: 2 student(s) left out (the teacher must still look at them):<ul>'
+            '<li>Ada: status &quot;not graded&quot;</li><li>Bob &lt;x&gt;: status &quot;needs a hand grade&quot;</li>'
+            '</ul></li>') in section.replace('&#x27;', "'")
+    assert '<li>similarity: 3 pairs</li><li>odd</li>' in section  # under a line that names no list: its own item
+
+
 def test_markdown_of_a_grade_renders_its_table():
     html = page.markdown_html(report.markdown(record('Jane', {'Q11': 1.5})))
     assert html.count('<tr>') == 1 + len(ITEMS) + 1  # header, items, total

@@ -149,6 +149,19 @@ def _status_cell(record):
         re.sub(r'\W+', '-', status), _e(record.get('status_reason', '')), _e(status))
 
 
+def _notes(notes):
+    """The desk's lines as a list; a line indented under one ending in ":" (each student a line names:
+    "moodle feedback: 3 student(s) left out ...:") is an item of that line's own list, as on the terminal."""
+    items = []
+    for note in notes:
+        if note.startswith('  ') and items and items[-1][0].endswith(':'):
+            items[-1][1].append(note.strip())
+        else:
+            items.append((note.strip(), []))
+    return '<ul>%s</ul>' % ''.join('<li>%s%s</li>' % (_e(n), '<ul>%s</ul>' % ''.join('<li>%s</li>' % _e(s) for s in sub)
+                                                      if sub else '') for n, sub in items)
+
+
 def render(records, title, entries, similar=None, notes=None):
     """The page's HTML, of records only: every text it shows was made safe where it was made, and is
     escaped here for HTML, never cleaned again.
@@ -201,7 +214,7 @@ def render(records, title, entries, similar=None, notes=None):
         parts.append('<p>Nobody: every submission was graded by the machine.</p>')
     if notes:
         parts.append('<h2 id="notes">Hand points, Moodle worksheet and checks</h2>')
-        parts.append('<ul>%s</ul>' % ''.join('<li>%s</li>' % _e(n) for n in notes))
+        parts.append(_notes(notes))
     parts.append('<h2 id="histogram">Totals</h2>')
     parts.append(histogram_svg(totals, maximum))
     parts.append('<h2 id="table">Students and items</h2><p>Click a column to sort.</p>')
