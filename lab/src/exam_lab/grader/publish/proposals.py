@@ -19,7 +19,7 @@ import json
 import os
 
 from exam_lab.grader import contract
-from exam_lab.grader.publish import cells
+from exam_lab.grader.publish import cells, moodle
 from exam_lab.grader.score import answers, code_items, kept, records, safe_text
 from exam_lab.grader.score.records import ReportRecord
 from exam_lab.grader.score.reference import ReferenceRecord, facts, reference_file
@@ -124,7 +124,8 @@ def write(out, grade_records, single=False):
         if ref is None:
             lines.append('proposals of sheet %s: the answers were not compared with the drone: %s' % (sheet, why))
     lines.append('proposals: %s (%s): the teacher confirms them on make review OUT=%s' % (
-        os.path.join(out, FILE), ', '.join('%d %s' % (n, s) for s, n in sorted(states.items())) or 'none', out))
+        os.path.join(out, FILE), ', '.join('%d %s' % (n, s) for s, n in sorted(states.items())) or 'none',
+        moodle.shell_quoted(out)))
     return lines
 
 
