@@ -8,6 +8,7 @@ its targets are the Makefile's, and each ``VAR=value`` one the Makefile reads. E
 failing on a planted error first.
 """
 import glob
+import json
 import os
 import re
 import shlex
@@ -366,6 +367,42 @@ def test_the_figures_from_the_grader_benchmark_are_its_records():
     start, end = re.search(r'at start ([\d.]+), [\d.]+, [\d.]+, at end ([\d.]+),', bench).groups()
     assert bench_figure_problems(grading, bench.replace('at start %s' % start, 'at start 9.99')) == [
         'not said (from lab/bench/grader.md): load average 9.99 at the start of the run, %s at its end' % end]
+
+
+#: The class-only runs of 2026-12-03 that grading.md's Speed quotes, and the full run they compare with.
+CLASS_RUNS = ('grader-class-1203-jobs4.json', 'grader-class-1203-jobs6.json')
+
+
+def class_run_problems(grading, runs, alone):
+    """grading.md's figures of the class-only runs (``runs``: [results.json of grader_bench.py
+    --no-alone]): each class's wall time and CPU a grading, and that every copy got the points of its
+    package in ``alone`` (the recorded full run's results)."""
+    flat, problems = re.sub(r'\s+', ' ', grading), []
+    for run in runs:
+        for c in run['classes']:
+            said = '`JOBS=%d` **%.0f s' % (c['jobs'], c['wall'])
+            cpu = '%.1f s of CPU a grading' % (c['cpu'] / c['students'])
+            for phrase in (said, cpu):
+                if phrase not in flat:
+                    problems.append('not said: %s (JOBS=%d)' % (phrase, c['jobs']))
+            moved = [r['student'] for r in c['rows'] if r['points'] != alone['alone'][r['kind']]['points']]
+            if moved:
+                problems.append('JOBS=%d: %s did not get the points of their package alone' % (c['jobs'], moved))
+    return problems
+
+
+def test_the_class_runs_quoted_are_their_records():
+    grading = _read(os.path.join(REPO, 'docs', 'grading.md'))
+    history = os.path.join(REPO, 'lab', 'bench', 'history')
+    runs = [json.loads(_read(os.path.join(history, name))) for name in CLASS_RUNS]
+    alone = json.loads(_read(os.path.join(REPO, 'lab', 'bench', 'grader_results.json')))
+    assert all(name in grading for name in ('grader-class-1203-jobs4.json', 'grader-class-1203-jobs6.json'))
+    assert class_run_problems(grading, runs, alone) == []
+    assert class_run_problems(grading.replace('**773 s', '**770 s'), runs, alone) == ['not said: `JOBS=4` **773 s (JOBS=4)']
+    row = dict(runs[0]['classes'][0]['rows'][0])
+    changed = dict(runs[0], classes=[dict(runs[0]['classes'][0], rows=[dict(row, points=dict(row['points'], Q11=0))])])
+    assert class_run_problems(grading, [changed], alone) == [
+        'JOBS=4: [%r] did not get the points of their package alone' % row['student']]
 
 
 def leg_name_problems(grading, words=None):
