@@ -26,7 +26,8 @@ DOCS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(HERE))), 'do
 sys.path.insert(0, os.path.join(os.path.dirname(DOCS), 'lab', 'report'))
 
 import screenshots  # noqa: E402  (lab/report is a script folder, not a package)
-CHROMIUM = shutil.which('chromium') or shutil.which('chromium-browser')
+
+CHROMIUM = screenshots.chromium()
 #: The two students whose feedback pages are opened: the good student (its report.pdf of two pages)
 #: and one who lost points.
 STUDENTS = ('good_student', 'no_kelvin')
