@@ -97,6 +97,17 @@ def test_without_the_reference_the_answers_are_to_check_and_said(tmp_path, kept_
     assert any('not compared with the drone' in line for line in lines)
 
 
+def test_the_proposals_line_pastes_an_out_with_spaces(tmp_path, kept_reports):
+    """The terminal's "make review OUT=..." of the proposals line runs as pasted, as the next commands do."""
+    import shlex
+    out = tmp_path / 'ROS Exam (groupe D)'
+    out.mkdir()
+    graded = [student(out, 'alice', english_report())]
+    line = [l for l in desk.finish(str(out), graded) if l.startswith('proposals: ')][0]
+    pasted = shlex.split(line.split('confirms them on ', 1)[1])
+    assert pasted == ['make', 'review', 'OUT=%s' % out]
+
+
 def test_a_cell_a_spreadsheet_would_run_is_quoted(tmp_path, kept_reports):
     shutil.copy(os.path.join(DATA, 'reference-altitude.json'), str(tmp_path))
     graded = [student(tmp_path, '=HYPERLINK', english_report())]
