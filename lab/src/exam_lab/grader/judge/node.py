@@ -18,7 +18,7 @@ LAUNCH_START_S = 60.0
 #: Seconds to wait for the second input's subscription once the node is up.
 SUBSCRIBE_S = 6.0
 #: Seconds to wait for each subscribed input to connect or be refused: rospy connects in its own
-#: threads, which a loaded machine runs late (over 3 s seen with two classes graded at once).
+#: threads, which a loaded machine runs late (over 3 s seen in a fresh clone's loaded test run).
 SETTLE_S = 15.0
 #: Seconds a publisher in the node's type first waits for its connection before it is registered anew;
 #: each new try waits twice as long (a connection slower than one wait is not cut at every try).
