@@ -11,6 +11,9 @@ results="$EXAM_WS/build/test_results"
 GRADER=run_tests_exam_lab_pytest_grader
 filter() { grep -E "^\[(ROSTEST|ROSUNIT)\]|^ *\[(PASSED|FAILED)\]|^SUMMARY|^ \* RESULT|^FAILURE|^ERROR|passed|failed" || true; }
 
+# Hypothesis keeps its database in the current folder, a package's sources under catkin: in the build tree
+# instead, so that no test writes beside sources the grader's underlay is built from, while it runs.
+export HYPOTHESIS_STORAGE_DIRECTORY="$EXAM_WS/hypothesis"
 rm -rf "$results"
 cd "$EXAM_WS"
 if [ "${targets[*]}" = run_tests ]; then
