@@ -2,8 +2,9 @@
 # A Slurm on this machine, to try `make grade ... ENGINE=slurm` before the university's cluster
 # (docs/grading.md, "Grading on a Slurm cluster"); lab/test/grader/test_slurm.py starts and stops it too.
 #
-#   tools/slurm_local.sh start [--nodes N]  # installs Debian's slurmctld, slurmd, slurm-client, munge if
-#                                           # missing (root); N nodes, default 1
+#   tools/slurm_local.sh start [--nodes N] [--cpus C]
+#                                           # installs Debian's slurmctld, slurmd, slurm-client, munge if
+#                                           # missing (root); N nodes, default 1; C CPUs each (below)
 #   export SLURM_CONF=...                   # the line `start` prints: sbatch, squeue and the grader read it
 #   tools/slurm_local.sh login COMMAND...   # COMMAND where the controller is reached (the "login node")
 #   tools/slurm_local.sh status
@@ -16,7 +17,9 @@
 # exam-nodeI, address 10.213.78.(I+1)), the controller in a third one (exam-ctl, 10.213.78.1) holding the
 # bridge the nodes' veth pairs are joined to: addresses that exist nowhere else, on links this script
 # makes and `stop` deletes; the file system is the machine's, shared as a cluster's would be. Each node
-# gets its share of the machine's CPUs and memory, so one node and two offer the same CPUs. sbatch and
+# gets its share of the machine's CPUs and memory, so one node and two offer the same CPUs, unless
+# --cpus C gives each node C of them (1 to nproc: what its slurmd finds; each task takes one, so C is how
+# many gradings a node runs at once, the local engine's JOBS for the cluster). sbatch and
 # squeue reach the controller from its namespace (`login`). One munged and one key for all (its socket
 # is in the folder: a munged of the machine, if any, is neither used nor disturbed). Jobs run as whoever
 # submits them (the folder is readable by all, the key by root only): SlurmUser is root here (this
@@ -40,6 +43,7 @@ subnet=10.213.78
 #: The namespaces of this folder's cluster: one name per folder, so two folders' clusters never meet.
 ns_prefix="exam_slurm_$(printf '%s' "$dir" | md5sum | cut -c1-8)"
 nodes_file="$dir/nodes"
+cpus_file="$dir/cpus"
 
 say() { echo "slurm_local: $*"; }
 die() { echo "slurm_local: $*" >&2; exit 1; }
@@ -93,8 +97,8 @@ nodes_idle() { [ "$(in_ctl sinfo -h -N -o '%t' | grep -cx 'idle')" -eq "$(nodes)
 queue_empty() { [ -z "$(in_ctl squeue -h -o '%A')" ]; }
 gone() { ! kill -0 "$1" 2>/dev/null; }
 
-write_conf() {
-  local n="$1" node ctl_host params i cpus memory
+write_conf() {  # write_conf N [CPUS]
+  local n="$1" node ctl_host params i cpus="${2:-}" memory
   if [ "$n" -eq 1 ]; then
     # The node as slurmd itself sees it (CPUs, sockets, cores, RealMemory in MB), so Slurm never drains it.
     node="$(slurmd -C | head -1) NodeAddr=127.0.0.1 State=UNKNOWN"
@@ -103,7 +107,7 @@ write_conf() {
   else
     # Each node its share of the machine (at least one CPU); the namespaces hold no other address, so
     # the daemons may listen on all of theirs.
-    cpus=$(( $(nproc) / n )); [ "$cpus" -ge 1 ] || cpus=1
+    [ -n "$cpus" ] || { cpus=$(( $(nproc) / n )); [ "$cpus" -ge 1 ] || cpus=1; }
     memory=$(( $(slurmd -C | head -1 | sed -n 's/.*RealMemory=\([0-9]*\).*/\1/p') / n ))
     node=""
     for ((i = 1; i <= n; i++)); do
@@ -188,16 +192,23 @@ launch() {  # launch NAME NAMESPACE HOSTNAME COMMAND...: a daemon detached, its 
 }
 
 start() {
-  local n=1 i
+  local n=1 cpus="" i
   while [ $# -gt 0 ]; do
     case "$1" in
       --nodes) n="${2:-}"; shift 2 || die "--nodes needs a number" ;;
       --nodes=*) n="${1#--nodes=}"; shift ;;
-      *) die "start: unknown option $1 (start [--nodes N])" ;;
+      --cpus) cpus="${2:-}"; shift 2 || die "--cpus needs a number" ;;
+      --cpus=*) cpus="${1#--cpus=}"; shift ;;
+      *) die "start: unknown option $1 (start [--nodes N] [--cpus C])" ;;
     esac
   done
   [[ "$n" =~ ^[1-9][0-9]?$ ]] && [ "$n" -le 50 ] || die "--nodes takes 1 to 50, not '$n'"
-  if [ "$(nodes)" -eq "$n" ] && all_alive; then
+  if [ -n "$cpus" ]; then
+    [[ "$cpus" =~ ^[1-9][0-9]*$ ]] && [ "$cpus" -le "$(nproc)" ] ||
+      die "--cpus takes 1 to $(nproc) (the CPUs a node's slurmd finds on this machine), not '$cpus'"
+    [ "$n" -gt 1 ] || die "--cpus is for several nodes: one node offers what slurmd finds (slurmd -C)"
+  fi
+  if [ "$(nodes)" -eq "$n" ] && [ "$(cat "$cpus_file" 2>/dev/null)" = "$cpus" ] && all_alive; then
     say "already running ($dir)"
     echo "export SLURM_CONF=$conf"
     [ "$n" -eq 1 ] || echo "netns $(ctl_ns)"
@@ -220,9 +231,10 @@ start() {
     (umask 077 && dd if=/dev/urandom of="$dir/munge.key" bs=1024 count=1 status=none)
   fi
   echo "$n" > "$nodes_file"
+  echo "$cpus" > "$cpus_file"
   # A start that fails half way stops what it started.
   trap 'stop_daemons; delete_network' EXIT
-  write_conf "$n"
+  write_conf "$n" "$cpus"
   [ "$n" -eq 1 ] || make_network "$n"
   launch munged "" "" munged --foreground --force --key-file="$dir/munge.key" --socket="$dir/munge.socket" \
     --pid-file="$dir/munged-own.pid" --seed-file="$dir/munge.seed" --log-file="$dir/munged.log"
@@ -272,7 +284,7 @@ stop() {
   fi
   stop_daemons
   delete_network
-  rm -f "$nodes_file"
+  rm -f "$nodes_file" "$cpus_file"
   say "stopped"
 }
 

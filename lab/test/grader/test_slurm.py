@@ -19,7 +19,7 @@
   again, and is then "not graded" with what Slurm said.
 
 About 6 to 10 minutes (377 and 603 s measured) on the shared two cores (the teacher's workspace
-built, seven students graded locally, six and the lost ones on Slurm, one CPU per node). Needs root (the daemons, the account, the
+built, seven students graded locally, six and the lost ones on Slurm, as many at once as locally). Needs root (the daemons, the account, the
 namespaces); installs Slurm when missing.
 """
 import csv
@@ -36,6 +36,7 @@ import zipfile
 
 import pytest
 
+from exam_lab.grader import class_run
 from exam_lab.grader.host import similarity_setup
 from exam_lab.grader.host import uids
 from exam_lab.harness.wait import wait_until
@@ -58,6 +59,9 @@ LOST = NODES[0]
 #: Slurm needs an account: slurmd looks the job's user up to start its task).
 UIDS = range(65200, 65300)
 ACCOUNT_PREFIX = 'exam-slurm-'
+#: Each node's CPUs: the two run as many tasks at once (a task takes one) as the local run grades
+#: students side by side (the default JOBS), within what each slurmd finds on this machine.
+NODE_CPUS = max(1, min(os.cpu_count() or 1, class_run.default_jobs() // len(NODES)))
 #: Generous: the machine is shared; the class takes about 6 minutes on Slurm, 4 locally.
 WAIT_S = 1800.0
 
@@ -230,7 +234,7 @@ def cluster():
     namespaces)``; stopped at the end (the test below checks that nothing is left)."""
     state = tempfile.mkdtemp(prefix='exam-slurm-')  # not in pytest's folder: the teacher reads slurm.conf
     started = time.monotonic()
-    code, output = _slurm_local(['start', '--nodes', '2'], state)
+    code, output = _slurm_local(['start', '--nodes', '2', '--cpus', str(NODE_CPUS)], state)
     try:
         assert code == 0, output
         conf = [l.split('=', 1)[1] for l in output.splitlines() if l.startswith('export SLURM_CONF=')]

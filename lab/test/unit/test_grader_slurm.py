@@ -305,3 +305,20 @@ def test_the_task_says_in_one_line_why_its_manifest_line_cannot_be_graded(tmp_pa
     said = capsys.readouterr().err
     assert said.startswith('exam_lab.grader.engine.slurm task 0: the Slurm manifest %s, line 1 cannot be read: '
                            % manifest) and 'Traceback' not in said and said.count('\n') == 1
+
+
+@pytest.mark.parametrize('args, said', [
+    (['--nodes', '2', '--cpus', '0'], '--cpus takes 1 to'),
+    (['--nodes', '2', '--cpus', 'two'], '--cpus takes 1 to'),
+    (['--nodes', '2', '--cpus', str((os.cpu_count() or 1) + 1)], 'the CPUs a node\'s slurmd finds'),
+    (['--cpus', '1'], '--cpus is for several nodes'),
+    (['--nodes', '2', '--cpus'], '--cpus needs a number'),
+])
+def test_the_local_slurm_refuses_a_cpu_count_it_cannot_offer_before_starting_anything(tmp_path, args, said):
+    """tools/slurm_local.sh start --cpus C: each node's CPUs, checked before a daemon or a namespace is made."""
+    import subprocess
+    script = os.path.join(os.path.dirname(__file__), '..', '..', '..', 'tools', 'slurm_local.sh')
+    done = subprocess.run(['bash', script, 'start'] + args, env=dict(os.environ, EXAM_SLURM_DIR=str(tmp_path)),
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=30)
+    assert done.returncode != 0 and said in done.stdout.decode(), done.stdout.decode()
+    assert sorted(os.listdir(str(tmp_path))) == []
