@@ -11,8 +11,9 @@ lab/test/unit/data/reports (LibreOffice's PDFs, one a .docx converted in the box
 the worst wall clock of each kind, against the goals (a text report under 5 s, a 10-page scan under 30 s
 on two cores), its CPU (user + sys of this process, its children and the box's cgroup: on a shared
 machine the wall clock is also the others' load, shown), and what a class of 60 adds at the default JOBS.
-Then a class of ``--class-size`` (8) copies of the good student's package, each with a text report beside
-it, is graded as make grade grades a class: each grading's own report stage, and what they add to the class. Prints a Markdown section and writes
+Then a class of ``--class-size`` (60) copies of the good student's package is graded as make grade grades
+a class, without reports, then each with a text report beside it: the two wall clocks, and each grading's
+own report stage. Prints a Markdown section and writes
 ``reports_results.json`` in --out; ``--record`` also writes the section to lab/bench/reports.md and keeps
 the results beside it (lab/bench/reports_results.json).
 """
@@ -62,27 +63,36 @@ def measure(path, scratch, repeat):
 
 
 def class_with_reports(scratch, count):
-    """A class of ``count`` copies of the good student's package, each handed in with fr_odt.pdf beside
-    it, graded as ``make grade CLASS=`` grades one (:func:`exam_lab.grader.class_run.grade_class`, the
-    default JOBS): ``{"students", "jobs", "seconds"`` (the class's wall clock), ``"report"`` (each
-    student's report stage, wall s, as its grading timed it in ``logs/timings.json``), ``"read"`` (the
-    reports read)``}``."""
-    folder, out = os.path.join(scratch, 'class'), os.path.join(scratch, 'class-out')
-    for n in range(count):
-        student = os.path.join(folder, 's%02d' % (n + 1))
-        shutil.copytree(GOOD, os.path.join(student, 'exam'), ignore=shutil.ignore_patterns('__pycache__'))
-        shutil.copyfile(os.path.join(DATA, 'fr_odt.pdf'), os.path.join(student, 'rapport.pdf'))
-    jobs = class_run.default_jobs()
-    start = time.monotonic()
-    graded = class_run.grade_class(folder, out, jobs=jobs)
-    seconds = round(time.monotonic() - start, 1)
+    """The same class of ``count`` copies of the good student's package graded twice as ``make grade
+    CLASS=`` grades one (:func:`exam_lab.grader.class_run.grade_class`, the default JOBS): first without
+    a report, then each student with one of the text reports beside it (the three of :data:`TEXT` in
+    turn: a .docx is converted in its box). ``{"students", "jobs", "seconds"`` (the class with reports,
+    wall clock), ``"seconds_without"`` (the same class without), ``"report"`` (each student's report
+    stage, wall s, as its grading timed it in ``logs/timings.json``), ``"read"`` (the reports read)``}``."""
+    seconds = {}
+    for with_reports in (False, True):
+        folder = os.path.join(scratch, 'class-%s' % with_reports)
+        out = os.path.join(scratch, 'class-out-%s' % with_reports)
+        for n in range(count):
+            student = os.path.join(folder, 's%02d' % (n + 1))
+            shutil.copytree(GOOD, os.path.join(student, 'exam'), ignore=shutil.ignore_patterns('__pycache__'))
+            if with_reports:
+                name = TEXT[n % len(TEXT)]
+                shutil.copyfile(os.path.join(DATA, name), os.path.join(student, 'rapport' + os.path.splitext(name)[1]))
+        jobs = class_run.default_jobs()
+        start = time.monotonic()
+        graded = class_run.grade_class(folder, out, jobs=jobs)
+        seconds[with_reports] = round(time.monotonic() - start, 1)
+        print('report_bench: a class of %d %s reports: %s s' % (count, 'with' if with_reports else 'without',
+                                                                 seconds[with_reports]), flush=True)
     walls, read = [], 0
     for record in graded:
         with open(os.path.join(out, record['student'], 'logs', timings.FILE)) as f:
             walls.append(json.load(f)['stages']['report']['wall'])
         with open(os.path.join(out, record['student'], 'report.json')) as f:
             read += json.load(f)['state'] == 'read'
-    return {'students': count, 'jobs': jobs, 'seconds': seconds, 'report': walls, 'read': read}
+    return {'students': count, 'jobs': jobs, 'seconds': seconds[True], 'seconds_without': seconds[False],
+            'report': walls, 'read': read}
 
 
 def section(results):
@@ -109,14 +119,14 @@ def section(results):
     graded = results.get('class')
     if graded:
         added = sum(graded['report']) / graded['jobs']
-        lines += ['In a class: %d copies of the good student\'s package, each with fr_odt.pdf beside it, graded as '
-                  '`make grade CLASS=` grades one at the default JOBS=%d in %.0f s; %d of %d reports read. Each '
-                  'student\'s report stage (its own `logs/timings.json`) took median %.1f s, worst %.1f s, read '
-                  'while the other slots fly: the reports added about %.0f s to the class (their stages\' sum / '
-                  'JOBS), about %.0f s for a class of %d.' % (
-                      graded['students'], graded['jobs'], graded['seconds'], graded['read'], graded['students'],
-                      statistics.median(graded['report']), max(graded['report']), added,
-                      added * CLASS / graded['students'], CLASS), '']
+        lines += ['In a class: %d copies of the good student\'s package graded as `make grade CLASS=` grades one, '
+                  'at the default JOBS=%d, first without a report (%.0f s), then each with a text report beside it '
+                  '(the three above in turn) in %.0f s: %+.0f s; %d of %d reports read. Each student\'s report stage '
+                  '(its own `logs/timings.json`) took median %.1f s, worst %.1f s, read while the other slots fly: '
+                  'their sum / JOBS is %.0f s.' % (
+                      graded['students'], graded['jobs'], graded['seconds_without'], graded['seconds'],
+                      graded['seconds'] - graded['seconds_without'], graded['read'], graded['students'],
+                      statistics.median(graded['report']), max(graded['report']), added), '']
     return '\n'.join(lines)
 
 
@@ -125,7 +135,7 @@ def main(argv=None):
     parser.add_argument('--repeat', type=int, default=5)
     parser.add_argument('--out', default=None)
     parser.add_argument('--record', action='store_true')
-    parser.add_argument('--class-size', type=int, default=8,
+    parser.add_argument('--class-size', type=int, default=CLASS,
                         help='students of the class graded with a report each (0: none)')
     args = parser.parse_args(argv)
     out = args.out or tempfile.mkdtemp(prefix='report-bench-')

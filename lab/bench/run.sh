@@ -104,8 +104,8 @@ if [ "$grader" = record ]; then
   cp "$scratch/grader/results.json" "$repo/lab/bench/grader_results.json"
   # docs/benchmarks.md again, now with the new lab/bench/grader.md appended.
   /usr/bin/python3 "$repo/lab/bench/bench.py" "${args[@]}" --render-only
-  # The reports' reading time and a class of 8 with a report each (lab/bench/report_bench.py, reader47's piece:
-  # about 5 minutes), lab/bench/reports.md.
+  # The reports' reading time and the same class of 60 without and with a report each
+  # (lab/bench/report_bench.py, reader47's piece: about 30 minutes), lab/bench/reports.md.
   /usr/bin/python3 "$repo/lab/bench/report_bench.py" --out "$scratch/reports" --record &
   bench_pid=$!
   wait "$bench_pid"

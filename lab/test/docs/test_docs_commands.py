@@ -405,6 +405,25 @@ def test_the_class_runs_quoted_are_their_records():
         'JOBS=4: [%r] did not get the points of their package alone' % row['student']]
 
 
+def report_class_problems(grading, results):
+    """grading.md's figures of the class graded without and with reports (lab/bench/reports_results.json's
+    ``class``: report_bench.py's record)."""
+    graded, flat = results['class'], re.sub(r'\s+', ' ', grading)
+    said = '%.0f s without, %.0f s with: %+.0f s at JOBS=%d' % (
+        graded['seconds_without'], graded['seconds'], graded['seconds'] - graded['seconds_without'], graded['jobs'])
+    stages = 'the report stages\' sum over the slots, %.0f s' % (sum(graded['report']) / graded['jobs'])
+    return ['not said (from lab/bench/reports_results.json): %s' % p for p in (said, stages) if p not in flat] + \
+        ['a class of %d, not 60' % graded['students']] * (graded['students'] != 60)
+
+
+def test_the_class_with_reports_quoted_is_its_record():
+    grading = _read(os.path.join(REPO, 'docs', 'grading.md'))
+    results = json.loads(_read(os.path.join(REPO, 'lab', 'bench', 'reports_results.json')))
+    assert report_class_problems(grading, results) == []
+    other = dict(results, **{'class': dict(results['class'], seconds=results['class']['seconds'] + 10)})
+    assert len(report_class_problems(grading, other)) == 1
+
+
 def leg_name_problems(grading, words=None):
     """The plot's leg names (publish/flightplot.py LEG_NAMES) and grade.md's (score/flight.py LEG_WORDS:
     the name and its side) against the first column of the manual's table of the legs, in the flight's order."""

@@ -276,6 +276,42 @@ def test_q8_a_period_given_as_a_rate_is_said(ref):
     assert proposal['points'] == 0.5 and 'period' in proposal['evidence'] and proposal['state'] == 'to check'
 
 
+@pytest.mark.parametrize('sentence', [
+    'A new temperature message arrives every 1.3 seconds or so.',
+    'Les messages arrivent toutes les 1,29 s environ.',
+    'The period between two messages is about 1.29 s.',
+])
+def test_q8_the_rate_given_as_its_period_in_seconds_is_right_and_to_check(ref, sentence):
+    """"Every 1.3 s" answers "at which rate" with the drone's period: the rate check holds (1/1.3 Hz is
+    the drone's), said to check; never "no rate stated" and 0.5 proposed as if it were wrong."""
+    proposal = one('Q8', out('altitude', 'rostopic_echo') + '\n' + sentence, ref)
+    assert check(proposal, 'rate') is True and proposal['points'] == 1.0
+    assert proposal['state'] == 'to check' and 'given as its period' in proposal['evidence']
+
+
+def test_q8_a_period_of_the_other_topic_is_wrong_and_said(ref):
+    proposal = one('Q8', out('altitude', 'rostopic_echo') + '\nOne message every 0.5 s.', ref)
+    assert check(proposal, 'rate') is False and proposal['points'] == 0.5
+    assert "/pressure's" in proposal['evidence'] and proposal['state'] == 'to check'
+
+
+def test_q8_a_frequency_without_its_unit_in_english(ref):
+    proposal = one('Q8', out('altitude', 'rostopic_echo') + '\nMessages are published at a frequency of 0.78.', ref)
+    assert check(proposal, 'rate') is True and proposal['points'] == 1.0
+
+
+def test_q8_the_drones_rate_rounded_coarsely_is_to_check(ref):
+    proposal = one('Q8', out('altitude', 'rostopic_echo') + '\nIt publishes at 1 Hz approximately.', ref)
+    assert proposal['points'] == 0.5 and proposal['state'] == 'to check' and 'rounded' in proposal['evidence']
+
+
+def test_q8_rostopic_hz_named_in_a_sentence_is_no_topic(ref):
+    """A sentence that names the tool ("... according to rostopic hz.") is not a command run on "hz."."""
+    proposal = one('Q8', out('altitude', 'rostopic_echo') + '\nPublished at 0.777 Hz on average according to '
+                   'rostopic hz.', ref)
+    assert proposal['state'] == 'proposed' and proposal['points'] == 1.0 and 'hz was run on' not in proposal['evidence']
+
+
 def test_q8_hz_run_on_another_topic_is_said(ref):
     proposal = one('Q8', out('altitude', 'rostopic_echo') + '\n' + out('altitude', 'rostopic_hz_other') +
                    '\nThey are published at 2 Hz.', ref)
@@ -304,6 +340,24 @@ def test_a_copied_question_is_not_a_comment(ref):
     body = 'Run the node mydrone_node from the package mydrone. Then list all the running nodes.\n' + \
         out('altitude', 'rosnode_list')
     assert one('Q4', body, ref)['points'] == 0.5
+
+
+def test_an_answer_reusing_the_questions_words_is_the_students_own(ref):
+    """An explanation made of the statement's words with words of its own ("Created the exam package
+    with rospy and std_msgs as dependencies") explains; the statement copied, in whole or in part, does not."""
+    made = 'catkin_create_pkg exam rospy std_msgs\n'
+    assert check(one('Q9', made + 'Created the exam package with rospy and std_msgs as dependencies.', ref),
+                 'explained') is True
+    for copied in ('Create a package exam in your catkin workspace, with dependencies to rospy, std_msgs and mydrone;',
+                   'Create a package exam.'):
+        assert check(one('Q9', made + copied, ref), 'explained') is False, copied
+
+
+@pytest.mark.parametrize('head', ['(4)', '4/', '4°)', '#4', '4 -', 'Question n° 4 :'])
+def test_more_headings_of_a_number(ref, head):
+    found = answers.find_answers([page('Name: Jane Doe, group 3\n\n%s\n%s\nTwo nodes run here.\n9. nothing'
+                                       % (head, out('altitude', 'rosnode_list')))])
+    assert '/mydrone' in found['Q4']['text'] and found['Q9']['text'] == 'nothing'
 
 
 def test_without_the_reference_every_answer_is_to_check():

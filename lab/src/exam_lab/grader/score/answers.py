@@ -34,16 +34,18 @@ MAX_PASSAGE = 4000
 #: A heading that names its question by a word: anywhere on a line (two answers in one paragraph).
 _NAMED = re.compile(r'(?<![\w/])(?:Q(?:uestion)?|Exercice|Exercise|Ex|R[ée]ponse|Answer)\s*(?:n\s*[°o]\s*)?\.?\s*'
                     r'(\d{1,2})(?![\d.,]\d)(?:\s*[.):\-–]|\b)', re.I)
-#: A heading of a number alone: at a line's start (``4.``, ``4)``, ``4 -``, ``4:``), or after a
-#: sentence's end within a line (``... rosout. 5) ...``).
-_BARE = re.compile(r'(?:^|(?<=[.!?;]\s))[ \t>*•\-|]*(\d{1,2})\s*[.):\-–](?![\d.,]*\d)(?=\s|$)', re.M)
+#: A heading of a number alone: at a line's start (``4.``, ``4)``, ``(4)``, ``4 -``, ``4:``, ``4/``,
+#: ``4°)``, ``#4``), or after a sentence's end within a line (``... rosout. 5) ...``).
+_BARE = re.compile(r'(?:^|(?<=[.!?;]\s))[ \t>*•\-|]*(?:[(#]\s*)?(\d{1,2})\s*(?:°\s*)?[.):\-–/](?![\d.,]*\d)(?=\s|$)'
+                   r'|^[ \t]*#\s*(\d{1,2})(?=\s)', re.M)
 def _headings(text):
     """``[(start, end, number, strong)]`` of the headings of a page's text."""
     found = [(m.start(), m.end(), int(m.group(1)), True) for m in _NAMED.finditer(text)]
     taken = [(s, e) for s, e, _, _ in found]
     for m in _BARE.finditer(text):
-        if not any(s <= m.start(1) < e for s, e in taken):
-            found.append((m.start(1), m.end(), int(m.group(1)), False))
+        group = 1 if m.group(1) else 2
+        if not any(s <= m.start(group) < e for s, e in taken):
+            found.append((m.start(group), m.end(), int(m.group(group)), False))
     return sorted(found)
 
 
@@ -278,10 +280,17 @@ def _q7(passage, ref, table=False):
     return checks, 1.0 if comment['ok'] else 0.5, doubts, 'the type: 1, half without a comment'
 
 
-#: A rate stated in words: "0.77 Hz", "0,78Hz", "à 2 hertz", "2 messages par seconde", "rate of 0.78".
+#: A rate stated in words: "0.77 Hz", "0,78Hz", "à 2 hertz", "2 messages par seconde", "rate of 0.78",
+#: "a frequency of 0.78".
 _RATE = re.compile(r'(\d+(?:[.,]\d+)?)\s*(?:hz|hertz|messages?\s*(?:par|per|/)\s*s(?:econde?)?|/\s*s\b|fois\s+par\s+seconde)',
                    re.I)
-_RATE_WORD = re.compile(r'(?:rate|fr[ée]quence|d[ée]bit|taux|rythme)\D{0,25}?(\d+(?:[.,]\d+)?)', re.I)
+_RATE_WORD = re.compile(r'(?:rate|fr[ée]quen(?:ce|cy)|d[ée]bit|taux|rythme)\D{0,25}?(\d+(?:[.,]\d+)?)(?![\d.,]*\d)(?!\s*(?:s\b|sec))',
+                        re.I)
+#: A rate stated as its period: "every 1.3 seconds", "toutes les 1,29 s", "a period of 1.29 s", "1.3 s
+#: between two messages".
+_PERIOD = re.compile(r'(?:every|each|toutes\s+les|chaque|p[ée]riod[e]?\D{0,40}?)\s*(\d+(?:[.,]\d+)?)\s*'
+                     r'(?:s\b|sec\b|secs\b|seconds?|secondes?)'
+                     r'|(\d+(?:[.,]\d+)?)\s*(?:s|sec|seconds?|secondes?)\s+(?:between|entre)\b', re.I)
 #: A stated rate within this share of the real one is right (the drone's own hz varies by a few %).
 RATE_TOLERANCE = 0.1
 
@@ -290,16 +299,39 @@ def _close(value, target):
     return target is not None and target > 0 and abs(value - target) <= RATE_TOLERANCE * target
 
 
+def _number(text):
+    return float(text.replace(',', '.'))
+
+
 def stated_rates(sentences):
     """The rates a passage's own sentences state (Hz), in order."""
     found = []
     for sentence in sentences:
         for pattern in (_RATE, _RATE_WORD):
             for m in pattern.finditer(sentence):
-                value = float(m.group(1).replace(',', '.'))
+                value = _number(m.group(1))
                 if value not in found:
                     found.append(value)
     return found
+
+
+def stated_periods(sentences):
+    """The periods (s) a passage's own sentences give for the rate ("every 1.3 seconds"), in order."""
+    found = []
+    for sentence in sentences:
+        for m in _PERIOD.finditer(sentence):
+            value = _number(m.group(1) or m.group(2))
+            if value > 0 and value not in found:
+                found.append(value)
+    return found
+
+
+def _rounded_to(value, target):
+    """True when ``target`` rounded to the decimals ``value`` is written with is ``value`` ("1 Hz" for
+    0.778): a rate that may be the drone's, stated coarsely."""
+    text = shown_number(value)
+    decimals = len(text.split('.')[1]) if '.' in text else 0
+    return target is not None and round(target, decimals) == value
 
 
 def _q8(passage, ref, table=False):
@@ -311,33 +343,47 @@ def _q8(passage, ref, table=False):
                               else 'no message (data: ...) pasted')]
     real = ref['rate']
     # the student's own hz: on which topic, and what it measured
-    hz_topics = [c.split()[-1] for c in commands_of(passage) if re.match(r'rostopic\s+hz\b', c)]
-    measured = [float(r.replace(',', '.')) for r in AVERAGE_RATE.findall(passage)]
+    hz_topics = [m.group(1) for m in (re.match(r'rostopic\s+hz\s+(?:-\S+\s+(?:\d\S*\s+)?)*(/\S+)', c)
+                                      for c in commands_of(passage)) if m]
+    measured = [_number(r) for r in AVERAGE_RATE.findall(passage)]
     doubts = []
     if hz_topics and all(t != topic for t in hz_topics):
         doubts.append('rostopic hz was run on %s, not %s' % (', '.join(hz_topics), topic))
-    stated = stated_rates(own_sentences(passage, 'Q8'))
+    sentences = own_sentences(passage, 'Q8')
+    stated = stated_rates(sentences)
+    periods = [p for p in stated_periods(sentences) if 1.0 / p not in stated]
     # a rate pasted only as hz's output, with no sentence stating it, still answers "at which rate"
     candidates = stated or (measured[-1:] if measured and not doubts else [])
     right = [v for v in candidates if _close(v, real)]
     period = [v for v in candidates if real and _close(v, 1.0 / real)]
+    as_period = [p for p in periods if _close(1.0 / p, real)]
     if right and not stated:
         doubts.append('the rate is only in the pasted hz output, no sentence states it')
     if right:
         rate = named_check('rate', True, '%s Hz %s (the drone: %s Hz, hz measured %s)' % (
             shown_number(right[0]), 'stated' if stated else 'from the pasted hz', shown_number(real), shown_number(ref['measured'])))
+    elif as_period:
+        rate = named_check('rate', True, 'one message every %s s stated, %s Hz (the drone: %s Hz)' % (
+            shown_number(as_period[0]), shown_number(1.0 / as_period[0]), shown_number(real)))
+        doubts.append('the rate is given as its period (%s s): whether that answers "at which rate" is the '
+                      'teacher\'s call' % shown_number(as_period[0]))
     elif period:
         rate = named_check('rate', False, '%s is the period (s), not the rate: the drone publishes at %s Hz' % (
             shown_number(period[0]), shown_number(real)))
         doubts.append('a period given as a rate')
-    elif candidates:
-        rate = named_check('rate', False, '%s Hz stated, the drone publishes at %s Hz' % (
-            ', '.join(shown_number(v) for v in candidates), shown_number(real)))
+    elif candidates or periods:
+        rate = named_check('rate', False, '%s stated, the drone publishes at %s Hz' % (
+            ', '.join(['%s Hz' % shown_number(v) for v in candidates] +
+                      ['one message every %s s' % shown_number(p) for p in periods]), shown_number(real)))
         other = ref.get('other_rate')
-        if any(_close(v, other) for v in candidates):
+        if any(_close(v, other) for v in candidates) or any(_close(1.0 / p, other) for p in periods):
             doubts.append('the rate stated is %s\'s (%s Hz)' % (ref['other_topic'], shown_number(other)))
         if measured and any(_close(v, measured[-1]) for v in candidates) and not _close(measured[-1], real):
             doubts.append('the rate stated is the student\'s own hz output (%s Hz), not the drone\'s' % shown_number(measured[-1]))
+        coarse = [v for v in candidates if _rounded_to(v, real)]
+        if coarse:
+            doubts.append('%s Hz is the drone\'s %s Hz rounded: right, stated coarsely?' % (
+                shown_number(coarse[0]), shown_number(real)))
     else:
         rate = named_check('rate', False, 'no rate stated')
     checks.append(rate)

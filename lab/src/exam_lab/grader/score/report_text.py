@@ -92,7 +92,18 @@ def own_sentences(text, item, least=SENTENCE_WORDS):
             words = _words(sentence)
             if len(words) < least:
                 continue
-            if statement and not re.search(r'\d', sentence) and sum(w in statement for w in words) >= 0.7 * len(words):
+            if statement and not re.search(r'\d', sentence) and _copied(words, statement):
                 continue
             kept.append(sentence.strip())
     return kept
+
+
+def _copied(words, statement):
+    """Whether a sentence of ``words`` is the statement copied: most of its words are the statement's
+    (or the sheet's names), and it adds at most one word of its own, or covers most of the statement.
+    An answer of the student's reuses the question's words ("Created the exam package with rospy and
+    std_msgs as dependencies"), with words of its own around them."""
+    inside = sum(w in statement for w in words)
+    if inside < 0.7 * len(words):
+        return False
+    return len(words) - inside <= 1 or len(set(words) & statement) >= 0.6 * len(statement - set(_words(_SHEET_NAMES)))
