@@ -295,6 +295,12 @@ def test_q8_a_period_of_the_other_topic_is_wrong_and_said(ref):
     assert "/pressure's" in proposal['evidence'] and proposal['state'] == 'to check'
 
 
+def test_q8_a_rate_stated_in_a_short_sentence(sub):
+    """"Published at 2 Hz." is three words: too short for a comment, but it states the rate."""
+    proposal = one('Q8', out('depth', 'rostopic_echo') + '\nPublished at 2 Hz.', sub)
+    assert check(proposal, 'rate') is True and proposal['points'] == 1.0
+
+
 def test_q8_a_frequency_without_its_unit_in_english(ref):
     proposal = one('Q8', out('altitude', 'rostopic_echo') + '\nMessages are published at a frequency of 0.78.', ref)
     assert check(proposal, 'rate') is True and proposal['points'] == 1.0
@@ -358,6 +364,14 @@ def test_more_headings_of_a_number(ref, head):
     found = answers.find_answers([page('Name: Jane Doe, group 3\n\n%s\n%s\nTwo nodes run here.\n9. nothing'
                                        % (head, out('altitude', 'rosnode_list')))])
     assert '/mydrone' in found['Q4']['text'] and found['Q9']['text'] == 'nothing'
+
+
+def test_a_page_footer_is_no_heading(ref):
+    """A word processor's page number ("4 / 6", "4/6", "- 4 -", "4 of 6", "Page 4") at a page's foot is
+    not question 4."""
+    for footer in ('4 / 6', '4/6', '- 4 -', '4 of 6', '4 sur 6', 'Page 4', 'page 4 / 6'):
+        found = answers.find_answers([page('Q5\nrien\n\n%s' % footer, 4)])
+        assert found['Q4'] is None and found['Q5']['text'].startswith('rien'), footer
 
 
 def test_without_the_reference_every_answer_is_to_check():

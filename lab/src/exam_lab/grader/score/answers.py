@@ -35,13 +35,18 @@ MAX_PASSAGE = 4000
 _NAMED = re.compile(r'(?<![\w/])(?:Q(?:uestion)?|Exercice|Exercise|Ex|R[ée]ponse|Answer)\s*(?:n\s*[°o]\s*)?\.?\s*'
                     r'(\d{1,2})(?![\d.,]\d)(?:\s*[.):\-–]|\b)', re.I)
 #: A heading of a number alone: at a line's start (``4.``, ``4)``, ``(4)``, ``4 -``, ``4:``, ``4/``,
-#: ``4°)``, ``#4``), or after a sentence's end within a line (``... rosout. 5) ...``).
-_BARE = re.compile(r'(?:^|(?<=[.!?;]\s))[ \t>*•\-|]*(?:[(#]\s*)?(\d{1,2})\s*(?:°\s*)?[.):\-–/](?![\d.,]*\d)(?=\s|$)'
+#: ``4°)``, ``#4``; not a page's footer ``4 / 6``), or after a sentence's end within a line (``... rosout. 5) ...``).
+_BARE = re.compile(r'(?:^|(?<=[.!?;]\s))[ \t>*•\-|]*(?:[(#]\s*)?(\d{1,2})\s*(?:°\s*)?(?:[.):\-–]|/(?!\s*\d))(?![\d.,]*\d)(?=\s|$)'
                    r'|^[ \t]*#\s*(\d{1,2})(?=\s)', re.M)
+#: A line that is a page's number (a word processor's footer): "- 4 -", "4 / 6", "4 of 6", "Page 4".
+_FOOTER = re.compile(r'^[ \t]*(?:(?:page|p\.)\s*\d{1,3}\b.*|[-–]\s*\d{1,3}\s*[-–]|\d{1,3}\s*(?:/|of|sur)\s*\d{1,3})[ \t]*$',
+                     re.M | re.I)
+
+
 def _headings(text):
-    """``[(start, end, number, strong)]`` of the headings of a page's text."""
+    """``[(start, end, number, strong)]`` of the headings of a page's text (never a page's number)."""
     found = [(m.start(), m.end(), int(m.group(1)), True) for m in _NAMED.finditer(text)]
-    taken = [(s, e) for s, e, _, _ in found]
+    taken = [(s, e) for s, e, _, _ in found] + [m.span() for m in _FOOTER.finditer(text)]
     for m in _BARE.finditer(text):
         group = 1 if m.group(1) else 2
         if not any(s <= m.start(group) < e for s, e in taken):
@@ -349,7 +354,7 @@ def _q8(passage, ref, table=False):
     doubts = []
     if hz_topics and all(t != topic for t in hz_topics):
         doubts.append('rostopic hz was run on %s, not %s' % (', '.join(hz_topics), topic))
-    sentences = own_sentences(passage, 'Q8')
+    sentences = own_sentences(passage, 'Q8', 1)  # "At 2 Hz." states a rate in three words
     stated = stated_rates(sentences)
     periods = [p for p in stated_periods(sentences) if 1.0 / p not in stated]
     # a rate pasted only as hz's output, with no sentence stating it, still answers "at which rate"
