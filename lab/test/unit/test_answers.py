@@ -301,6 +301,18 @@ def test_q8_a_rate_stated_in_a_short_sentence(sub):
     assert check(proposal, 'rate') is True and proposal['points'] == 1.0
 
 
+def test_the_node_and_topic_named_relative_as_rosnode_and_rostopic_resolve_them(ref):
+    """`rosnode info mydrone` and `rostopic echo temperature` are the drone's /mydrone and /temperature
+    (a relative name resolves in the root namespace); `rostopic hz pressure` is hz of /pressure."""
+    info = out('altitude', 'rosnode_info').split('\n', 1)[1]
+    assert check(one('Q5', 'rosnode info mydrone\n' + info, ref), 'command') is True
+    assert check(one('Q5', 'rosnode info mydrone_node\n' + info, ref), 'command') is False
+    echo = out('altitude', 'rostopic_echo').split('\n', 1)[1]
+    proposal = one('Q8', 'rostopic echo temperature\n' + echo + '\nrostopic hz pressure\nThey come at 0.78 Hz.', ref)
+    assert check(proposal, 'command') is True and 'hz was run on /pressure' in proposal['evidence']
+    assert check(one('Q8', 'rostopic echo temperatures\n' + echo, ref), 'command') is False
+
+
 def test_q8_a_frequency_without_its_unit_in_english(ref):
     proposal = one('Q8', out('altitude', 'rostopic_echo') + '\nMessages are published at a frequency of 0.78.', ref)
     assert check(proposal, 'rate') is True and proposal['points'] == 1.0

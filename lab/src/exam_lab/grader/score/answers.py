@@ -203,8 +203,9 @@ Q5_PARTS = (
 
 def _q5(passage, ref, table=False):
     node = re.escape(ref['node'])
-    command = _command_check(passage, r'rosnode\s+info\s+%s\b' % node, 'rosnode info %s' % ref['node'],
-                             table and 'rosnodeinfo' + node)
+    # the name as typed: "rosnode info mydrone" resolves to /mydrone as the global name does
+    command = _command_check(passage, r'rosnode\s+info\s+/?%s(?![\w/])' % re.escape(ref['node'].lstrip('/')),
+                             'rosnode info %s' % ref['node'], table and 'rosnodeinfo/?' + re.escape(ref['node'].lstrip('/')))
     names = _names_in(passage)
     missing = [t for t in ref['publications'] if t not in names]
     has_node = re.search(r'Node\s*\[\s*%s\s*\]' % node, passage) is not None
@@ -341,15 +342,21 @@ def _rounded_to(value, target):
 
 def _q8(passage, ref, table=False):
     topic = ref['topic']
-    command = _command_check(passage, r'rostopic\s+echo\b.*%s(?![\w/])' % re.escape(topic), 'rostopic echo %s' % topic,
-                             table and r'rostopicecho.*%s' % re.escape(topic))
+    bare = re.escape(topic.lstrip('/'))  # "rostopic echo temperature" resolves to /temperature
+    command = _command_check(passage, r'rostopic\s+echo\b.*(?<![\w/])/?%s(?![\w/])' % bare, 'rostopic echo %s' % topic,
+                             table and r'rostopicecho.*%s' % bare)
     values = re.findall(r'data\s*:\s*-?\d', passage)
     checks = [command, named_check('messages', bool(values), '%d message(s) pasted' % len(values) if values
                               else 'no message (data: ...) pasted')]
     real = ref['rate']
     # the student's own hz: on which topic, and what it measured
-    hz_topics = [m.group(1) for m in (re.match(r'rostopic\s+hz\s+(?:-\S+\s+(?:\d\S*\s+)?)*(/\S+)', c)
-                                      for c in commands_of(passage)) if m]
+    # on which topic: a global name, or a relative one of the drone's ("rostopic hz temperature"); a
+    # sentence naming the tool ("... with rostopic hz to measure it") names none
+    known = {topic.lstrip('/'): topic, ref.get('other_topic', '').lstrip('/'): ref.get('other_topic')}
+    hz_topics = [name if name.startswith('/') else known[name] for name in (
+        m.group(1) for m in (re.match(r'rostopic\s+hz\s+(?:-\S+\s+(?:\d\S*\s+)?)*(\S+)', c)
+                             for c in commands_of(passage)) if m)
+        if name.startswith('/') or name in known and known[name]]
     measured = [_number(r) for r in AVERAGE_RATE.findall(passage)]
     doubts = []
     if hz_topics and all(t != topic for t in hz_topics):
