@@ -235,6 +235,24 @@ def test_q5_each_singled_out_line_explained_is_2_in_french(ref):
     assert proposal['points'] == 2.0 and proposal['state'] == 'proposed'
 
 
+def test_q5_each_line_explained_on_the_line_itself(ref):
+    """"Pid: 13996 is the id of its process": the output's line, then the student's words about it, is
+    an explanation; the output alone is not (the drone's own lines stay output, a host name in them too)."""
+    info = out('altitude', 'rosnode_info')
+    explained = '\n'.join(['Explanation of each line:', 'Node [/mydrone]: the name of the node we asked about.',
+                           'Publications: the topics the node publishes on.',
+                           'Subscriptions: None, the node listens to no topic.',
+                           'Services: the services the node offers.',
+                           'contacting node http://127.0.0.1:40391/: the address and port of the node.',
+                           'Pid: 13996 is the id of the process of the node.',
+                           'direction: outbound, the node sends the messages.',
+                           'transport: TCPROS, the protocol used by ROS over TCP.'])
+    proposal = one('Q5', info + '\n' + explained, ref)
+    assert proposal['points'] == 2.0, proposal['evidence']
+    proposal = one('Q5', info + '\nPid: 13996\nSubscriptions: None\n * /mydrone (http://vm-student:40000/)', ref)
+    assert proposal['points'] == 1.0 and check(proposal, 'explains Pid') is False
+
+
 def test_q5_a_connection_said_to_go_to_the_master_is_to_check(ref):
     proposal = one('Q5', out('altitude', 'rosnode_info') + '\nThe node publishes topics, subscribes to none, '
                    'offers services. Contacting node gives its address. The Pid is its process number. '

@@ -15,6 +15,17 @@ _OUTPUT = re.compile(
     r'|Node \[|Publications\s*:|Subscriptions\s*:|Services\s*:|contacting node|Pid\s*:|Connections\s*:'
     r'|direction\s*:|transport\s*:|to\s*:\s*/|topic\s*:\s*/|float32 data\s*$|std_msgs/\w+\s*$|Created (?:file|folder)'
     r'|Successfully created|Type\s*:|Publishers\s*:|Subscribers\s*:|\[?(?:INFO|WARN|ERROR)\]?\s*\[)', re.I)
+#: The tool's own part of an output line a student may explain on the line itself ("Pid: 13996 is the
+#: process's number", "Subscriptions: None, it listens to nothing"): what follows it is the student's.
+_OUTPUT_PART = re.compile(
+    r'^\s*(?:[*\u2022-]\s*)?(?:Node\s*\[[^\]]*\]'
+    r'|(?:Publications|Subscriptions|Services|Connections|Publishers|Subscribers)\s*:(?:\s*None\b)?'
+    r'|contacting node\s+\S+(?:\s*\.\.\.)?|Pid\s*:\s*\d*'
+    r'|direction\s*:\s*(?:outbound|inbound)?(?:\s*\([^)]*\))?(?:\s*\[\d+\])?'
+    r'|transport\s*:\s*(?:TCPROS|UDPROS)?|Type\s*:\s*[\w/]*|data\s*:\s*[-+\d.eE]*|average rate\s*:\s*[\d.]*'
+    r'|(?:to|topic)\s*:\s*/[\w/]*|/[\w/]+\s*(?:\[[\w/]+\]|\(\S+\))?)', re.I)
+#: Words after an output line's own part that make the line the student's explanation of it.
+_EXPLAINED_WORDS = 2
 #: The report reader's lines around the OCR of a picture on a text page (ReportRecord's ``text``).
 _PICTURE = re.compile(r'^\s*\[(?:picture \d+, OCR|end of picture \d+)\]\s*$')
 #: A command line as pasted: a prompt, or a line that starts with one of the course's tools.
@@ -71,13 +82,23 @@ def _paragraphs(text):
     one paragraph (a word processor wraps a sentence over lines)."""
     paragraphs, current = [], []
     for line in text.splitlines() + ['']:
+        explains = _OUTPUT.match(line) and _explains_itself(line)
         if not line.strip() or is_command(line) or _OUTPUT.match(line) or _PICTURE.match(line):
             if current:
                 paragraphs.append(' '.join(current))
             current = []
+            if explains:  # "Pid: 13996 is the number of its process": a paragraph of its own
+                paragraphs.append(line.strip().lstrip('*\u2022- '))
         else:
             current.append(line.strip())
     return paragraphs
+
+
+def _explains_itself(line):
+    """Whether an output line goes on with the student's words about it (at least
+    :data:`_EXPLAINED_WORDS` words after the tool's own part)."""
+    part = _OUTPUT_PART.match(line)
+    return bool(part) and len(_words(line[part.end():])) >= _EXPLAINED_WORDS
 
 
 def own_sentences(text, item, least=SENTENCE_WORDS):
