@@ -278,6 +278,14 @@ def test_q7_the_type_half_without_a_comment(ref):
     assert one('Q7', 'The message holds a single number of the sensor.', ref)['points'] == 0.0
 
 
+@pytest.mark.parametrize('sentence', ['The messages are Float32.', 'Le type de message est un Float32 (std_msgs).'])
+def test_q7_the_type_named_without_its_package_is_to_check(ref, sentence):
+    """"The messages are Float32" names the type: never 0 proposed as "the type is missing"."""
+    proposal = one('Q7', sentence, ref)
+    assert check(proposal, 'type') is True and proposal['points'] == 1.0 and proposal['state'] == 'to check'
+    assert one('Q7', 'The messages are Float64 numbers.', ref)['points'] == 0.0
+
+
 def test_q8_rate_wrong_with_the_right_command_is_half(ref):
     proposal = one('Q8', out('altitude', 'rostopic_echo') + '\nThe messages are published at 10 Hz.', ref)
     assert proposal['points'] == 0.5 and check(proposal, 'rate') is False

@@ -271,15 +271,19 @@ def _q7(passage, ref, table=False):
                              'rostopic type / rosmsg info', table and r'rostopic(?:type|info)|rosmsg(?:info|show)')
     kind = re.search(r'std_msgs/Float32', re.sub(r'\s+', '', passage), re.I)  # a table's cell may wrap it
     fields = re.search(r'float32\s+data', passage)
+    # "the messages are Float32": the type named without its package, in the student's own words
+    named = not (kind or fields) and any(re.search(r'(?<![\w/])float\s?32\b', sentence, re.I)
+                                         for sentence in own_sentences(passage, 'Q7', 1))
     expected = ref['type'] or 'std_msgs/Float32'
     checks = [command,
-              named_check('type', bool(kind or fields), '%s found' % ('float32 data' if fields else expected)
-                     if kind or fields else 'neither %s nor float32 data' % expected),
+              named_check('type', bool(kind or fields or named), '%s found' % (
+                  'float32 data' if fields else expected if kind else 'Float32 (without std_msgs/)')
+                  if kind or fields or named else 'neither %s nor float32 data' % expected),
               named_check('field', bool(fields), 'float32 data' if fields else 'the field float32 data not shown')]
     comment, _ = _comment_check(passage, 'Q7')
     checks.append(comment)
-    doubts = []
-    if not (kind or fields):
+    doubts = ['the type named Float32 without its package (std_msgs/Float32)'] if named else []
+    if not (kind or fields or named):
         return checks, 0.0, [], 'the type is missing: 0'
     if not fields:
         doubts.append('the type without its field (rosmsg info shows float32 data)')
