@@ -127,4 +127,5 @@ def _copied(words, statement):
     inside = sum(w in statement for w in words)
     if inside < 0.7 * len(words):
         return False
-    return len(words) - inside <= 1 or len(set(words) & statement) >= 0.6 * len(statement - set(_words(_SHEET_NAMES)))
+    own = statement - set(_words(_SHEET_NAMES))  # the statement's words but the drones' names
+    return len(words) - inside <= 1 or len(set(words) & own) >= 0.8 * len(own)
