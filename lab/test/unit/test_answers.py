@@ -400,7 +400,7 @@ def test_an_answer_reusing_the_questions_words_is_the_students_own(ref):
         assert check(one('Q9', made + copied, ref), 'explained') is False, copied
 
 
-@pytest.mark.parametrize('head', ['(4)', '4/', '4°)', '#4', '4 -', 'Question n° 4 :'])
+@pytest.mark.parametrize('head', ['(4)', '4/', '4°)', '#4', '4 -', 'Question n° 4 :', 'Questions 4 et 5 :'])
 def test_more_headings_of_a_number(ref, head):
     found = answers.find_answers([page('Name: Jane Doe, group 3\n\n%s\n%s\nTwo nodes run here.\n9. nothing'
                                        % (head, out('altitude', 'rosnode_list')))])

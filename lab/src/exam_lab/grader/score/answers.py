@@ -32,7 +32,7 @@ PROPOSED, TO_CHECK, NO_ANSWER, NOT_READ = 'proposed', 'to check', 'no answer fou
 MAX_PASSAGE = 4000
 
 #: A heading that names its question by a word: anywhere on a line (two answers in one paragraph).
-_NAMED = re.compile(r'(?<![\w/])(?:Q(?:uestion)?|Exercice|Exercise|Ex|R[ée]ponse|Answer)\s*(?:n\s*[°o]\s*)?\.?\s*'
+_NAMED = re.compile(r'(?<![\w/])(?:Q(?:uestions?)?|Exercice|Exercise|Ex|R[ée]ponse|Answer)\s*(?:n\s*[°o]\s*)?\.?\s*'
                     r'(\d{1,2})(?![\d.,]\d)(?:\s*[.):\-–]|\b)', re.I)
 #: A heading of a number alone: at a line's start (``4.``, ``4)``, ``(4)``, ``4 -``, ``4:``, ``4/``,
 #: ``4°)``, ``#4``; not a page's footer ``4 / 6``), or after a sentence's end within a line (``... rosout. 5) ...``).
