@@ -214,6 +214,15 @@ def test_q4_half_without_a_comment(ref):
                ref)['points'] == 1.0
 
 
+def test_a_comment_under_four_words_is_to_check(ref):
+    """"Deux nœuds tournent." may be the comment the notes ask for: counted as not met (0.5), to check,
+    never 0.5 proposed as if there were none."""
+    proposal = one('Q4', out('altitude', 'rosnode_list') + '\nDeux nœuds tournent.', ref)
+    assert proposal['points'] == 0.5 and proposal['state'] == 'to check' and check(proposal, 'comment') is None
+    assert 'Deux nœuds tournent' in proposal['evidence']
+    assert one('Q4', out('altitude', 'rosnode_list'), ref)['state'] == 'proposed'
+
+
 def test_q4_both_nodes_of_the_drone_needed(ref, sub):
     proposal = one('Q4', out('altitude', 'rosnode_list') + '\nThe drone and rosout are the two running nodes.', sub)
     assert check(proposal, 'nodes') is False and proposal['state'] == 'to check'

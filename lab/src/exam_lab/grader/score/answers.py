@@ -156,6 +156,9 @@ def _comment_check(passage, item, name='comment'):
     sentences = own_sentences(passage, item)
     if sentences:
         return named_check(name, True, '"%s"' % _quote(sentences[0])), sentences
+    short = own_sentences(passage, item, 2)
+    if short:  # "Deux nœuds tournent.": a comment, or a title? the teacher's call
+        return named_check(name, None, 'only a sentence under %d words: "%s"' % (SENTENCE_WORDS, _quote(short[0]))), []
     return named_check(name, False, 'no sentence of the student\'s own (at least %d words beyond the commands, '
                                'their output and the question)' % SENTENCE_WORDS), sentences
 
@@ -473,7 +476,8 @@ def judge(item, found, ref):
         return proposal(item, TO_CHECK, None, '%s: the drone\'s reference outputs are missing, nothing was '
                         'compared' % where, page=found['page'], passage=found['text'])
     checks, points, doubts, rule = JUDGES[item](found['text'], ref, table=found['how'] == 'table')
-    doubts = list(found['doubts']) + list(doubts)
+    doubts = list(found['doubts']) + list(doubts) + [
+        'the %s check cannot say (%s): counted as not met' % (c['name'], c['detail']) for c in checks if c['ok'] is None]
     state = TO_CHECK if doubts else PROPOSED
     evidence = '%s: %s; rule %s: %s -> %s%s' % (where, _summary(checks), item, rule, shown_number(points),
                                                '; to check: %s' % '; '.join(doubts) if doubts else '')
