@@ -424,6 +424,20 @@ def test_a_page_footer_is_no_heading(ref):
         assert found['Q4'] is None and found['Q5']['text'].startswith('rien'), footer
 
 
+def test_a_report_numbered_its_own_way_is_to_check(ref):
+    """A report that numbers its answers 1 to 6 (the preparation left out): its "4." holds question 7's
+    command, said and to check, never judged silently as question 4's."""
+    text = '\n'.join(['1. rosnode list', '/mydrone', '/rosout', 'Two nodes run: the drone and rosout.',
+                      '4. rosmsg show std_msgs/Float32', 'float32 data', 'A single float field named data.',
+                      '5. rostopic echo /temperature', 'data: 2.8', '---', 'They come at 0.78 Hz here.',
+                      '6. catkin_create_pkg exam rospy std_msgs mydrone', 'This makes the exam package.'])
+    proposals = by_item(answers.report_proposals(report(page(text)), ref))
+    for item, other in (('Q4', 'Q7'), ('Q5', 'Q8'), ('Q6', 'Q9')):
+        assert proposals[item]['state'] == 'to check', proposals[item]
+        assert 'commands are those of %s, not of %s' % (other, item) in proposals[item]['evidence']
+    assert 'numbered its own way' not in by_item(answers.report_proposals(english_report(), ref))['Q8']['evidence']
+
+
 def test_without_the_reference_every_answer_is_to_check():
     proposals = answers.report_proposals(english_report(), None)
     assert [p['state'] for p in proposals] == ['to check'] * 6 and all(p['points'] is None for p in proposals)

@@ -450,6 +450,21 @@ def _q9(passage, ref, table=False):
 
 
 JUDGES = {'Q4': _q4, 'Q5': _q5, 'Q6': _q6, 'Q7': _q7, 'Q8': _q8, 'Q9': _q9}
+#: The command each question asks for: a passage holding another question's and none of its own is
+#: likely that question's answer (a report numbered its own way: "1." for the sheet's question 4).
+SIGNATURES = {'Q4': r'rosnode\s+list', 'Q5': r'rosnode\s+info', 'Q6': r'rostopic\s+list',
+              'Q7': r'rostopic\s+(?:type|info)|rosmsg\s+(?:info|show)', 'Q8': r'rostopic\s+(?:echo|hz)',
+              'Q9': r'catkin_create_pkg'}
+
+
+def _elsewhere(item, passage):
+    """Why the passage of ``item`` may be another question's, or None."""
+    said = commands_of(passage)
+    if not said or any(re.match(SIGNATURES[item], c) for c in said):
+        return None
+    others = [other for other in QUESTIONS if other != item and any(re.match(SIGNATURES[other], c) for c in said)]
+    return 'its commands are those of %s, not of %s: is the report numbered its own way?' % (
+        ' and '.join(others), item) if others else None
 
 
 def proposal(item, state, points, evidence, checks=(), page=None, passage=''):
@@ -476,7 +491,7 @@ def judge(item, found, ref):
         return proposal(item, TO_CHECK, None, '%s: the drone\'s reference outputs are missing, nothing was '
                         'compared' % where, page=found['page'], passage=found['text'])
     checks, points, doubts, rule = JUDGES[item](found['text'], ref, table=found['how'] == 'table')
-    doubts = list(found['doubts']) + list(doubts) + [
+    doubts = list(found['doubts']) + [why for why in [_elsewhere(item, found['text'])] if why] + list(doubts) + [
         'the %s check cannot say (%s): counted as not met' % (c['name'], c['detail']) for c in checks if c['ok'] is None]
     state = TO_CHECK if doubts else PROPOSED
     evidence = '%s: %s; rule %s: %s -> %s%s' % (where, _summary(checks), item, rule, shown_number(points),
