@@ -280,6 +280,20 @@ def test_q6_a_rosout_explanation_without_logging_is_0_to_check(ref):
     assert proposal['points'] == 0.0 and proposal['state'] == 'to check'
 
 
+@pytest.mark.parametrize('sentence, points, state', [
+    ('rosout is used to send messages between nodes.', 0.0, 'to check'),
+    ('/rosout permet aux nœuds de communiquer entre eux avec des messages.', 0.0, 'to check'),
+    ('/rosout est le topic où les nœuds publient leurs messages.', 0.0, 'to check'),
+    ('/rosout: standard output of the nodes, like stdout.', 1.0, 'proposed'),
+    ('The /rosout topic collects the logs (rospy.loginfo) of all nodes.', 1.0, 'proposed'),
+])
+def test_q6_messages_alone_or_between_nodes_is_no_logging_role(ref, sentence, points, state):
+    """/rosout carries the nodes' log messages: "messages between nodes" is the wrong role, "messages"
+    alone may be either; both to check, never 1 proposed."""
+    proposal = one('Q6', out('altitude', 'rostopic_list') + '\n' + sentence, ref)
+    assert (proposal['points'], proposal['state']) == (points, state), proposal['evidence']
+
+
 def test_q7_the_type_half_without_a_comment(ref):
     assert one('Q7', out('altitude', 'rosmsg_info'), ref)['points'] == 0.5
     assert one('Q7', out('altitude', 'rosmsg_info') + '\nThe message holds a single float named data.',

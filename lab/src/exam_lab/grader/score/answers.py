@@ -242,7 +242,12 @@ def _q5(passage, ref, table=False):
 
 
 #: Words of an explanation of /rosout's role (a log), French and English.
-ROSOUT_ROLE = r'\blog|journal|messages?\b|console|debug|erreur|error|warn|info|centralis|agr[eé]g|aggreg|trace'
+ROSOUT_ROLE = r'\blog|journal|console|debug|erreur|error|warn|\binfo|centralis|agr[eé]g|aggreg|trace|stdout|' \
+    r'standard output|sortie standard'
+#: "Messages" alone: right when they are the nodes' log messages, which the sentence does not say.
+ROSOUT_VAGUE = r'\bmessages?\b'
+#: /rosout said to carry the nodes' exchanges with each other (it carries their logs to rosout).
+ROSOUT_WRONG = r'between (?:the )?nodes|entre (?:les )?n(?:œ|oe|o)uds|entre eux|communiqu|communicat|[eé]chang'
 
 
 def _q6(passage, ref, table=False):
@@ -255,16 +260,23 @@ def _q6(passage, ref, table=False):
     if not about:  # "Ce topic sert à ..." right after /rosout is named: any own sentence then
         about = own_sentences(passage, 'Q6')
     role = [s for s in about if re.search(ROSOUT_ROLE, s, re.I)]
+    vague = [s for s in about if re.search(ROSOUT_VAGUE, s, re.I)]
+    wrong = [s for s in role or vague if re.search(ROSOUT_WRONG, s, re.I)]
     rosout = named_check('rosout role', bool(role), '"%s"' % _quote(role[0]) if role else
                     ('"%s": no word of logging in it' % _quote(about[0]) if about else '/rosout\'s role not explained'))
     doubts = []
+    if wrong:
+        doubts.append('"%s" says /rosout carries the nodes\' exchanges with each other (it carries their log '
+                      'messages): may be a wrong explanation' % _quote(wrong[0]))
     if role:
         points, rule = 1.0, '/rosout explained: 1'
         if not (command['ok'] and topics['ok']):
             doubts.append('the command or the topics are missing')
     else:
         points, rule = 0.0, '/rosout not explained (or wrongly): 0'
-        if about:
+        if vague and not wrong:
+            doubts.append('"%s" says messages, not log messages: right if it means the nodes\' logs' % _quote(vague[0]))
+        elif about and not wrong:
             doubts.append('an explanation of /rosout with no word of logging: may be right in other words')
     return [command, topics, rosout], points, doubts, rule
 
