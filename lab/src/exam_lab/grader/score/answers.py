@@ -21,7 +21,8 @@ import re
 
 from exam_lab.grader.score.reference import AVERAGE_RATE
 from exam_lab.grader.score.report_tables import continued, table_rows
-from exam_lab.grader.score.report_text import SENTENCE_WORDS, commands_of, own_sentences
+from exam_lab.grader.score.report_text import (SENTENCE_WORDS, commands_of, number, own_sentences, stated_periods,
+                                                stated_rates)
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
 #: The report's questions the grader looks for.
@@ -305,50 +306,12 @@ def _q7(passage, ref, table=False):
     return checks, 1.0 if comment['ok'] else 0.5, doubts, 'the type: 1, half without a comment'
 
 
-#: A rate stated in words: "0.77 Hz", "0,78Hz", "à 2 hertz", "2 messages par seconde", "rate of 0.78",
-#: "a frequency of 0.78".
-_RATE = re.compile(r'(\d+(?:[.,]\d+)?)\s*(?:hz|hertz|messages?\s*(?:par|per|/)\s*s(?:econde?)?|/\s*s\b|fois\s+par\s+seconde)',
-                   re.I)
-_RATE_WORD = re.compile(r'(?:rate|fr[ée]quen(?:ce|cy)|d[ée]bit|taux|rythme)\D{0,25}?(\d+(?:[.,]\d+)?)(?![\d.,]*\d)(?!\s*(?:s\b|sec))',
-                        re.I)
-#: A rate stated as its period: "every 1.3 seconds", "toutes les 1,29 s", "a period of 1.29 s", "1.3 s
-#: between two messages".
-_PERIOD = re.compile(r'(?:every|each|toutes\s+les|chaque|p[ée]riod[e]?\D{0,40}?)\s*(\d+(?:[.,]\d+)?)\s*'
-                     r'(?:s\b|sec\b|secs\b|seconds?|secondes?)'
-                     r'|(\d+(?:[.,]\d+)?)\s*(?:s|sec|seconds?|secondes?)\s+(?:between|entre)\b', re.I)
 #: A stated rate within this share of the real one is right (the drone's own hz varies by a few %).
 RATE_TOLERANCE = 0.1
 
 
 def _close(value, target):
     return target is not None and target > 0 and abs(value - target) <= RATE_TOLERANCE * target
-
-
-def _number(text):
-    return float(text.replace(',', '.'))
-
-
-def stated_rates(sentences):
-    """The rates a passage's own sentences state (Hz), in order."""
-    found = []
-    for sentence in sentences:
-        for pattern in (_RATE, _RATE_WORD):
-            for m in pattern.finditer(sentence):
-                value = _number(m.group(1))
-                if value not in found:
-                    found.append(value)
-    return found
-
-
-def stated_periods(sentences):
-    """The periods (s) a passage's own sentences give for the rate ("every 1.3 seconds"), in order."""
-    found = []
-    for sentence in sentences:
-        for m in _PERIOD.finditer(sentence):
-            value = _number(m.group(1) or m.group(2))
-            if value > 0 and value not in found:
-                found.append(value)
-    return found
 
 
 def _rounded_to(value, target):
@@ -376,7 +339,7 @@ def _q8(passage, ref, table=False):
         m.group(1) for m in (re.match(r'rostopic\s+hz\s+(?:-\S+\s+(?:\d\S*\s+)?)*(\S+)', c)
                              for c in commands_of(passage)) if m)
         if name.startswith('/') or name in known and known[name]]
-    measured = [_number(r) for r in AVERAGE_RATE.findall(passage)]
+    measured = [number(r) for r in AVERAGE_RATE.findall(passage)]
     doubts = []
     if hz_topics and all(t != topic for t in hz_topics):
         doubts.append('rostopic hz was run on %s, not %s' % (', '.join(hz_topics), topic))

@@ -1,5 +1,6 @@
 """What in a passage of a report is the student's own: the commands pasted, the tools' output, the
-sentences of the student's (French or English), the sheet's question copied. Pure, no rospy.
+sentences of the student's (French or English), the sheet's question copied, the rates and periods
+those sentences state. Pure, no rospy.
 
 The one rule behind every "comment" and "explained" check of :mod:`exam_lab.grader.score.answers`
 (:func:`own_sentences`).
@@ -129,3 +130,44 @@ def _copied(words, statement):
         return False
     own = statement - set(_words(_SHEET_NAMES))  # the statement's words but the drones' names
     return len(words) - inside <= 1 or len(set(words) & own) >= 0.8 * len(own)
+
+
+#: A rate stated in words: "0.77 Hz", "0,78Hz", "à 2 hertz", "2 messages par seconde", "rate of 0.78",
+#: "a frequency of 0.78".
+_RATE = re.compile(r'(\d+(?:[.,]\d+)?)\s*(?:hz|hertz|messages?\s*(?:par|per|/)\s*s(?:econde?)?|/\s*s\b|fois\s+par\s+seconde)',
+                   re.I)
+_RATE_WORD = re.compile(r'(?:rate|fr[ée]quen(?:ce|cy)|d[ée]bit|taux|rythme)\D{0,25}?(\d+(?:[.,]\d+)?)(?![\d.,]*\d)(?!\s*(?:s\b|sec))',
+                        re.I)
+#: A rate stated as its period: "every 1.3 seconds", "toutes les 1,29 s", "a period of 1.29 s", "1.3 s
+#: between two messages".
+_PERIOD = re.compile(r'(?:every|each|toutes\s+les|chaque|p[ée]riod[e]?\D{0,40}?)\s*(\d+(?:[.,]\d+)?)\s*'
+                     r'(?:s\b|sec\b|secs\b|seconds?|secondes?)'
+                     r'|(\d+(?:[.,]\d+)?)\s*(?:s|sec|seconds?|secondes?)\s+(?:between|entre)\b', re.I)
+
+
+def number(text):
+    """A number as a student writes it, a decimal comma too (``0,78``)."""
+    return float(text.replace(',', '.'))
+
+
+def stated_rates(sentences):
+    """The rates a passage's own sentences state (Hz), in order."""
+    found = []
+    for sentence in sentences:
+        for pattern in (_RATE, _RATE_WORD):
+            for m in pattern.finditer(sentence):
+                value = number(m.group(1))
+                if value not in found:
+                    found.append(value)
+    return found
+
+
+def stated_periods(sentences):
+    """The periods (s) a passage's own sentences give for the rate ("every 1.3 seconds"), in order."""
+    found = []
+    for sentence in sentences:
+        for m in _PERIOD.finditer(sentence):
+            value = number(m.group(1) or m.group(2))
+            if value > 0 and value not in found:
+                found.append(value)
+    return found
