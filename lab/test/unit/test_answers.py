@@ -452,6 +452,19 @@ def test_a_report_numbered_its_own_way_is_to_check(ref):
     assert 'numbered its own way' not in by_item(answers.report_proposals(english_report(), ref))['Q8']['evidence']
 
 
+def test_a_question_named_in_a_sentence_is_no_heading(ref):
+    """"As in question 4, the drone must run first." refers to question 4 inside question 8's answer:
+    the passage goes on (its rate is read), and question 4 has one heading."""
+    text = '\n'.join(['Question 4', out('altitude', 'rosnode_list'), 'Two nodes run: the drone and rosout.',
+                      'Question 8', out('altitude', 'rostopic_echo'),
+                      'As in question 4, the drone must run first. The messages come at 0.78 Hz.'])
+    proposals = by_item(answers.report_proposals(report(page(text)), ref))
+    assert proposals['Q8']['points'] == 1.0 and proposals['Q8']['state'] == 'proposed', proposals['Q8']['evidence']
+    assert proposals['Q4']['state'] == 'proposed', proposals['Q4']['evidence']
+    for head in ('Réponse à la question 4', 'Partie 1 - Question 4', 'Answer to question 4:'):
+        assert answers.find_answers([page('%s\n%s' % (head, out('altitude', 'rosnode_list')))])['Q4'], head
+
+
 def test_without_the_reference_every_answer_is_to_check():
     proposals = answers.report_proposals(english_report(), None)
     assert [p['state'] for p in proposals] == ['to check'] * 6 and all(p['points'] is None for p in proposals)

@@ -46,13 +46,26 @@ _FOOTER = re.compile(r'^[ \t]*(?:(?:page|p\.)\s*\d{1,3}\b.*|[-–]\s*\d{1,3}\s*[
 
 def _headings(text):
     """``[(start, end, number, strong)]`` of the headings of a page's text (never a page's number)."""
-    found = [(m.start(), m.end(), int(m.group(1)), True) for m in _NAMED.finditer(text)]
+    found = [(m.start(), m.end(), int(m.group(1)), True) for m in _NAMED.finditer(text) if _heads(text, m)]
     taken = [(s, e) for s, e, _, _ in found] + [m.span() for m in _FOOTER.finditer(text)]
     for m in _BARE.finditer(text):
         group = 1 if m.group(1) else 2
         if not any(s <= m.start(group) < e for s, e in taken):
             found.append((m.start(group), m.end(), int(m.group(group)), False))
     return sorted(found)
+
+
+def _heads(text, match):
+    """Whether a question named by a word heads an answer: at its line's start or after a sentence's
+    end ("... rosout. Q5: ..."), or after a few words of a heading ("Réponse à la question 4", "Partie 1 -
+    Question 4") when its punctuation, nothing or a new sentence follows; not a reference in a sentence
+    ("As in question 4, the drone must run")."""
+    before = text[text.rfind('\n', 0, match.start()) + 1:match.start()]
+    if not before.strip() or re.search(r'[.!?;]\s*$', before):
+        return True
+    rest = text[match.end():].split('\n', 1)[0]
+    return len(before) <= 40 and (match.group(0).rstrip()[-1] in '.):-\u2013' or not rest.strip() or
+                                  rest.lstrip()[:1].isupper())
 
 
 def _page_label(page, several_files, files):
