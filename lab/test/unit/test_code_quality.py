@@ -80,3 +80,16 @@ def test_every_function_and_block_with_its_comment():
     good = package('good_student')
     units = code_quality.comment_units(source.student_code(good), good)
     assert 0 < sum(u['commented'] for u in units) < len(units)
+
+
+def test_a_comment_opening_a_block_counts_and_the_main_guard_is_no_block(tmp_path):
+    """"if ...:" then "# formula (1)" above its first statement is a commented block; ``if __name__ ==
+    '__main__':`` is not counted (no note asks to comment it)."""
+    (tmp_path / 'scripts').mkdir()
+    (tmp_path / 'scripts' / 'exam_node.py').write_text('\n'.join([
+        'import math', '', '', 'def main(x):', '    while x:', '        if x > 1:', '            # formula (1)',
+        '            x = math.log(x)', '        else:', '            x = 0', '', '', "if __name__ == '__main__':",
+        '    main(3)', '']))
+    units = code_quality.comment_units([str(tmp_path / 'scripts' / 'exam_node.py')], str(tmp_path))
+    assert [(u['line'], u['kind'], u['commented']) for u in units] == [
+        (4, 'function', True), (5, 'while', False), (6, 'if', True)]

@@ -53,11 +53,19 @@ def _comment_above(line, comments, text_lines):
     return above in comments and text_lines[above - 1].strip().startswith('#')
 
 
+def _main_guard(node):
+    """Whether ``node`` is ``if __name__ == '__main__':``, which no note asks to comment."""
+    test = getattr(node, 'test', None)
+    return isinstance(node, ast.If) and isinstance(test, ast.Compare) and isinstance(test.left, ast.Name) and \
+        test.left.id == '__name__'
+
+
 def comment_units(paths, package_dir):
     """Each function and each block (if/for/while/with/try) of the student's code, commented or not:
     ``[{"file", "line", "kind", "name", "commented"}]``. A function is commented when it has a
     docstring, a comment just above its ``def`` or one in its body; a block when a comment is on its
-    first line, just above it, or on the first line of its body. What the notes call "commenté
+    first line, just above it, or before or on the first statement of its body (``if __name__ ==
+    '__main__':`` is no block to comment). What the notes call "commenté
     partout" is then every unit commented, not a share of lines: ten comments on the imports and none
     in the callbacks is not a commented node."""
     units = []
@@ -74,10 +82,11 @@ def comment_units(paths, package_dir):
                 commented = bool(ast.get_docstring(node)) or inside or _comment_above(node.lineno, comments, text_lines)
                 units.append({'file': f.rel, 'line': node.lineno, 'kind': 'function', 'name': node.name,
                               'commented': commented})
-            elif isinstance(node, _BLOCKS):
+            elif isinstance(node, _BLOCKS) and not _main_guard(node):
                 first_body = node.body[0].lineno if node.body else node.lineno
-                commented = _comment_above(node.lineno, comments, text_lines) or first_body in comments \
-                    or first_body in strings
+                # a comment on its line, just above it, or from its line to its body's first statement
+                commented = _comment_above(node.lineno, comments, text_lines) or first_body in strings or \
+                    any(n in comments for n in range(node.lineno, first_body + 1))
                 units.append({'file': f.rel, 'line': node.lineno, 'kind': type(node).__name__.lower(),
                               'name': '', 'commented': commented})
     units.sort(key=lambda u: (u['file'], u['line']))
