@@ -465,6 +465,19 @@ def test_a_question_named_in_a_sentence_is_no_heading(ref):
         assert answers.find_answers([page('%s\n%s' % (head, out('altitude', 'rosnode_list')))])['Q4'], head
 
 
+def test_a_running_header_or_footer_is_no_comment(ref):
+    """A word processor's header ("ROS exam report, John Smith") and footer ("John Smith - page 2") on
+    every page fall inside an answer that runs onto the next page: never its comment. The headings at
+    two pages' tops, commands and output stay."""
+    head, foot = 'ROS exam report, John Smith', 'John Smith - page %d'
+    pages = [page('\n'.join([head, 'Question 4', '$ rosnode list', foot % 1]), 1),
+             page('\n'.join([head, '/mydrone', '/rosout', 'Question 5', 'rien', foot % 2]), 2),
+             page('\n'.join([head, 'Question 6', '$ rostopic list', foot % 3]), 3)]
+    proposals = by_item(answers.report_proposals(report(*pages), ref))
+    assert proposals['Q4']['points'] == 0.5 and check(proposals['Q4'], 'comment') is False, proposals['Q4']['evidence']
+    assert check(proposals['Q6'], 'command') is True and proposals['Q5']['passage'] == 'rien'
+
+
 def test_without_the_reference_every_answer_is_to_check():
     proposals = answers.report_proposals(english_report(), None)
     assert [p['state'] for p in proposals] == ['to check'] * 6 and all(p['points'] is None for p in proposals)

@@ -21,8 +21,8 @@ import re
 
 from exam_lab.grader.score.reference import AVERAGE_RATE
 from exam_lab.grader.score.report_tables import continued, table_rows
-from exam_lab.grader.score.report_text import (SENTENCE_WORDS, commands_of, number, own_sentences, stated_periods,
-                                                stated_rates)
+from exam_lab.grader.score.report_text import (SENTENCE_WORDS, commands_of, number, own_sentences, running_lines,
+                                                stated_periods, stated_rates)
 from exam_lab.grader.score.sheets import HAND_ITEMS
 
 #: The report's questions the grader looks for.
@@ -87,9 +87,12 @@ def find_answers(pages, files=()):
     appears twice takes its first passage, and is to check."""
     several = len({p.get('file', 0) for p in pages}) > 1
     text, starts = '', []
+    # a page's running header or footer is no sentence of an answer (a heading at two pages' tops stays)
+    running = {line for line in running_lines([page.get('text') for page in pages]) if not _headings(line)}
     for page in pages:
         starts.append(len(text))
-        text += (page.get('text') or '') + '\n\f\n'
+        lines = (page.get('text') or '').split('\n')
+        text += '\n'.join('' if line.strip() in running else line for line in lines) + '\n\f\n'
     tables = [table_rows(page.get('layout') or '') for page in pages]
     for index in range(len(tables) - 1):  # a table's last row going on at the next page's top
         more = continued(pages[index + 1].get('layout') or '') if tables[index] else ''

@@ -40,6 +40,24 @@ def _first_word(line):
     return words[0] if words else ''
 
 
+def running_lines(texts, edge=3):
+    """The lines a word processor repeats at the top or the foot of the pages ``texts`` (a running
+    header "ROS exam report, John Smith", a footer "Jane Doe - page 2"): among the first or last ``edge``
+    lines of two pages or more, the same but for their numbers; never a command or a line of output."""
+    seen = {}
+    for text in texts:
+        lines = [line.strip() for line in (text or '').splitlines() if line.strip()]
+        for line in set(lines[:edge] + lines[-edge:]):
+            if not is_command(line) and not _OUTPUT.match(line):
+                seen.setdefault(re.sub(r'\d+', '#', line), set()).add(line)
+    counts = {}
+    for text in texts:
+        lines = [line.strip() for line in (text or '').splitlines() if line.strip()]
+        for key in {re.sub(r'\d+', '#', line) for line in lines[:edge] + lines[-edge:]}:
+            counts[key] = counts.get(key, 0) + 1
+    return {line for key, lines in seen.items() if counts.get(key, 0) >= 2 for line in lines}
+
+
 def is_command(line):
     """Whether a line is a command as pasted (a prompt, or a line starting with a course's tool)."""
     return bool(_PROMPT.match(line)) or _first_word(line) in _TOOLS
