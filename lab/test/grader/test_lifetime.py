@@ -21,7 +21,7 @@ import tempfile
 
 import pytest
 
-from exam_lab.harness.supervisor import MARKER, OWNER, descendants, marked, owner_mark
+from exam_lab.harness.supervisor import MARKER, OWNER, cmdline, descendants, marked, owner_mark
 from exam_lab.harness.wait import wait_until
 
 HERE = os.path.dirname(os.path.realpath(__file__))
@@ -40,18 +40,10 @@ pytestmark = pytest.mark.skipif(os.geteuid() != 0, reason='the judge\'s and the 
                                 '(docs/grading.md, "Isolation")')
 
 
-def _cmdline(pid):
-    try:
-        with open('/proc/%d/cmdline' % pid, 'rb') as f:
-            return f.read().replace(b'\0', b' ').decode('utf-8', 'replace')
-    except OSError:
-        return ''
-
-
 def flying(temp):
     """Whether the grading whose folders lie in ``temp`` flies its main run: its probe runs (after its
     master and the student's launch)."""
-    return any('exam_lab.grader.judge.probe' in _cmdline(pid) for pid in run_marked(temp))
+    return any('exam_lab.grader.judge.probe' in cmdline(pid) for pid in run_marked(temp))
 
 
 def _status(pid, field):
@@ -95,7 +87,7 @@ def left(mark, temp):
     its boxes (a bubblewrap that binds a folder of ``temp``) with every process in them."""
     found = set(marked(mark, OWNER) + run_marked(temp))
     for entry in os.listdir('/proc'):
-        if entry.isdigit() and _cmdline(int(entry)).startswith('bwrap ') and temp + '/' in _cmdline(int(entry)):
+        if entry.isdigit() and cmdline(int(entry)).startswith('bwrap ') and temp + '/' in cmdline(int(entry)):
             found.update([int(entry)] + descendants(int(entry)))
     return sorted(found)
 
@@ -122,7 +114,7 @@ def assert_nothing_left(proc, log, mark, temp, why):
     except subprocess.TimeoutExpired:
         status = None
     gone = wait_until(lambda: not left(mark, temp), GONE_S, period=0.2)
-    remaining = ['%d (parent %s, uid %s) %s' % (pid, _status(pid, 'PPid'), _status(pid, 'Uid'), _cmdline(pid)[:150])
+    remaining = ['%d (parent %s, uid %s) %s' % (pid, _status(pid, 'PPid'), _status(pid, 'Uid'), cmdline(pid)[:150])
                  for pid in left(mark, temp)]
     for pid in left(mark, temp):  # a failure leaves nothing behind either
         try:
@@ -156,7 +148,7 @@ def test_make_grade_stopped_by_ctrl_c_leaves_no_process(tmp_path, temp):
     argv = AS_FROM_A_TERMINAL + ['make', '-s', 'grade', 'SUBMISSION=%s' % GOOD, 'OUT=%s' % (tmp_path / 'out')]
 
     def grade(proc):
-        return next((pid for pid in descendants(proc.pid) if 'lab/scripts/grade.py' in _cmdline(pid)), None)
+        return next((pid for pid in descendants(proc.pid) if 'lab/scripts/grade.py' in cmdline(pid)), None)
     proc, log, mark = grading_of(argv, tmp_path, temp, grade)
     os.killpg(proc.pid, signal.SIGINT)
     status, output = assert_nothing_left(proc, log, mark, temp, 'Ctrl-C to make grade')
@@ -180,7 +172,7 @@ def test_a_class_stopped_by_ctrl_c_leaves_no_process(tmp_path, temp):
 def capture_master(temp):
     """Whether the reference capture's master runs (its Supervisor's folder in ``temp``): rosmaster itself,
     not the shell that starts it (whose script names it)."""
-    return any('rosmaster' in [os.path.basename(arg) for arg in _cmdline(pid).split()[:2]] for pid in run_marked(temp))
+    return any('rosmaster' in [os.path.basename(arg) for arg in cmdline(pid).split()[:2]] for pid in run_marked(temp))
 
 
 #: An owner as grade.py is, capturing the reference outputs of the altitude sheet's drone (what

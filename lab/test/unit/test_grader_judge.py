@@ -13,7 +13,7 @@ import pytest
 from exam_lab.grader.host import cgroups, limits, sandbox, uids
 from exam_lab.grader.host.run import uid_of
 from exam_lab.grader.judge import legs
-from exam_lab.harness.supervisor import Supervisor, descendants
+from exam_lab.harness.supervisor import Supervisor, cmdline, descendants
 from exam_lab.harness.wait import wait_until
 
 
@@ -67,14 +67,6 @@ def test_the_judge_is_a_user_of_its_own_in_its_cgroups(box):
         assert int(f.read()) == limits.MASTER_MEMORY_BYTES
 
 
-def _cmdline(pid):
-    try:
-        with open('/proc/%d/cmdline' % pid, 'rb') as f:
-            return f.read().replace(b'\0', b' ').decode('utf-8', 'replace')
-    except OSError:
-        return ''
-
-
 def test_the_master_runs_as_the_judge_not_root(box, tmp_path):
     """The master the session starts for the student's nodes: rosmaster and its rosout both have the
     judge's uid, and the master cgroup counts their memory."""
@@ -91,8 +83,8 @@ def test_the_master_runs_as_the_judge_not_root(box, tmp_path):
         # rosmaster (the process started), then rosout (its child, exec'd by the subshell that waits,
         # with short sleeps, for the master's port): waited for by its name, so that a sleep listed then
         # gone is no owner
-        assert wait_until(lambda: any('__name:=rosout' in _cmdline(pid) for pid in descendants(master.proc.pid)),
-                          30.0, period=0.1), [_cmdline(pid) for pid in descendants(master.proc.pid)]
+        assert wait_until(lambda: any('__name:=rosout' in cmdline(pid) for pid in descendants(master.proc.pid)),
+                          30.0, period=0.1), [cmdline(pid) for pid in descendants(master.proc.pid)]
         family = [master.proc.pid] + descendants(master.proc.pid)
         owners = {pid: uid for pid, uid in ((pid, uid_of(pid)) for pid in family) if uid is not None}
         assert len(owners) >= 2 and set(owners.values()) == {box.judge_uid}, owners

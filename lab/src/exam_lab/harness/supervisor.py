@@ -114,6 +114,15 @@ def workspace_env(setup_script, base=None, timeout=60.0):
     return {name: value for name, value in sourced.items() if name not in ('_', 'SHLVL', 'PWD', 'OLDPWD')}
 
 
+def cmdline(pid):
+    """The command line of process ``pid``, its arguments joined by spaces; '' once it is gone."""
+    try:
+        with open('/proc/%d/cmdline' % pid, 'rb') as f:
+            return f.read().replace(b'\0', b' ').decode('utf-8', 'replace')
+    except OSError:
+        return ''
+
+
 def descendants(pid):
     """Pids of every living descendant of ``pid``, from the parent links in /proc."""
     children = {}
